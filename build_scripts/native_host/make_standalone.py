@@ -1,0 +1,305 @@
+"""Make a pythonfmu FMU loadable by plain C/C++ FMI 2.0 hosts (Linux x86_64).
+
+pythonfmu's Linux binary does not link libpython, so outside a Python process
+``dlopen`` fails with ``undefined symbol: _Py_NoneStruct``. This module
+post-processes a built FMU, in place:
+
+* ``binaries/linux64/<id>.so`` (pythonfmu) is renamed ``<id>_pythonfmu.so``;
+* a small C shim compiled from ``fmi2_shim.c`` takes its place. It exports all
+  FMI 2.0 co-simulation functions. In a process without Python it loads the
+  libpython recorded below (RTLD_GLOBAL), starts the interpreter on the build
+  environment (venv), checks the required modules and then forwards every call
+  to the pythonfmu binary. In a Python host (fmpy, libcosimpy) it forwards
+  without touching the running interpreter;
+* ``resources/python_env.txt`` records the interpreter: libpython, executable,
+  home (base prefix), site-packages directories and required modules.
+
+Windows binaries are left unchanged. Running it again on an already processed
+FMU rebuilds the shim and the configuration file.
+
+Usage::
+
+    from make_standalone import make_standalone
+    make_standalone(Path("build/Model.fmu"))            # this interpreter / venv
+
+    python build_scripts/native_host/make_standalone.py build/Model.fmu \
+        [--python /path/to/venv/bin/python] [--require numpy --require scipy]
+"""
+from __future__ import annotations
+
+import argparse
+import ast
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import warnings
+import zipfile
+from pathlib import Path
+from typing import Iterable, Optional, Sequence
+from xml.etree import ElementTree
+
+HERE = Path(__file__).resolve().parent
+SHIM_SOURCE = HERE / "fmi2_shim.c"
+CONFIG_NAME = "python_env.txt"  # must match SHIM_CONFIG_NAME in fmi2_shim.c
+REAL_SUFFIX = "_pythonfmu"
+
+__all__ = ["make_standalone", "StandaloneError", "describe_interpreter"]
+
+
+class StandaloneError(RuntimeError):
+    """The FMU cannot be made standalone (missing compiler, static Python, ...)."""
+
+
+# Runs inside the target interpreter: everything the shim needs to know about it.
+_PROBE = r"""
+import importlib.util, json, os, platform, site, sys, sysconfig
+cv = sysconfig.get_config_var
+libdir = cv('LIBDIR') or ''
+dirs = [libdir, os.path.join(libdir, cv('MULTIARCH') or ''), cv('LIBPL') or '',
+        os.path.join(sys.base_prefix, 'lib')]
+names = [n for n in (cv('INSTSONAME'), cv('LDLIBRARY')) if n and '.so' in n]
+names.append('libpython%d.%d.so.1.0' % sys.version_info[:2])
+libpython = ''
+for n in names:
+    for d in dirs:
+        p = os.path.join(d, n)
+        if d and os.path.isfile(p):
+            libpython = p
+            break
+    if libpython:
+        break
+candidates = json.loads(sys.argv[1])
+found = {}
+for m in candidates:
+    try:
+        found[m] = importlib.util.find_spec(m) is not None
+    except Exception:
+        found[m] = False
+try:
+    sites = site.getsitepackages()
+except AttributeError:
+    sites = []
+if site.ENABLE_USER_SITE and os.path.isdir(site.getusersitepackages()):
+    sites.append(site.getusersitepackages())
+print(json.dumps(dict(
+    version=platform.python_version(),
+    executable=sys.executable,
+    prefix=sys.prefix,
+    base_prefix=sys.base_prefix,
+    libpython=libpython,
+    shared=bool(cv('Py_ENABLE_SHARED')),
+    include=sysconfig.get_paths().get('include', ''),
+    site=[s for s in sites if os.path.isdir(s)],
+    stdlib=sorted(getattr(sys, 'stdlib_module_names', ())),
+    importable=found,
+)))
+"""
+
+
+def describe_interpreter(python_executable: str, candidate_modules: Iterable[str] = ()) -> dict:
+    """Ask ``python_executable`` for its libpython, prefixes, site-packages, ..."""
+    out = subprocess.run(
+        [python_executable, "-c", _PROBE, json.dumps(sorted(set(candidate_modules)))],
+        check=True,
+        capture_output=True,
+        text=True,
+    ).stdout
+    return json.loads(out)
+
+
+def _model_identifier(model_description: bytes) -> str:
+    root = ElementTree.fromstring(model_description)
+    cs = root.find("CoSimulation")
+    if cs is None:
+        raise StandaloneError("modelDescription.xml has no <CoSimulation> element")
+    return cs.attrib["modelIdentifier"]
+
+
+def _imported_top_level_modules(sources: Iterable[bytes]) -> set[str]:
+    names: set[str] = set()
+    for src in sources:
+        try:
+            tree = ast.parse(src)
+        except SyntaxError:
+            continue
+        for node in ast.walk(tree):
+            if isinstance(node, ast.Import):
+                names.update(alias.name.split(".")[0] for alias in node.names)
+            elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
+                names.add(node.module.split(".")[0])
+    return names
+
+
+def _detect_requirements(entries: dict[str, bytes]) -> set[str]:
+    """Top-level modules imported by the Python files in resources/ that the
+    FMU does not ship itself (stdlib filtering happens in the interpreter)."""
+    sources = [
+        data
+        for name, data in entries.items()
+        if name.startswith("resources/") and name.endswith(".py") and not name.startswith("resources/pythonfmu/")
+    ]
+    shipped = set()
+    for name in entries:
+        if name.startswith("resources/"):
+            first = name[len("resources/"):].split("/")[0]
+            shipped.add(first[:-3] if first.endswith(".py") else first)
+    return _imported_top_level_modules(sources) - shipped - {"pythonfmu", "__future__"}
+
+
+def _config_text(info: dict, requires: Sequence[str]) -> str:
+    lines = [
+        "# Written by build_scripts/native_host/make_standalone.py.",
+        "# Read by the FMU's binaries/linux64 shim when the host process has no Python",
+        "# (plain C/C++ FMI hosts). Edit the paths to move the FMU to another Python",
+        f"# {'.'.join(info['version'].split('.')[:2])} installation; ignored inside Python hosts (fmpy, libcosimpy).",
+        f"python_version={info['version']}",
+        f"libpython={info['libpython']}",
+        f"executable={info['executable']}",
+        f"home={info['base_prefix']}",
+        "use_environment=0",
+    ]
+    lines += [f"site={s}" for s in info["site"]]
+    if requires:
+        lines.append("require=" + ",".join(requires))
+    return "\n".join(lines) + "\n"
+
+
+def _compile_shim(output: Path, real_name: str, include_dir: str, compiler: str) -> None:
+    cmd = [
+        compiler,
+        "-shared",
+        "-fPIC",
+        "-O2",
+        "-fvisibility=hidden",
+        f'-DSHIM_REAL_BINARY="{real_name}"',
+        f'-DSHIM_CONFIG_NAME="{CONFIG_NAME}"',
+    ]
+    if include_dir and (Path(include_dir) / "Python.h").is_file():
+        cmd += ["-DSHIM_HAVE_PYTHON_H", f"-I{include_dir}"]
+    cmd += [str(SHIM_SOURCE), "-o", str(output), "-ldl", "-lpthread"]
+    proc = subprocess.run(cmd, capture_output=True, text=True)
+    if proc.returncode != 0:
+        raise StandaloneError(f"compiling the FMI shim failed:\n{' '.join(cmd)}\n{proc.stderr}")
+
+
+def make_standalone(
+    fmu_path: Path,
+    python_executable: str = sys.executable,
+    *,
+    required_modules: Optional[Sequence[str]] = None,
+    compiler: str = "gcc",
+) -> None:
+    """Rewrite the FMU zip at ``fmu_path`` in place so that its Linux binary
+    also runs in hosts without Python (see the module docstring).
+
+    ``python_executable`` is the interpreter (typically the venv's python) the
+    FMU will use in such hosts; its libpython, prefixes and site-packages are
+    recorded. ``required_modules`` are checked at instantiation for a clear
+    error message; by default they are the non-stdlib top-level modules
+    imported by the FMU's Python files that are importable at build time.
+    """
+    fmu_path = Path(fmu_path)
+    if not sys.platform.startswith("linux"):
+        raise StandaloneError("make_standalone builds a Linux x86_64 shim and must run on Linux")
+    if shutil.which(compiler) is None:
+        raise StandaloneError(f"C compiler '{compiler}' not found (install gcc)")
+    if not SHIM_SOURCE.is_file():
+        raise StandaloneError(f"shim source missing: {SHIM_SOURCE}")
+
+    with zipfile.ZipFile(fmu_path) as zin:
+        infos = zin.infolist()
+        entries = {i.filename: zin.read(i.filename) for i in infos}
+
+    model_id = _model_identifier(entries["modelDescription.xml"])
+    shim_name = f"binaries/linux64/{model_id}.so"
+    real_name = f"binaries/linux64/{model_id}{REAL_SUFFIX}.so"
+    if real_name in entries:  # already processed: rebuild shim and config
+        real_binary = entries[real_name]
+    elif shim_name in entries:
+        real_binary = entries[shim_name]
+    else:
+        raise StandaloneError(f"{fmu_path} has no {shim_name}")
+    if b"Py_IsInitialized" not in real_binary:
+        raise StandaloneError(f"{shim_name} does not look like a pythonfmu binary")
+
+    candidates = _detect_requirements(entries) if required_modules is None else set()
+    info = describe_interpreter(python_executable, candidates)
+    if not info["libpython"]:
+        raise StandaloneError(
+            f"{python_executable} (Python {info['version']}) has no shared libpython "
+            f"(Py_ENABLE_SHARED={info['shared']}); a standalone FMU needs an interpreter built with "
+            "--enable-shared (pyenv: PYTHON_CONFIGURE_OPTS=--enable-shared, Debian: libpython3.X package)"
+        )
+    if required_modules is None:
+        stdlib = set(info["stdlib"])
+        requires = sorted(m for m in candidates if m not in stdlib and info["importable"].get(m))
+        unresolved = sorted(m for m in candidates if m not in stdlib and not info["importable"].get(m))
+        if unresolved:
+            warnings.warn(
+                f"{fmu_path.name}: modules imported by the FMU's Python code are not importable by "
+                f"{info['executable']}: {', '.join(unresolved)} (ignored if optional imports; otherwise the "
+                "FMU will fail to instantiate in hosts without Python)",
+                stacklevel=2,
+            )
+    else:
+        requires = list(dict.fromkeys(required_modules))
+
+    with tempfile.TemporaryDirectory(prefix="fmi2shim_") as tmp:
+        shim_so = Path(tmp) / f"{model_id}.so"
+        _compile_shim(shim_so, f"{model_id}{REAL_SUFFIX}.so", info["include"], compiler)
+        shim_binary = shim_so.read_bytes()
+
+    new_entries: dict[str, bytes] = {}
+    order: list[zipfile.ZipInfo] = []
+    for zi in infos:
+        if zi.filename in (shim_name, real_name, f"resources/{CONFIG_NAME}"):
+            continue
+        order.append(zi)
+        new_entries[zi.filename] = entries[zi.filename]
+
+    def add(name: str, data: bytes, mode: int) -> None:
+        zi = zipfile.ZipInfo(name, date_time=(1980, 1, 1, 0, 0, 0))
+        zi.compress_type = zipfile.ZIP_DEFLATED
+        zi.external_attr = (0o100000 | mode) << 16
+        order.append(zi)
+        new_entries[name] = data
+
+    add(shim_name, shim_binary, 0o755)
+    add(real_name, real_binary, 0o755)
+    add(f"resources/{CONFIG_NAME}", _config_text(info, requires).encode("utf-8"), 0o644)
+
+    fd, tmp_name = tempfile.mkstemp(prefix=fmu_path.name, suffix=".tmp", dir=fmu_path.parent)
+    os.close(fd)
+    try:
+        with zipfile.ZipFile(tmp_name, "w", zipfile.ZIP_DEFLATED) as zout:
+            for zi in order:
+                zout.writestr(zi, new_entries[zi.filename])
+        os.replace(tmp_name, fmu_path)
+    except BaseException:
+        Path(tmp_name).unlink(missing_ok=True)
+        raise
+
+
+def main(argv: Optional[Sequence[str]] = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("fmu", type=Path, nargs="+", help="FMU file(s) built by pythonfmu, rewritten in place")
+    parser.add_argument("--python", default=sys.executable, help="interpreter (venv python) to record")
+    parser.add_argument(
+        "--require",
+        action="append",
+        default=None,
+        help="module that must import at instantiation (repeatable; default: detected from the FMU's imports)",
+    )
+    parser.add_argument("--cc", default="gcc", help="C compiler")
+    args = parser.parse_args(argv)
+    for fmu in args.fmu:
+        make_standalone(fmu, args.python, required_modules=args.require, compiler=args.cc)
+        print(f"{fmu}: standalone shim added ({CONFIG_NAME} records {args.python})")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,31 @@
+"""restitution: apparent coefficient of restitution of a sphere hitting a plate of finite
+thickness, after I. Green, Nonlinear Dyn (2022): the Jackson-Green-Marghitu elastoplastic
+model (Eqs. 1-8) fused with Zener's plate-wave model (Eqs. 9-13a) by Eq. (20).
+
+Plain numpy/scipy functions; nothing here knows about FMI. Start with :func:`impact`.
+"""
+from .fusion import apparent_restitution, equivalent_plate_mass, velocities_after_impact
+from .jgm import (critical_velocity, effective_modulus, poisson_coefficient, restitution_e44,
+                  restitution_e45, yield_strain)
+from .materials import (BRITTLE_SY, MATERIALS, TABLE1_CASES, TABLE4_CASES, Material, Plate, Sphere,
+                        table4_case)
+from .model import EFFECT_MODES, RESTITUTION_MODELS, ImpactResult, impact
+from .zener import (TAU0_HERTZ, ZENER_METHODS, inelasticity_parameter, zener_linear, zener_paper_fit,
+                    zener_restitution)
+
+__version__ = "0.1.0"
+
+
+def impact_between(sphere: Sphere, plate: Plate, v, **options) -> ImpactResult:
+    """:func:`impact` for a :class:`Sphere` and a :class:`Plate` at approach speed ``v`` [m/s]."""
+    return impact(v, **sphere.params(), **plate.params(), **options)
+
+
+__all__ = [
+    "impact", "impact_between", "ImpactResult", "Material", "Sphere", "Plate", "MATERIALS",
+    "TABLE1_CASES", "TABLE4_CASES", "table4_case", "BRITTLE_SY", "RESTITUTION_MODELS",
+    "ZENER_METHODS", "EFFECT_MODES", "TAU0_HERTZ", "apparent_restitution", "equivalent_plate_mass",
+    "velocities_after_impact", "critical_velocity", "effective_modulus", "poisson_coefficient",
+    "restitution_e44", "restitution_e45", "yield_strain", "inelasticity_parameter",
+    "zener_linear", "zener_paper_fit", "zener_restitution", "__version__",
+]

@@ -1,0 +1,9 @@
+"""Host-side helpers that drive the project's FMUs through fmpy (needs the ``fmu`` extra).
+
+Nothing in the physics modules imports this subpackage.
+"""
+from .bouncing import Bounces, bounce, fmu_rebound, package_rebound
+from .fmu import FmiStatusError, FmuInstance, build_default_fmu, impact_fmu_parameters
+
+__all__ = ["FmuInstance", "FmiStatusError", "build_default_fmu", "impact_fmu_parameters",
+           "Bounces", "bounce", "fmu_rebound", "package_rebound"]

@@ -1,0 +1,149 @@
+"""An event-exact bouncing-ball master: a sphere dropped onto a plate, bouncing again and again.
+
+Free flight under gravity is integrated in closed form, each impact instant is located
+exactly (the root of h(t) = 0), the impact model is asked for the rebound at that instant,
+and flight resumes. Impacts are instantaneous (the contact duration, tens of microseconds,
+is reported but not spent): the classic rigid-impact bouncing ball.
+
+Stop rule: the ball is at rest when the rebound speed falls below ``v_min`` (default
+0.1 m/s, as the ``v_min`` of the Modelica Reference FMU BouncingBall) or when e <= 0 (the
+sphere stays with the plate). With this model e -> 1 as the speed -> 0 (no plasticity
+below V_c, lambda ~ v^(1/5)), so the ideal bounce sequence is Zeno-like: the stop rule,
+not the physics, ends it. ``max_bounces`` is a last guard.
+
+fmpy's ``simulate_fmu`` has no events in co-simulation (FMI-NOTES.md), hence this master
+on ``fmpy.fmi2.FMU2Slave`` (through :class:`~restitution.cosim.fmu.FmuInstance`).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+__all__ = ["Bounces", "bounce", "fmu_rebound", "package_rebound", "RECORDED", "STANDARD_GRAVITY"]
+
+STANDARD_GRAVITY = 9.80665  # [m/s^2]
+
+#: FMU output name -> record field, read at every impact.
+RECORDED = {
+    "e": "e", "jgm.e": "e_ep", "zener.e": "e_ze", "zener.lambda": "lam", "zener.tau0": "tau0",
+    "zener.t_contact": "t_contact", "v_rebound": "v_rebound",
+}
+
+
+@dataclass
+class Bounces:
+    """Every impact of one drop; arrays are indexed by impact number. Units in brackets."""
+
+    time: np.ndarray  #: impact instants [s]
+    v_approach: np.ndarray  #: approach speeds [m/s]
+    e: np.ndarray  #: apparent COR [1]
+    e_ep: np.ndarray  #: elastoplastic COR [1]
+    e_ze: np.ndarray  #: Zener COR [1]
+    lam: np.ndarray  #: Zener's lambda [1]
+    tau0: np.ndarray  #: dimensionless contact time [1]
+    t_contact: np.ndarray  #: contact duration [s]
+    v_rebound: np.ndarray  #: rebound speeds [m/s]
+    apex: np.ndarray  #: apex height after each impact [m] (0 when the ball stays down)
+    rest_time: float  #: when the ball came to rest [s]
+    stop_reason: str  #: "v_min", "e<=0" or "max_bounces"
+    drop_height: float  #: [m]
+    gravity: float  #: [m/s^2]
+    extra: dict = field(default_factory=dict)
+
+    @property
+    def n_impacts(self) -> int:
+        return int(self.time.size)
+
+    def height(self, t):
+        """Height of the ball [m] at times ``t`` [s] (piecewise parabolas between impacts)."""
+        t = np.asarray(t, dtype=float)
+        g = self.gravity
+        starts = np.concatenate([[0.0], self.time])
+        v0 = np.concatenate([[0.0], self.v_rebound])
+        h0 = np.concatenate([[self.drop_height], np.zeros(self.time.size)])
+        k = np.clip(np.searchsorted(starts, t, side="right") - 1, 0, starts.size - 1)
+        dt = t - starts[k]
+        h = h0[k] + v0[k] * dt - 0.5 * g * dt * dt
+        h = np.where(t >= self.rest_time, 0.0, h)
+        return np.maximum(h, 0.0)
+
+
+def package_rebound(**options):
+    """Rebound function backed by :func:`restitution.impact` (options as for impact, incl. materials)."""
+    from ..model import impact
+
+    def rebound(v):
+        res = impact(v, **options)
+        return {"e": res.e, "e_ep": res.e_ep, "e_ze": res.e_ze, "lam": res.lam, "tau0": res.tau0,
+                "t_contact": res.t_contact, "v_rebound": res.v_rebound}
+    return rebound
+
+
+def fmu_rebound(instance):
+    """Rebound function backed by a SpherePlateImpact :class:`FmuInstance`.
+
+    At each impact: set ``v_approach``, read the outputs (direct feedthrough: valid right
+    after fmi2SetReal, no step needed). The master steps the FMU across each flight.
+    """
+    names = list(RECORDED)
+    fields_ = [RECORDED[n] for n in names]
+    vr_in = instance.vr("v_approach")
+    vrs = [instance.vr(n) for n in names]
+    slave = instance.slave
+
+    def rebound(v):
+        slave.setReal([vr_in], [v])
+        return dict(zip(fields_, slave.getReal(vrs)))
+
+    def advance(t, dt):
+        if dt > 0.0:
+            instance.do_step(t, dt)
+
+    rebound.advance = advance
+    return rebound
+
+
+def bounce(rebound, drop_height: float, gravity: float = STANDARD_GRAVITY, v_min: float = 0.1,
+           max_bounces: int = 100_000) -> Bounces:
+    """Drop a ball from ``drop_height`` [m] and bounce it until it rests (see module doc).
+
+    ``rebound(v_approach) -> dict`` gives e, e_ep, e_ze, lam, tau0, t_contact, v_rebound
+    for an impact at speed v [m/s]; :func:`fmu_rebound` and :func:`package_rebound` make one.
+    """
+    if not (math.isfinite(drop_height) and drop_height > 0.0):
+        raise ValueError(f"drop_height = {drop_height!r} m is outside the allowed range: finite and > 0")
+    if not (math.isfinite(gravity) and gravity > 0.0):
+        raise ValueError(f"gravity = {gravity!r} m/s2 is outside the allowed range: finite and > 0")
+    if not (math.isfinite(v_min) and v_min > 0.0):
+        raise ValueError(f"v_min = {v_min!r} m/s is outside the allowed range: finite and > 0")
+    advance = getattr(rebound, "advance", None)
+    rows = []
+    t = 0.0
+    v_up = 0.0  # upward speed at the last impact (0: released from rest)
+    h = drop_height
+    stop = "max_bounces"
+    for _ in range(max_bounces):
+        # h + v_up s - g s^2/2 = 0; this form avoids cancellation when v_up is large.
+        v_impact = math.sqrt(v_up * v_up + 2.0 * gravity * h)
+        flight = (v_up + v_impact) / gravity
+        if advance is not None:
+            advance(t, flight)
+        t += flight
+        out = rebound(v_impact)
+        v_reb = out["v_rebound"]
+        apex = v_reb * v_reb / (2.0 * gravity) if v_reb > 0.0 else 0.0
+        rows.append((t, v_impact, out["e"], out["e_ep"], out["e_ze"], out["lam"], out["tau0"],
+                     out["t_contact"], v_reb, apex))
+        if out["e"] <= 0.0:
+            stop = "e<=0"
+            break
+        if v_reb < v_min:
+            stop = "v_min"
+            break
+        v_up, h = v_reb, 0.0
+    cols = np.array(rows, dtype=float).T
+    return Bounces(time=cols[0], v_approach=cols[1], e=cols[2], e_ep=cols[3], e_ze=cols[4], lam=cols[5],
+                   tau0=cols[6], t_contact=cols[7], v_rebound=cols[8], apex=cols[9], rest_time=float(cols[0][-1]),
+                   stop_reason=stop, drop_height=drop_height, gravity=gravity)

@@ -1,0 +1,134 @@
+"""Elastoplastic restitution: the Jackson-Green-Marghitu (JGM) model as recast in
+I. Green, Nonlinear Dyn (2022), Eqs. (1)-(8).
+
+Every function accepts Python floats (fast path, returns floats) or numpy arrays
+(broadcast, returns arrays). Subscript a is the sphere, b the plate.
+"""
+from __future__ import annotations
+
+import math
+
+from ._num import exp, log, minimum, maximum, sqrt, where
+
+__all__ = [
+    "reduced_modulus", "effective_modulus", "poisson_coefficient", "critical_pressure",
+    "sphere_yields_first", "yield_strain", "critical_interference", "critical_load",
+    "sphere_mass", "critical_velocity", "restitution_e45", "restitution_e44",
+    "VSTAR_FIT_MAX", "E44_BRANCH_JOIN",
+]
+
+#: Upper end of the V* range the JGM fits were made on [1].
+VSTAR_FIT_MAX = 1000.0
+#: V* where Eq. (7) switches branch [1].
+E44_BRANCH_JOIN = 60.0
+_LOG60 = math.log(60.0)
+# exp() argument cap: beyond it the restitution term is astronomically larger
+# than 1 and e is floored at 0 anyway; capping avoids a floating overflow.
+_EXP_ARG_CAP = 700.0
+
+
+def reduced_modulus(E, nu):
+    """E_i' = E_i / (1 - nu_i^2) [Pa], Eq. (1) right."""
+    return E / (1.0 - nu * nu)
+
+
+def effective_modulus(E_a, nu_a, E_b, nu_b):
+    """E' = E_a' E_b' / (E_a' + E_b') [Pa], Eq. (1) left."""
+    Ea = reduced_modulus(E_a, nu_a)
+    Eb = reduced_modulus(E_b, nu_b)
+    return Ea * Eb / (Ea + Eb)
+
+
+def poisson_coefficient(nu):
+    """C(nu) = 1.295 exp(0.736 nu) [1], Eq. (2): max pressure over max von Mises stress at yield onset."""
+    return 1.295 * exp(0.736 * nu)
+
+
+def critical_pressure(nu_a, Sy_a, nu_b, Sy_b):
+    """C S_y = min[C(nu_a) S_ya, C(nu_b) S_yb] [Pa], Eq. (2): the body with the smaller value yields first."""
+    return minimum(poisson_coefficient(nu_a) * Sy_a, poisson_coefficient(nu_b) * Sy_b)
+
+
+def sphere_yields_first(nu_a, Sy_a, nu_b, Sy_b):
+    """True where C(nu_a) S_ya <= C(nu_b) S_yb, the condition of Eq. (3)."""
+    return poisson_coefficient(nu_a) * Sy_a <= poisson_coefficient(nu_b) * Sy_b
+
+
+def yield_strain(E_prime, nu_a, Sy_a, nu_b, Sy_b):
+    """eps_y = S_y / E' [1], Eq. (3), with S_y of the body that yields first.
+
+    Not C S_y / E' as some public scripts use (ERRATA.md).
+    """
+    Sy = where(sphere_yields_first(nu_a, Sy_a, nu_b, Sy_b), Sy_a, Sy_b)
+    return Sy / E_prime
+
+
+def critical_interference(CSy, E_prime, R):
+    """omega_c = (pi C S_y / (2 E'))^2 R [m], Eq. (4); R = d/2 for a sphere on a plate."""
+    x = math.pi * CSy / (2.0 * E_prime)
+    return x * x * R
+
+
+def critical_load(CSy, E_prime, R):
+    """P_c = 4/3 (R/E')^2 (pi/2 C S_y)^3 [N], Eq. (5)."""
+    r = R / E_prime
+    p = 0.5 * math.pi * CSy
+    return (4.0 / 3.0) * r * r * p * p * p
+
+
+def sphere_mass(rho_a, d):
+    """m_a = rho_a pi d^3 / 6 [kg]."""
+    return rho_a * math.pi * d * d * d / 6.0
+
+
+def critical_velocity(omega_c, P_c, m_a):
+    """V_c = sqrt(4 omega_c P_c / (5 m_a)) [m/s], Eq. (6): impact speed at the onset of yielding.
+
+    With m_a = rho_a pi d^3/6, V_c does not depend on d (R cancels).
+    """
+    return sqrt(0.8 * omega_c * P_c / m_a)
+
+
+def _above_one(v_star):
+    """(mask V* > 1, V* - 1 where above else 1): keeps log/power arguments safe on every branch."""
+    above = v_star > 1.0
+    return above, where(above, v_star - 1.0, 1.0)
+
+
+def restitution_e45(v_star, eps_y):
+    """e45 [1], Eq. (8) (JGM Eq. 45), the paper's default elastoplastic COR.
+
+    e = 1 - 0.0361 eps_y^-0.114 ln(V*) (V* - 1)^(9.5 eps_y) for V* > 1, e = 1 for V* <= 1.
+    The fit covers 1 < V* <= 1000. Extension: beyond that range the fit can fall
+    below 0, which no elastoplastic rebound can do; it is floored at 0 there
+    (the caller flags V* > 1000 as outside the validated range). The power is
+    evaluated in log space so brittle pairs (eps_y ~ 10) cannot overflow.
+    """
+    above, vm1 = _above_one(v_star)
+    log_v = log(where(above, v_star, 1.0))
+    power = exp(minimum(9.5 * eps_y * log(vm1), _EXP_ARG_CAP))
+    e = 1.0 - 0.0361 * eps_y ** -0.114 * log_v * power
+    return where(above, maximum(e, 0.0), 1.0)
+
+
+def restitution_e44(v_star):
+    """e44 [1], Eq. (7) (JGM Eqs. 43-44).
+
+    1 < V* <= 60:  e = 1 - 0.1 ln(V*) ((V* - 1)/59)^0.156
+    V* > 60:       e = 1 - 0.1 ln 60 - 0.11 ln(V*/60) ((V* - 60)/940)^2.366   (RECONSTRUCTED)
+    V* <= 1:       e = 1
+
+    Departure from the printed text: the OCR'd second branch reads (V* - 60)^2.366,
+    which gives e ~ -350 at V* = 100 and cannot be right. The reconstruction
+    ((V* - 60)/940)^2.366 (ERRATA.md) mirrors the first branch's normalisation,
+    joins it continuously at V* = 60 and gives e = 0.281 at V* = 1000. Treat the
+    second branch as reconstructed. Floored at 0 beyond the fit range, as e45.
+    """
+    above, vm1 = _above_one(v_star)
+    low = 1.0 - 0.1 * log(where(above, v_star, 1.0)) * (vm1 / 59.0) ** 0.156
+    upper = v_star > E44_BRANCH_JOIN
+    v_hi = where(upper, v_star, E44_BRANCH_JOIN)
+    ratio = (v_hi - E44_BRANCH_JOIN) / 940.0
+    high = 1.0 - 0.1 * _LOG60 - 0.11 * log(v_hi / E44_BRANCH_JOIN) * exp(minimum(2.366 * log(where(upper, ratio, 1.0)), _EXP_ARG_CAP))
+    e = where(upper, high, low)
+    return where(above, maximum(e, 0.0), 1.0)

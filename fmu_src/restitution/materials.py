@@ -1,0 +1,158 @@
+"""Materials, spheres and plates, with the material presets of I. Green, Nonlinear Dyn (2022).
+
+Units: E [Pa], nu [1], Sy [Pa], rho [kg/m^3], d and t [m].
+
+Brittle materials carry Sy = 1e12 Pa "to ward off yielding", as the paper does
+(Table 1 footnote). Tables 1 and 2 give no elastic moduli: E is taken from
+Table 3 where the material is the same, otherwise from a handbook value, which
+the preset's ``source`` marks as such.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+from .validation import check_poisson, check_positive
+
+__all__ = ["Material", "Sphere", "Plate", "BRITTLE_SY", "MATERIALS", "TABLE4_CASES", "table4_case"]
+
+#: Yield strength the paper assigns to brittle materials [Pa].
+BRITTLE_SY = 1.0e12
+
+
+@dataclass(frozen=True)
+class Material:
+    """An isotropic, elastic-perfectly plastic material."""
+
+    name: str
+    E: float  #: elastic modulus [Pa]
+    nu: float  #: Poisson's ratio [1]
+    Sy: float  #: yield strength [Pa] (BRITTLE_SY for brittle materials)
+    rho: float  #: density [kg/m^3]
+    source: str = ""  #: where each value comes from
+
+    def __post_init__(self):
+        check_positive(f"{self.name}.E", self.E, "Pa")
+        check_poisson(f"{self.name}.nu", self.nu)
+        check_positive(f"{self.name}.Sy", self.Sy, "Pa")
+        check_positive(f"{self.name}.rho", self.rho, "kg/m3")
+
+    @property
+    def brittle(self) -> bool:
+        return self.Sy >= BRITTLE_SY
+
+
+@dataclass(frozen=True)
+class Sphere:
+    """Impacting sphere: material and diameter d [m]."""
+
+    material: Material
+    d: float
+
+    def __post_init__(self):
+        check_positive("sphere.d", self.d, "m")
+
+    def params(self) -> dict:
+        """Keyword arguments for :func:`restitution.impact` (``sphere_*``)."""
+        m = self.material
+        return dict(sphere_E=m.E, sphere_nu=m.nu, sphere_Sy=m.Sy, sphere_rho=m.rho, sphere_d=self.d)
+
+
+@dataclass(frozen=True)
+class Plate:
+    """Target plate: material and thickness t [m]."""
+
+    material: Material
+    t: float
+
+    def __post_init__(self):
+        check_positive("plate.t", self.t, "m")
+
+    def params(self) -> dict:
+        """Keyword arguments for :func:`restitution.impact` (``plate_*``)."""
+        m = self.material
+        return dict(plate_E=m.E, plate_nu=m.nu, plate_Sy=m.Sy, plate_rho=m.rho, plate_t=self.t)
+
+    def with_thickness(self, t: float) -> "Plate":
+        return replace(self, t=t)
+
+
+_T1 = "Green (2022) Table 1"
+_T2 = "Green (2022) Table 2"
+_T3 = "Green (2022) Table 3"
+_HB = "handbook value, not from the paper"
+
+#: Every material of the paper's Tables 1-3, keyed by a short name.
+MATERIALS: dict[str, Material] = {
+    # Table 3 (Patil & Higgs 2018): complete property sets.
+    "brass_260": Material("Brass alloy 260", 103e9, 0.35, 0.393e9, 8525, _T3),
+    "al_1100_h16": Material("Aluminum 1100-H16", 70e9, 0.33, 0.103e9, 2710, _T3),
+    "tungsten_carbide": Material("Tungsten carbide", 621e9, 0.18, 1.720e9, 14950, _T3),
+    "s2_tool_steel": Material("S2 tool steel", 207e9, 0.30, 2.00e9, 7861, _T3),
+    "low_carbon_steel": Material("Low carbon steel", 200e9, 0.30, 0.303e9, 7833, _T3),
+    "borosilicate_glass": Material("Borosilicate glass", 63e9, 0.20, BRITTLE_SY, 2214,
+                                   f"{_T3}; Sy N/A (brittle), set to 1e12 Pa as in Table 1"),
+    "al_6061": Material("Aluminum 6061", 69e9, 0.33, 0.290e9, 2700, _T3),
+    # Table 1 spheres (Marinack et al. 2013) that differ from Table 3.
+    "borosilicate_glass_t1": Material("Borosilicate glass (Table 1)", 63e9, 0.30, BRITTLE_SY, 2214,
+                                      f"{_T1}; E from {_T3}; nu = 0.30 as Table 1 gives (0.20 in Table 3)"),
+    "chrome_steel": Material("Chrome steel (AISI 52100)", 210e9, 0.30, 1.38e9, 7700,
+                             f"{_T1}; E = 210 GPa is a {_HB} (AISI 52100)"),
+    "nitinol_60": Material("NiTiNOL 60", 114e9, 0.34, BRITTLE_SY, 6700,
+                           f"{_T1}/{_T2}; E = 114 GPa is a {_HB} (60NiTi, NASA Glenn)"),
+    # Table 2 plates.
+    "s7_tool_steel": Material("S7 tool steel", 207e9, 0.30, 0.552e9, 7760,
+                              f"{_T2}; E = 207 GPa is a {_HB} (AISI S7)"),
+    "stainless_440c": Material("Stainless steel 440C", 200e9, 0.30, 0.448e9, 7750,
+                               f"{_T2}; E = 200 GPa is a {_HB} (AISI 440C)"),
+}
+# Table 1 repeats these Table 3 materials with the same values.
+MATERIALS["al_110_h16"] = MATERIALS["al_1100_h16"]
+
+_T4 = "Green (2022) Table 4 (Patil & Higgs 2017), nu = 0.3"
+_T4_SPHERE_SY = (f"{_T4}; sphere Sy not given (elastic in the FEA of [11]): "
+                 f"set to 1e12 Pa, so the plate yields first")
+
+
+def table4_case(case: str) -> tuple[Material, Material]:
+    """(sphere material, plate material) of Table 4 case A1-A4 or B1-B4.
+
+    Table 4's fourth column is the *plate* modulus (mislabelled "Sphere" in the
+    text, see ERRATA). Cases A: heavy, stiff sphere on a light, soft plate;
+    cases B the reverse. The plate yield strength is 10, 100, 1000, 10000 MPa
+    for cases 1-4.
+    """
+    family, number = case[:1].upper(), case[1:]
+    if family not in ("A", "B") or number not in ("1", "2", "3", "4"):
+        raise ValueError(f"Table 4 case = {case!r} is not one of A1-A4, B1-B4")
+    heavy = dict(E=800e9, rho=15000.0)
+    light = dict(E=10e9, rho=2000.0)
+    sphere_props, plate_props = (heavy, light) if family == "A" else (light, heavy)
+    plate_sy = 10e6 * 10 ** (int(number) - 1)
+    sphere = Material(f"Table 4 {case} sphere", sphere_props["E"], 0.3, BRITTLE_SY, sphere_props["rho"], _T4_SPHERE_SY)
+    plate = Material(f"Table 4 {case} plate", plate_props["E"], 0.3, plate_sy, plate_props["rho"], _T4)
+    return sphere, plate
+
+
+TABLE4_CASES = tuple(f"{f}{n}" for f in "AB" for n in "1234")
+
+#: Table 1 cases: (sphere material key, sphere diameter [m], plate material key).
+TABLE1_CASES = {
+    1: ("al_110_h16", 6.35e-3, "s7_tool_steel"),
+    2: ("borosilicate_glass_t1", 4.76e-3, "s7_tool_steel"),
+    3: ("borosilicate_glass_t1", 4.76e-3, "borosilicate_glass_t1"),
+    4: ("borosilicate_glass_t1", 6.35e-3, "s7_tool_steel"),
+    5: ("borosilicate_glass_t1", 6.35e-3, "borosilicate_glass_t1"),
+    6: ("brass_260", 4.76e-3, "s7_tool_steel"),
+    7: ("brass_260", 6.35e-3, "s7_tool_steel"),
+    8: ("chrome_steel", 4.76e-3, "s7_tool_steel"),
+    9: ("chrome_steel", 4.76e-3, "stainless_440c"),
+    10: ("low_carbon_steel", 4.76e-3, "s7_tool_steel"),
+    11: ("low_carbon_steel", 6.35e-3, "s7_tool_steel"),
+    12: ("nitinol_60", 6.35e-3, "s7_tool_steel"),
+    13: ("nitinol_60", 6.35e-3, "nitinol_60"),
+    14: ("s2_tool_steel", 6.35e-3, "nitinol_60"),
+    15: ("s2_tool_steel", 4.76e-3, "s7_tool_steel"),
+    16: ("tungsten_carbide", 4.76e-3, "s7_tool_steel"),
+    17: ("tungsten_carbide", 4.76e-3, "stainless_440c"),
+}
+__all__.append("TABLE1_CASES")

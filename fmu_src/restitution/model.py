@@ -1,0 +1,204 @@
+"""The whole model: apparent COR of a sphere hitting a plate of finite thickness,
+I. Green, Nonlinear Dyn (2022), JGM (Eqs. 1-8) and Zener (Eqs. 9-13a) fused by Eq. (20).
+
+:func:`impact` takes Python floats (one impact, fast path) or numpy arrays
+(broadcast together, one result per element).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, fields
+
+import numpy as np
+
+from ._num import is_scalar, where
+from .fusion import apparent_restitution, equivalent_plate_mass, velocities_after_impact
+from .jgm import (VSTAR_FIT_MAX, critical_interference, critical_load, critical_pressure,
+                  critical_velocity, effective_modulus, restitution_e44, restitution_e45,
+                  sphere_mass, yield_strain)
+from .validation import check_choice, check_nonnegative, check_poisson, check_positive
+from .zener import (LAMBDA_STUDIED_MAX, TAU0_HERTZ, ZENER_METHODS, contact_duration,
+                    hertz_stiffness, inelasticity_parameter, time_scale, zener_restitution)
+
+__all__ = ["ImpactResult", "impact", "RESTITUTION_MODELS", "EFFECT_MODES", "ZENER_SLOPE_BOUND",
+           "PARAMETERS", "validate_parameters"]
+
+RESTITUTION_MODELS = ("e45", "e44")
+EFFECT_MODES = ("off", "on", "auto")
+#: Upper bound of (1 - e_ze(lambda)) / lambda over lambda > 0 for the nonlinear ODE [1]
+#: (the slope at lambda = 0, 1.73015, is the supremum; checked against the exact solution in the tests).
+#: ``plate_waves='auto'`` skips Zener where this bound times lambda is below the tolerance.
+ZENER_SLOPE_BOUND = 1.731
+
+#: (name, unit, check) of every model parameter, in the order of :func:`impact`.
+PARAMETERS = (
+    ("sphere_E", "Pa", "positive"), ("sphere_nu", "1", "poisson"), ("sphere_Sy", "Pa", "positive"),
+    ("sphere_rho", "kg/m3", "positive"), ("sphere_d", "m", "positive"),
+    ("plate_E", "Pa", "positive"), ("plate_nu", "1", "poisson"), ("plate_Sy", "Pa", "positive"),
+    ("plate_rho", "kg/m3", "positive"), ("plate_t", "m", "positive"),
+)
+
+
+def validate_parameters(**params) -> dict:
+    """Check each parameter named in :data:`PARAMETERS`; ValueError naming the first bad one."""
+    checked = {}
+    for name, unit, kind in PARAMETERS:
+        label = name.replace("_", ".", 1)
+        if kind == "poisson":
+            checked[name] = check_poisson(label, params[name])
+        else:
+            checked[name] = check_positive(label, params[name], unit)
+    return checked
+
+
+@dataclass(frozen=True)
+class ImpactResult:
+    """Everything one impact (or one array of impacts) produces. Units in brackets."""
+
+    e: object  #: apparent COR, Eq. (20) [1]
+    v_rebound: object  #: sphere speed away from the plate after impact, e * v [m/s]
+    e_ep: object  #: elastoplastic COR, Eq. (7) or (8) [1]
+    V_c: object  #: critical (yield onset) velocity, Eq. (6) [m/s]
+    V_star: object  #: normalised impact speed v / V_c [1]
+    eps_y: object  #: yield strain, Eq. (3) [1]
+    e_ze: object  #: Zener's COR [1]
+    lam: object  #: Zener's parameter lambda, Eq. (12) [1]
+    tau0: object  #: dimensionless contact time [1]
+    T: object  #: Zener's time unit, Eq. (9) [s]
+    t_contact: object  #: contact duration T tau0 [s] (0 when v = 0: no impact)
+    m_a: object  #: sphere mass [kg]
+    m_eff: object  #: equivalent plate mass, Eq. (19) [kg] (+inf for e_ze = 1)
+    v_plate: object  #: plate velocity after impact, Eq. (17) [m/s]
+    plasticity_used: object  #: JGM contributed (e_ep < 1 was applied)
+    plate_waves_used: object  #: Zener contributed (e_ze was computed)
+    lambda_in_range: object  #: lambda <= 1.5, Zener's studied range
+    vstar_in_range: object  #: V* <= 1000, JGM's fit range
+    e_negative: object  #: e < 0: the sphere keeps moving with the plate
+
+    @property
+    def valid(self):
+        """Inside both models' validated ranges."""
+        if is_scalar(self.lam):
+            return self.lambda_in_range and self.vstar_in_range
+        return np.logical_and(self.lambda_in_range, self.vstar_in_range)
+
+    def as_dict(self) -> dict:
+        d = {f.name: getattr(self, f.name) for f in fields(self)}
+        d["valid"] = self.valid
+        return d
+
+
+def _mode(name, value):
+    if isinstance(value, (int, np.integer)) and not isinstance(value, bool):
+        if not 0 <= value < len(EFFECT_MODES):
+            raise ValueError(f"{name} = {value!r} is not one of 0 = off, 1 = on, 2 = auto")
+        return EFFECT_MODES[value]
+    return check_choice(name, value, EFFECT_MODES)
+
+
+def impact(v, sphere_E, sphere_nu, sphere_Sy, sphere_rho, sphere_d,
+           plate_E, plate_nu, plate_Sy, plate_rho, plate_t, *,
+           restitution_model: str = "e45", zener_method: str = "exact",
+           plasticity="auto", plate_waves="auto", effect_tolerance: float = 1e-6,
+           ode_rtol: float = 1e-10, validate: bool = True) -> ImpactResult:
+    """Apparent COR and everything behind it for a sphere hitting a plate at normal speed ``v``.
+
+    Parameters (units in brackets): ``v`` approach speed [m/s] >= 0; sphere E [Pa],
+    nu [1], Sy [Pa], rho [kg/m^3], d [m]; plate E, nu, Sy, rho, t [m].
+    ``restitution_model``: "e45" (Eq. 8, default) or "e44" (Eq. 7, second branch reconstructed).
+    ``zener_method``: "exact" (default), "paper_fit", "linear" or "ode" (see :mod:`restitution.zener`).
+    ``plasticity`` / ``plate_waves``: "on", "off" (e_ep = 1, resp. e_ze = 1) or "auto":
+    skip the effect where its contribution to e is below ``effect_tolerance``
+    (plasticity: V* <= 1 or 1 - e_ep < tol; plate waves: ZENER_SLOPE_BOUND * lambda < tol,
+    which bounds 1 - e_ze). A skipped plate-wave effect treats the plate as a half-space:
+    e_ze = 1, tau0 = 3.2180655 (Hertz). ``ode_rtol`` is the tolerance of ``zener_method="ode"``.
+    ``validate=False`` skips the input checks (for callers that already checked).
+
+    Validity is reported, never clipped: ``lambda_in_range`` (<= 1.5), ``vstar_in_range``
+    (<= 1000), ``e_negative``. Bad input raises ValueError naming the parameter.
+    """
+    params = dict(sphere_E=sphere_E, sphere_nu=sphere_nu, sphere_Sy=sphere_Sy, sphere_rho=sphere_rho,
+                  sphere_d=sphere_d, plate_E=plate_E, plate_nu=plate_nu, plate_Sy=plate_Sy,
+                  plate_rho=plate_rho, plate_t=plate_t)
+    plasticity = _mode("plasticity", plasticity)
+    plate_waves = _mode("plate_waves", plate_waves)
+    if validate:
+        check_choice("restitution_model", restitution_model, RESTITUTION_MODELS)
+        check_choice("zener_method", zener_method, ZENER_METHODS)
+        check_nonnegative("effect_tolerance", effect_tolerance)
+        check_positive("ode_rtol", ode_rtol)
+        v = check_nonnegative("v_approach", v, "m/s")
+        params = validate_parameters(**params)
+    scalar = is_scalar(v) and all(is_scalar(p) for p in params.values())
+    if not scalar:
+        arrays = np.broadcast_arrays(np.asarray(v, dtype=float),
+                                     *(np.asarray(p, dtype=float) for p in params.values()))
+        v = arrays[0]
+        params = dict(zip(params, arrays[1:]))
+    p = params
+
+    # --- JGM, Eqs. (1)-(8)
+    E_prime = effective_modulus(p["sphere_E"], p["sphere_nu"], p["plate_E"], p["plate_nu"])
+    CSy = critical_pressure(p["sphere_nu"], p["sphere_Sy"], p["plate_nu"], p["plate_Sy"])
+    eps_y = yield_strain(E_prime, p["sphere_nu"], p["sphere_Sy"], p["plate_nu"], p["plate_Sy"])
+    R = 0.5 * p["sphere_d"]
+    m_a = sphere_mass(p["sphere_rho"], p["sphere_d"])
+    V_c = critical_velocity(critical_interference(CSy, E_prime, R), critical_load(CSy, E_prime, R), m_a)
+    V_star = v / V_c
+    if plasticity == "off":
+        e_ep = 1.0 if scalar else np.ones_like(v)
+    else:
+        e_ep = (restitution_e45(V_star, eps_y) if restitution_model == "e45"
+                else restitution_e44(V_star))
+    if plasticity == "auto":
+        e_ep = where(1.0 - e_ep < effect_tolerance, 1.0, e_ep)
+    plasticity_used = e_ep < 1.0
+
+    # --- Zener, Eqs. (9)-(13a)
+    lam = inelasticity_parameter(v, p["sphere_E"], p["sphere_nu"], p["sphere_rho"], p["sphere_d"],
+                                 p["plate_E"], p["plate_nu"], p["plate_rho"], p["plate_t"])
+    if plate_waves == "off":
+        needed = False if scalar else np.zeros(np.shape(v), dtype=bool)
+    elif plate_waves == "on":
+        needed = True if scalar else np.ones(np.shape(v), dtype=bool)
+    else:
+        needed = ZENER_SLOPE_BOUND * lam >= effect_tolerance
+    e_ze, tau0 = _zener_where_needed(lam, needed, zener_method, ode_rtol, scalar)
+
+    moving = v > 0.0
+    v_safe = where(moving, v, 1.0)
+    T = where(moving, time_scale(m_a, hertz_stiffness(E_prime, p["sphere_d"]), v_safe), math.inf)
+    t_contact = where(moving, contact_duration(where(moving, T, 0.0), tau0), 0.0)
+
+    # --- Fusion, Eqs. (17)-(20)
+    e = apparent_restitution(e_ep, e_ze)
+    m_eff = equivalent_plate_mass(m_a, e_ze)
+    _, v_plate = velocities_after_impact(v, e_ep, e_ze)
+
+    out = ImpactResult(
+        e=e, v_rebound=e * v, e_ep=e_ep, V_c=V_c, V_star=V_star, eps_y=eps_y, e_ze=e_ze, lam=lam,
+        tau0=tau0, T=T, t_contact=t_contact, m_a=m_a, m_eff=m_eff, v_plate=v_plate,
+        plasticity_used=plasticity_used, plate_waves_used=needed,
+        lambda_in_range=lam <= LAMBDA_STUDIED_MAX, vstar_in_range=V_star <= VSTAR_FIT_MAX,
+        e_negative=e < 0.0,
+    )
+    if scalar:
+        return ImpactResult(**{f.name: (bool if f.name in _FLAGS else float)(getattr(out, f.name))
+                               for f in fields(out)})
+    shape = np.shape(v)
+    return ImpactResult(**{f.name: np.broadcast_to(getattr(out, f.name), shape).astype(
+        bool if f.name in _FLAGS else float) for f in fields(out)})
+
+
+_FLAGS = frozenset({"plasticity_used", "plate_waves_used", "lambda_in_range", "vstar_in_range", "e_negative"})
+
+
+def _zener_where_needed(lam, needed, method, rtol, scalar):
+    """(e_ze, tau0), computed only where the plate-wave effect is needed; half-space values elsewhere."""
+    if scalar:
+        return zener_restitution(lam, method, rtol) if needed else (1.0, TAU0_HERTZ)
+    e_ze = np.ones(np.shape(lam))
+    tau0 = np.full(np.shape(lam), TAU0_HERTZ)
+    if np.any(needed):
+        e_ze[needed], tau0[needed] = zener_restitution(lam[needed], method, rtol)
+    return e_ze, tau0

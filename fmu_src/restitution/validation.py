@@ -1,0 +1,51 @@
+"""Checks on user input: a clear ValueError naming the parameter, its value and the allowed range."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ._num import is_scalar
+
+__all__ = ["check_positive", "check_nonnegative", "check_poisson", "check_choice"]
+
+
+def _check(name, value, unit, ok_scalar, ok_array, allowed):
+    if is_scalar(value):
+        v = float(value)
+        if not ok_scalar(v):
+            raise ValueError(f"{name} = {v!r}{unit} is outside the allowed range: {allowed}")
+        return v
+    arr = np.asarray(value, dtype=float)
+    with np.errstate(invalid="ignore"):
+        good = ok_array(arr)
+    if not np.all(good):
+        bad_value = float(arr[~good].flat[0]) if arr.ndim else float(arr)
+        raise ValueError(f"{name} = {bad_value!r}{unit} is outside the allowed range: {allowed}")
+    return arr
+
+
+def check_positive(name: str, value, unit: str = ""):
+    """Require finite values > 0."""
+    u = f" {unit}" if unit else ""
+    return _check(name, value, u, lambda v: math.isfinite(v) and v > 0.0,
+                  lambda a: np.isfinite(a) & (a > 0.0), "finite and > 0")
+
+
+def check_nonnegative(name: str, value, unit: str = ""):
+    """Require finite values >= 0."""
+    u = f" {unit}" if unit else ""
+    return _check(name, value, u, lambda v: math.isfinite(v) and v >= 0.0,
+                  lambda a: np.isfinite(a) & (a >= 0.0), "finite and >= 0")
+
+
+def check_poisson(name: str, value):
+    """Require a Poisson's ratio in [0, 0.5) (0.5, incompressible, makes E' infinite)."""
+    return _check(name, value, "", lambda v: 0.0 <= v < 0.5,
+                  lambda a: (a >= 0.0) & (a < 0.5), "0 <= nu < 0.5")
+
+
+def check_choice(name: str, value, choices):
+    if value not in choices:
+        raise ValueError(f"{name} = {value!r} is not one of {sorted(choices)}")
+    return value

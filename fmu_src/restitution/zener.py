@@ -1,0 +1,129 @@
+"""Elastic waves in the plate: Zener's model as recast in I. Green, Nonlinear Dyn (2022), Eqs. (9)-(13a), (22)-(23).
+
+Zener's ODE, Eq. (10): sigma'' + (1 + lambda d/dtau) sigma^(3/2) = 0, sigma(0) = 0,
+sigma'(0) = 1 (Eq. 11). The rebound is the first return of sigma to 0, at tau = tau0;
+Zener's COR is e_ze = -sigma'(tau0). Four ways to get (e_ze, tau0) from lambda:
+
+``exact``      the ODE's solution, tabulated offline and interpolated (rel. error <= 1e-8, default)
+``paper_fit``  Eq. (13) and (13a) as published
+``linear``     Eq. (22), the linearised ODE, in closed form
+``ode``        Eq. (10) integrated at every call, with a settable tolerance
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ._num import exp, is_scalar, sqrt, where
+from .jgm import reduced_modulus
+from .zener_exact import zener_exact
+from .zener_ode import solve_zener_ode
+
+__all__ = [
+    "ZENER_METHODS", "LAMBDA_STUDIED_MAX", "TAU0_HERTZ", "plate_wave_speed", "inelasticity_parameter",
+    "hertz_stiffness", "time_scale", "zener_paper_fit", "zener_linear", "zener_linear_fit",
+    "zener_ode", "zener_restitution", "contact_duration",
+]
+
+ZENER_METHODS = ("exact", "paper_fit", "linear", "ode")
+#: Largest lambda Zener (and the paper's fits) studied [1].
+LAMBDA_STUDIED_MAX = 1.5
+#: tau0 at lambda = 0 (Hertz impact on a half-space): 2 (5/4)^(2/5) (2/5) B(2/5, 1/2) [1].
+TAU0_HERTZ = 2.0 * 1.25 ** 0.4 * 0.4 * math.gamma(0.4) * math.gamma(0.5) / math.gamma(0.9)
+
+
+def plate_wave_speed(E_b, nu_b, rho_b):
+    """v' = sqrt(E_b' / rho_b) [m/s], the plate's sound speed under Eq. (12)."""
+    return sqrt(reduced_modulus(E_b, nu_b) / rho_b)
+
+
+def inelasticity_parameter(v0, E_a, nu_a, rho_a, d, E_b, nu_b, rho_b, t):
+    """Zener's "inelasticity" parameter lambda [1], Eq. (12).
+
+    lambda = pi^(3/5)/sqrt(3) ((d/2)/t)^2 (v0/v')^(1/5) (rho_a/rho_b)^(3/5) (E_a'/(E_a' + E_b'))^(2/5),
+    with v0 the impact speed [m/s], d the sphere diameter [m], t = 2h the plate thickness [m].
+    It depends on t/d only, not on t and d separately.
+    """
+    Ea = reduced_modulus(E_a, nu_a)
+    Eb = reduced_modulus(E_b, nu_b)
+    r_over_t = 0.5 * d / t
+    return (_LAMBDA_PREFACTOR * r_over_t * r_over_t * (v0 / sqrt(Eb / rho_b)) ** 0.2
+            * (rho_a / rho_b) ** 0.6 * (Ea / (Ea + Eb)) ** 0.4)
+
+
+_LAMBDA_PREFACTOR = math.pi ** 0.6 / math.sqrt(3.0)
+
+
+def hertz_stiffness(E_prime, d):
+    """k = (4/3) r^(1/2) E' [N/m^1.5], with r = d/2 (text after Eq. 10): F = k s^(3/2)."""
+    return (4.0 / 3.0) * sqrt(0.5 * d) * E_prime
+
+
+def time_scale(m_a, k, v0):
+    """Zener's time unit T = (m / (k v0^(1/2)))^(2/5) [s], Eq. (9). Infinite at v0 = 0."""
+    return (m_a / (k * sqrt(v0))) ** 0.4
+
+
+def contact_duration(T, tau0):
+    """t_contact = T tau0 [s]: the time sphere and plate stay in compressive contact."""
+    return T * tau0
+
+
+def zener_paper_fit(lam):
+    """(e_ze, tau0) [1] from Eqs. (13) and (13a) as published.
+
+    e_ze = exp(-1.68374 lambda), tau0 = 3.215 exp(0.318 lambda^(3/2)).
+    Fitted on 0 <= lambda <= 1.5: absolute error in e up to 0.0136 (relative 20 %
+    at lambda = 1.5); tau0 within ~1 % there but diverging above lambda ~ 2.
+    """
+    return exp(-1.68374 * lam), 3.215 * exp(0.318 * lam ** 1.5)
+
+
+def zener_linear(lam):
+    """(e_ze, tau0) [1] of the linearised ODE, Eq. (22): sigma'' + lambda sigma' + sigma = 0.
+
+    Closed form (ERRATA.md), for lambda < 2: e = exp(-pi lambda / sqrt(4 - lambda^2)),
+    tau0 = pi / sqrt(1 - lambda^2/4). For lambda >= 2 the oscillator is (over)damped
+    and never returns to sigma = 0: e = 0 and tau0 = +inf (contact is never lost).
+    Note tau0(0) = pi, not the Hertz value 3.2180655: a different contact law.
+    """
+    under = lam < 2.0
+    lam_u = where(under, lam, 0.0)
+    root = sqrt(4.0 - lam_u * lam_u)
+    e = where(under, exp(-math.pi * lam_u / root), 0.0)
+    tau0 = where(under, 2.0 * math.pi / root, math.inf)
+    return e, tau0
+
+
+def zener_linear_fit(lam):
+    """(e_ze)_linear = exp(-1.72847 lambda) [1], Eq. (23): the paper's fit to Eq. (22)."""
+    return exp(-1.72847 * lam)
+
+
+def zener_ode(lam, rtol: float = 1e-10):
+    """(e_ze, tau0) [1] by integrating Eq. (10) at every call, relative tolerance ``rtol``.
+
+    The reference and the slow end of the accuracy scale.
+    """
+    if is_scalar(lam):
+        return solve_zener_ode(float(lam), rtol=rtol)
+    lam = np.asarray(lam, dtype=float)
+    e = np.empty(lam.shape)
+    tau0 = np.empty(lam.shape)
+    for i, value in np.ndenumerate(lam):
+        e[i], tau0[i] = solve_zener_ode(float(value), rtol=rtol)
+    return e, tau0
+
+
+def zener_restitution(lam, method: str = "exact", rtol: float = 1e-10):
+    """(e_ze, tau0) [1] for Zener's parameter lambda [1] by ``method`` (see module doc)."""
+    if method == "exact":
+        return zener_exact(lam)
+    if method == "paper_fit":
+        return zener_paper_fit(lam)
+    if method == "linear":
+        return zener_linear(lam)
+    if method == "ode":
+        return zener_ode(lam, rtol=rtol)
+    raise ValueError(f"zener_method = {method!r} is not one of {ZENER_METHODS}")

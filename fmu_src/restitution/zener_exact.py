@@ -1,0 +1,234 @@
+"""Zener's COR and contact time, to ODE accuracy at closed-form cost (the "exact" method).
+
+Solves, in effect, I. Green, Nonlinear Dyn (2022), Eq. (10) with Eq. (11) (Zener, Phys. Rev.
+59 (1941)): sigma'' + (1 + lambda d/dtau) sigma^(3/2) = 0, sigma(0) = 0, sigma'(0) = 1, and
+returns e_ze = -sigma'(tau0) [1] (the quantity fitted by Eq. (13)) and the contact time tau0
+[1] (fitted by Eq. (13a)), tau0 being the first return of sigma to 0.
+
+How
+---
+* 0 <= lambda <= 100: C^1 piecewise-cubic Hermite interpolation of e_ze and tau0 on the
+  uniform grid lambda = k/128, from values and slopes tabulated offline
+  (data/zener_table.npz, made by build_scripts/make_zener_table.py from rtol = 1e-13
+  solves).  Measured relative error against fresh independent solves between the nodes:
+  <= 4e-10 for e_ze and <= 3e-11 for tau0 (bound 1e-8).  The table reproduces
+  e_ze(0) = 1 and tau0(0) = 2 (5/4)^(2/5) (2/5) B(2/5, 1/2) = 3.2180655 exactly.
+* lambda > 100: a verified large-lambda form (no ODE solve).  The substitution
+  sigma = lambda^-4 S, p = lambda^-5 P, tau = lambda T maps the problem onto the lambda = 1
+  system with initial velocity lambda^5: a fast initial layer, a long creep down the
+  attracting slow manifold lambda sigma^(3/2) ~ p, and a universal final ejection.  Hence
+
+      e_ze = E_INF lambda^-5,                          E_INF = 0.679293063936
+      tau0 = lambda (5 ln lambda + g(lambda^(-5/3))),  g(u) = G0 + 3 u + 0.9575 u^2 + ...,
+                                                        G0 = -0.359367056648
+
+  with g a Chebyshev series fitted to direct solves (lambda = 6 ... 190).  The neglected
+  terms decay like exp(-c lambda^(5/3)), c ~ 3 (in e_ze: 3e-6 at lambda = 3, < 1e-13
+  from lambda = 4; in tau0: 2e-8 at lambda = 5, < 1e-14 from lambda = 6).
+  Checked against direct ODE solves at lambda = 150, 1000, 1e4: relative error < 1e-11
+  in e_ze and < 2e-13 in tau0.  The form is continuous (value and slope) with the table
+  at lambda = 100, whose nodes above lambda = 6 come from the same form.  e_ze underflows
+  to 0 only for lambda > ~1e61.
+
+Cost (measured, Python 3.11, numpy 2.4): a Python float in [0, 100] takes ~0.35 us, 1.8-2.0x
+the closed-form fit math.exp(-1.68374 lambda), 3.215 math.exp(0.318 lambda^1.5) of Eqs. (13)/
+(13a) (~0.19 us); other scalars (int, numpy scalars) ~0.6 us, lambda > 100 ~1.7 us.  Arrays:
+~25 ns per element for 1e5 elements, 0.7-1.1x the numpy evaluation of the same fit.  The
+table costs ~17 ms and ~6 MB (mostly Python floats for the scalar path) at import; the
+file is 0.4 MB.
+"""
+
+from __future__ import annotations
+
+import io
+import math
+import os
+
+import numpy as np
+
+__all__ = ["zener_exact", "LAMBDA_TABLE_MAX", "E_INF", "TAU0_LAMBDA0"]
+
+_DATA_NAME = "zener_table.npz"
+
+
+def _load_table():
+    path = os.path.join(os.path.dirname(os.path.abspath(__file__)), "data", _DATA_NAME)
+    if os.path.exists(path):
+        src = path
+    else:  # e.g. imported from a zip: go through importlib.resources
+        from importlib.resources import files
+
+        res = files(__package__ or "restitution").joinpath("data", _DATA_NAME)
+        src = io.BytesIO(res.read_bytes())
+    with np.load(src) as d:
+        return {k: d[k] for k in d.files}
+
+
+def _hermite(f, df, h):
+    """Coefficients of a0 + t (a1 + t (a2 + t a3)), t = (lambda - lambda_k)/h in [0, 1]."""
+    f0, f1, d0, d1 = f[:-1], f[1:], h * df[:-1], h * df[1:]
+    return f0, d0, 3.0 * (f1 - f0) - 2.0 * d0 - d1, 2.0 * (f0 - f1) + d0 + d1
+
+
+_T = _load_table()
+_H = float(_T["h"])
+_INV_H = 1.0 / _H
+#: Upper end of the tabulated range of lambda [1]; above it the large-lambda form is used.
+LAMBDA_TABLE_MAX = float(_T["lam_table_max"])
+#: lim lambda^5 e_ze for lambda -> inf [1] (the large-lambda form e_ze = E_INF lambda^-5).
+E_INF = float(_T["asym_E_inf"])
+#: tau0 at lambda = 0: 2 (5/4)^(2/5) (2/5) B(2/5, 1/2) [1].
+TAU0_LAMBDA0 = float(_T["tau0"][0])
+_U_MAX = float(_T["asym_u_max"])
+_G_CHEB = [float(c) for c in _T["asym_g_cheb"]]
+# (n_intervals, 8): e coefficients a0..a3, then tau0 coefficients b0..b3
+_COEF_ARR = np.ascontiguousarray(
+    np.stack(_hermite(_T["e"], _T["de"], _H) + _hermite(_T["tau0"], _T["dtau0"], _H), axis=1)
+)
+_COEF = [tuple(row) for row in _COEF_ARR.tolist()]
+if LAMBDA_TABLE_MAX * _INV_H >= len(_COEF):  # lambda = LAMBDA_TABLE_MAX needs one more interval
+    raise RuntimeError(f"{_DATA_NAME}: table does not extend past lambda = {LAMBDA_TABLE_MAX}")
+del _T
+
+
+def _bad_lambda(value, where=""):
+    return ValueError(
+        f"lambda must be finite and >= 0 (allowed range [0, inf)); got lambda={value!r}{where}"
+    )
+
+
+def _asym_scalar(lam):
+    """Large-lambda form (lambda >= 6, used above LAMBDA_TABLE_MAX) for a float."""
+    u = lam ** (-5.0 / 3.0)
+    z2 = 2.0 * (2.0 * u / _U_MAX - 1.0)
+    c = _G_CHEB
+    b1 = b2 = 0.0
+    for k in range(len(c) - 1, 0, -1):
+        b1, b2 = c[k] + z2 * b1 - b2, b1
+    g = c[0] + 0.5 * z2 * b1 - b2
+    return E_INF * (1.0 / lam) ** 5, lam * (5.0 * math.log(lam) + g)
+
+
+def _scalar_general(lam):
+    """Slow scalar path: ints, numpy scalars, lambda > LAMBDA_TABLE_MAX, and the errors."""
+    try:
+        x = float(lam)
+    except (TypeError, ValueError):
+        raise _bad_lambda(lam) from None
+    if not (x >= 0.0 and x < math.inf):
+        raise _bad_lambda(x)
+    if x <= LAMBDA_TABLE_MAX:
+        y = x * _INV_H
+        i = int(y)
+        t = y - i
+        a0, a1, a2, a3, b0, b1, b2, b3 = _COEF[i]
+        return a0 + t * (a1 + t * (a2 + t * a3)), b0 + t * (b1 + t * (b2 + t * b3))
+    return _asym_scalar(x)
+
+
+def _table_array(lam):
+    x = lam * _INV_H
+    i = x.astype(np.intp)
+    t = x - i
+    c = _COEF_ARR[i]  # gather (..., 8)
+    e = c[..., 3] * t
+    e += c[..., 2]
+    e *= t
+    e += c[..., 1]
+    e *= t
+    e += c[..., 0]
+    tau = c[..., 7] * t
+    tau += c[..., 6]
+    tau *= t
+    tau += c[..., 5]
+    tau *= t
+    tau += c[..., 4]
+    return e, tau
+
+
+def _asym_array(lam):
+    u = lam ** (-5.0 / 3.0)
+    z2 = 2.0 * (2.0 * u / _U_MAX - 1.0)
+    c = _G_CHEB
+    b1 = np.zeros_like(u)
+    b2 = np.zeros_like(u)
+    for k in range(len(c) - 1, 0, -1):
+        b1, b2 = c[k] + z2 * b1 - b2, b1
+    g = c[0] + 0.5 * z2 * b1 - b2
+    with np.errstate(under="ignore", over="ignore"):
+        e = E_INF * (1.0 / lam) ** 5
+        tau = lam * (5.0 * np.log(lam) + g)
+    return e, tau
+
+
+def _array(lam):
+    a = np.asarray(lam, dtype=float)
+    if a.size == 0:
+        return np.empty(a.shape), np.empty(a.shape)
+    lo = a.min()
+    hi = a.max()
+    if not (lo >= 0.0 and hi < math.inf):  # also catches nan (min/max propagate it)
+        bad = ~(np.isfinite(a) & (a >= 0.0))
+        idx = np.argwhere(bad)[0] if a.ndim else ()
+        raise _bad_lambda(float(a[tuple(idx)]), f" (at index {tuple(int(j) for j in idx)})"
+                          if a.ndim else "")
+    if a.ndim == 0:
+        e, tau = _scalar_general(float(a))
+        return np.array(e), np.array(tau)
+    if hi <= LAMBDA_TABLE_MAX:
+        return _table_array(a)
+    big = a > LAMBDA_TABLE_MAX
+    e = np.empty(a.shape)
+    tau = np.empty(a.shape)
+    small = ~big
+    e[small], tau[small] = _table_array(a[small])
+    e[big], tau[big] = _asym_array(a[big])
+    return e, tau
+
+
+def zener_exact(lam):
+    """Zener's coefficient of restitution and contact time, to ODE accuracy, fast.
+
+    The "exact" method: the solution of I. Green, Nonlinear Dyn (2022), Eq. (10) with
+    Eq. (11) (Zener 1941), tabulated offline and interpolated for 0 <= lambda <= 100
+    (relative error <= 1e-9), and a verified large-lambda form above (see module doc).
+
+    Parameters
+    ----------
+    lam : float or array_like
+        Zener's "inelasticity" parameter lambda [1], Eq. (12); finite and >= 0.
+        A Python (or numpy) scalar gives Python floats; an array (any shape, including
+        0-d) or a list gives ndarrays of that shape.
+
+    Returns
+    -------
+    e_ze : float or ndarray
+        Zener's COR [1], -sigma'(tau0), the quantity of Eq. (13); 1 at lambda = 0,
+        0.0664 at lambda = 1.5, ~0.679 lambda^-5 for large lambda.
+    tau0 : float or ndarray
+        Nondimensional contact time [1] (Eq. (9): t = T tau), the quantity of Eq. (13a);
+        3.2180655 at lambda = 0, 5.836 at lambda = 1.5, ~lambda (5 ln lambda - 0.359)
+        for large lambda.
+
+    Raises
+    ------
+    ValueError
+        If lambda (or any element) is negative, nan or infinite.
+    """
+    if lam.__class__ is float and 0.0 <= lam <= 100.0:  # fast path (LAMBDA_TABLE_MAX = 100)
+        x = lam * _INV_H
+        i = int(x)
+        t = x - i
+        a0, a1, a2, a3, b0, b1, b2, b3 = _COEF[i]
+        return a0 + t * (a1 + t * (a2 + t * a3)), b0 + t * (b1 + t * (b2 + t * b3))
+    if isinstance(lam, (int, float, np.number)) and not isinstance(lam, np.complexfloating):
+        return _scalar_general(lam)
+    if isinstance(lam, np.ndarray) or isinstance(lam, (list, tuple)):
+        return _array(lam)
+    if np.ndim(lam) == 0:  # other real scalars (Fraction, Decimal, ...)
+        return _scalar_general(lam)
+    return _array(lam)
+
+
+if LAMBDA_TABLE_MAX != 100.0:  # the literal in the fast path must match the table
+    raise RuntimeError(f"{_DATA_NAME}: expected a table up to lambda = 100, got {LAMBDA_TABLE_MAX}")

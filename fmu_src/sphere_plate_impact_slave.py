@@ -1,0 +1,224 @@
+"""SpherePlateImpact: the FMI 2.0 co-simulation adapter around the ``restitution`` package.
+
+A thin layer: it keeps the inputs and parameters, checks each value as it is set,
+evaluates :func:`restitution.impact` lazily (only when an output is read or a step is
+taken after something changed) and exposes the results. Nothing here is physics.
+
+Bad input never raises (pythonfmu would turn an exception into fmi2Fatal for every
+instance): the value is kept, a message naming the variable, its value and the allowed
+range is logged with fmi2Error, outputs read NaN and ``fmi2DoStep`` returns fmi2Discard
+until valid values are set again (or the instance is reset).
+
+The module has a name of its own (not ``model``): two pythonfmu FMUs whose scripts share
+a module name clash in one process.
+"""
+from __future__ import annotations
+
+import math
+import os
+import sys
+
+from pythonfmu import Fmi2Causality, Fmi2Slave, Fmi2Variability, Boolean, Integer, Real
+from pythonfmu.enums import Fmi2Initial, Fmi2Status
+
+# Inside the FMU the bundled package sits next to this script in resources/; put it first
+# so the FMU runs the code it was built with, not whatever the host happens to have.
+_HERE = os.path.dirname(os.path.abspath(__file__))
+if os.path.isdir(os.path.join(_HERE, "restitution")) and sys.path[0] != _HERE:
+    sys.path.insert(0, _HERE)
+
+from restitution.model import EFFECT_MODES, RESTITUTION_MODELS, ZENER_METHODS, impact  # noqa: E402
+
+P, IN, OUT = "parameter", "input", "output"
+
+# (name, type, causality, unit, start, description, key); key is the impact() keyword for
+# inputs/parameters and the ImpactResult field for outputs. build_fmu.py reads this table
+# to write units, ranges and descriptions into modelDescription.xml.
+VARIABLES = (
+    ("v_approach", "Real", IN, "m/s", 1.0, "Normal approach speed of the sphere toward the plate, >= 0", "v"),
+    ("sphere.E", "Real", P, "Pa", 207e9, "Sphere elastic modulus, > 0 (default: S2 tool steel, Table 3)", "sphere_E"),
+    ("sphere.nu", "Real", P, "1", 0.30, "Sphere Poisson's ratio, 0 <= nu < 0.5", "sphere_nu"),
+    ("sphere.Sy", "Real", P, "Pa", 2.0e9, "Sphere yield strength, > 0 (1e12 for brittle materials)", "sphere_Sy"),
+    ("sphere.rho", "Real", P, "kg/m3", 7861.0, "Sphere density, > 0", "sphere_rho"),
+    ("sphere.d", "Real", P, "m", 6.35e-3, "Sphere diameter, > 0", "sphere_d"),
+    ("plate.E", "Real", P, "Pa", 69e9, "Plate elastic modulus, > 0 (default: Al 6061, Table 3)", "plate_E"),
+    ("plate.nu", "Real", P, "1", 0.33, "Plate Poisson's ratio, 0 <= nu < 0.5", "plate_nu"),
+    ("plate.Sy", "Real", P, "Pa", 0.290e9, "Plate yield strength, > 0 (1e12 for brittle materials)", "plate_Sy"),
+    ("plate.rho", "Real", P, "kg/m3", 2700.0, "Plate density, > 0", "plate_rho"),
+    ("plate.t", "Real", P, "m", 6.35e-3, "Plate thickness, > 0", "plate_t"),
+    ("restitution_model", "Integer", P, None, 1,
+     "Elastoplastic COR: 1 = e45 (Eq. 8, default), 2 = e44 (Eq. 7, second branch reconstructed)",
+     "restitution_model"),
+    ("zener_method", "Integer", P, None, 1,
+     "Zener COR and contact time: 1 = exact (tabulated ODE solution), 2 = paper_fit (Eqs. 13, 13a), "
+     "3 = linear (Eq. 22), 4 = ode (Eq. 10 integrated at every evaluation)", "zener_method"),
+    ("plasticity", "Integer", P, None, 2,
+     "Elastoplastic effect: 0 = off (e_ep = 1), 1 = on, 2 = auto (skipped where 1 - e_ep < effect_tolerance)",
+     "plasticity"),
+    ("plate_waves", "Integer", P, None, 2,
+     "Plate-wave effect: 0 = off (e_ze = 1, half-space), 1 = on, "
+     "2 = auto (skipped where 1 - e_ze < effect_tolerance is guaranteed)", "plate_waves"),
+    ("effect_tolerance", "Real", P, "1", 1e-6, "Largest change in e that auto may neglect, >= 0", "effect_tolerance"),
+    ("zener.ode_tolerance", "Real", P, "1", 1e-10,
+     "Relative tolerance of zener_method = 4 (ode), 1e-14 <= tol <= 1e-2", "ode_rtol"),
+    ("e", "Real", OUT, "1", None, "Apparent coefficient of restitution, Eq. (20); < 0: sphere moves on with the plate", "e"),
+    ("v_rebound", "Real", OUT, "m/s", None, "Sphere speed away from the plate after impact, e * v_approach", "v_rebound"),
+    ("jgm.e", "Real", OUT, "1", None, "Elastoplastic COR e_ep, Eq. (7) or (8)", "e_ep"),
+    ("jgm.V_c", "Real", OUT, "m/s", None, "Critical velocity at the onset of yielding, Eq. (6)", "V_c"),
+    ("jgm.V_star", "Real", OUT, "1", None, "Normalised impact speed V* = v_approach / V_c", "V_star"),
+    ("zener.e", "Real", OUT, "1", None, "Zener's COR e_ze (1 where plate waves are off or skipped)", "e_ze"),
+    ("zener.lambda", "Real", OUT, "1", None, "Zener's inelasticity parameter lambda, Eq. (12)", "lam"),
+    ("zener.tau0", "Real", OUT, "1", None, "Dimensionless contact time tau0 (3.2180655, Hertz, where skipped)", "tau0"),
+    ("zener.t_contact", "Real", OUT, "s", None, "Contact duration T * tau0 (0 when v_approach = 0)", "t_contact"),
+    ("plate.m_eff", "Real", OUT, "kg", None, "Equivalent plate mass, Eq. (19) (+inf for a half-space, e_ze = 1)", "m_eff"),
+    ("plate.v_after", "Real", OUT, "m/s", None, "Plate velocity after impact, Eq. (17), positive along the approach", "v_plate"),
+    ("valid", "Boolean", OUT, None, None, "Inside both models' validated ranges: lambda <= 1.5 and V* <= 1000", "valid"),
+    ("zener.in_range", "Boolean", OUT, None, None, "lambda <= 1.5, Zener's studied range", "lambda_in_range"),
+    ("jgm.in_range", "Boolean", OUT, None, None, "V* <= 1000, the range of the JGM fits", "vstar_in_range"),
+    ("e_negative", "Boolean", OUT, None, None, "e < 0: the sphere keeps moving with the plate after impact", "e_negative"),
+    ("effects.plasticity", "Boolean", OUT, None, None, "The elastoplastic effect was applied (e_ep < 1)", "plasticity_used"),
+    ("effects.plate_waves", "Boolean", OUT, None, None, "The plate-wave effect was computed", "plate_waves_used"),
+)
+
+_CHOICES = {
+    "restitution_model": (RESTITUTION_MODELS, "1 = e45 or 2 = e44"),
+    "zener_method": (ZENER_METHODS, "1 = exact, 2 = paper_fit, 3 = linear or 4 = ode"),
+    "plasticity": (EFFECT_MODES, "0 = off, 1 = on or 2 = auto"),
+    "plate_waves": (EFFECT_MODES, "0 = off, 1 = on or 2 = auto"),
+}
+_CODE_OFFSET = {"restitution_model": 1, "zener_method": 1, "plasticity": 0, "plate_waves": 0}
+
+
+def allowed_range(name):
+    """(predicate, allowed-range text, xml min, xml max) of an input or parameter.
+
+    The one place the interface's ranges live: the setters check values with it and
+    build_fmu.py writes the min/max attributes from it.
+    """
+    if name in _CHOICES:
+        choices, text = _CHOICES[name]
+        low = _CODE_OFFSET[name]
+        high = low + len(choices) - 1
+        return (lambda v: low <= int(v) <= high), text, str(low), str(high)
+    if name.endswith(".nu"):
+        return (lambda v: 0.0 <= v < 0.5), "0 <= value < 0.5", "0", "0.5"
+    if name in ("v_approach", "effect_tolerance"):
+        return (lambda v: 0.0 <= v < math.inf), "finite and >= 0", "0", None
+    if name == "zener.ode_tolerance":
+        return (lambda v: 1e-14 <= v <= 1e-2), "1e-14 <= value <= 1e-2", "1e-14", "1e-2"
+    return (lambda v: 0.0 < v < math.inf), "finite and > 0", "0", None
+
+
+class SpherePlateImpact(Fmi2Slave):
+    """Apparent COR of a sphere hitting a plate of finite thickness (I. Green, Nonlinear Dyn 2022)."""
+
+    author = "restitution developers"
+    description = ("Apparent coefficient of restitution of a sphere hitting a plate of finite thickness: "
+                   "JGM elastoplastic model fused with Zener's plate-wave model, I. Green, Nonlinear Dyn (2022)")
+
+    def __init__(self, **kwargs):
+        super().__init__(**kwargs)
+        self._values = {}  # name -> current value of every input and parameter
+        self._invalid = {}  # name -> message, for values currently rejected
+        self._outputs = {}
+        self._evaluated_key = None
+        self._failure = None  # message of the last evaluation that raised
+        for name, vtype, causality, _unit, start, description, key in VARIABLES:
+            if causality == OUT:
+                var_cls = Real if vtype == "Real" else Boolean
+                self.register_variable(var_cls(
+                    name, causality=Fmi2Causality.output, variability=Fmi2Variability.continuous
+                    if vtype == "Real" else Fmi2Variability.discrete, initial=Fmi2Initial.calculated,
+                    description=description, getter=self._output_getter(key, vtype)), nested=False)
+                continue
+            self._values[name] = start
+            var_cls = Real if vtype == "Real" else Integer
+            if causality == IN:
+                fmi_causality, variability = Fmi2Causality.input, Fmi2Variability.continuous
+            else:
+                fmi_causality, variability = Fmi2Causality.parameter, Fmi2Variability.tunable
+            self.register_variable(var_cls(
+                name, causality=fmi_causality, variability=variability, start=start,
+                description=description, getter=self._input_getter(name),
+                setter=self._setter(name)), nested=False)
+
+    # --- variable access -------------------------------------------------------------
+    def _input_getter(self, name):
+        return lambda: self._values[name]
+
+    def _setter(self, name):
+        ok, allowed, _low, _high = allowed_range(name)
+
+        def set_value(value):
+            if value == self._values.get(name) and name not in self._invalid:
+                return
+            self._values[name] = value
+            try:
+                good = ok(value)
+            except (TypeError, ValueError, OverflowError):
+                good = False
+            if good:
+                self._invalid.pop(name, None)
+            else:
+                message = f"{name} = {value!r} is outside the allowed range: {allowed}"
+                self._invalid[name] = message
+                self.log(message, Fmi2Status.error)
+        return set_value
+
+    def _output_getter(self, key, vtype):
+        nan = math.nan if vtype == "Real" else False
+
+        def get_value():
+            outputs = self._evaluate()
+            return outputs.get(key, nan) if outputs is not None else nan
+        return get_value
+
+    # --- evaluation --------------------------------------------------------------------
+    def _evaluate(self):
+        """Outputs for the current inputs, recomputed only when an input or parameter changed."""
+        if self._invalid:
+            return None
+        key = tuple(self._values.values())
+        if key == self._evaluated_key:
+            return self._outputs if self._failure is None else None
+        self._evaluated_key = key
+        v = self._values
+        try:
+            result = impact(
+                float(v["v_approach"]), float(v["sphere.E"]), float(v["sphere.nu"]), float(v["sphere.Sy"]),
+                float(v["sphere.rho"]), float(v["sphere.d"]), float(v["plate.E"]), float(v["plate.nu"]),
+                float(v["plate.Sy"]), float(v["plate.rho"]), float(v["plate.t"]),
+                restitution_model=RESTITUTION_MODELS[int(v["restitution_model"]) - 1],
+                zener_method=ZENER_METHODS[int(v["zener_method"]) - 1],
+                plasticity=EFFECT_MODES[int(v["plasticity"])], plate_waves=EFFECT_MODES[int(v["plate_waves"])],
+                effect_tolerance=float(v["effect_tolerance"]), ode_rtol=float(v["zener.ode_tolerance"]),
+                validate=False)
+        except Exception as exc:  # a numerical failure must not become fmi2Fatal
+            self._failure = f"evaluation failed for {self._describe_inputs()}: {type(exc).__name__}: {exc}"
+            self.log(self._failure, Fmi2Status.error)
+            return None
+        self._failure = None
+        self._outputs = result.as_dict()
+        return self._outputs
+
+    def _describe_inputs(self):
+        return ", ".join(f"{k} = {val!r}" for k, val in self._values.items())
+
+    # --- FMI calls -------------------------------------------------------------------------
+    def exit_initialization_mode(self):
+        self._evaluate()
+
+    def do_step(self, current_time: float, step_size: float) -> bool:
+        if self._invalid:
+            self.log("doStep discarded: " + "; ".join(self._invalid.values()), Fmi2Status.discard)
+            return False
+        return self._evaluate() is not None
+
+    def reset(self):
+        for name, _vtype, causality, _unit, start, _description, _key in VARIABLES:
+            if causality != OUT:
+                self._values[name] = start
+        self._invalid.clear()
+        self._evaluated_key = None
+        self._failure = None
+        self._outputs = {}

@@ -1,0 +1,223 @@
+"""A pythonfmu FMU post-processed by build_scripts/native_host/make_standalone.py
+must run in a plain C FMI host (no LD_PRELOAD, no PYTHONPATH/PYTHONHOME, no
+venv, PATH=/usr/bin:/bin), must keep running in Python hosts (fmpy), and must
+fail cleanly (log message + NULL instance) when its interpreter is missing.
+"""
+from __future__ import annotations
+
+import importlib.util
+import math
+import shutil
+import subprocess
+import sys
+import textwrap
+import zipfile
+from pathlib import Path
+from xml.etree import ElementTree
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+HOST_SOURCE = ROOT / "tests" / "c_host" / "fmi2_host.c"
+MAKE_STANDALONE = ROOT / "build_scripts" / "native_host" / "make_standalone.py"
+
+pytestmark = [
+    pytest.mark.skipif(not sys.platform.startswith("linux"), reason="Linux-only (linux64 shim)"),
+    pytest.mark.skipif(shutil.which("gcc") is None, reason="gcc not available"),
+]
+
+MODULE = "chost_standalone_sqrt_slave"  # unique module name (FMUs sharing one clash)
+MODEL = "ChostStandaloneSqrt"
+SLAVE_SOURCE = f'''
+import numpy
+from pythonfmu import Fmi2Slave, Fmi2Causality, Fmi2Variability, Real
+
+
+class {MODEL}(Fmi2Slave):
+    author = "tests"
+    description = "y = numpy.sqrt(x)"
+
+    def __init__(self, **kwargs):
+        super().__init__(**kwargs)
+        self.x = 4.0
+        self.y = 2.0
+        self.register_variable(Real("x", causality=Fmi2Causality.input,
+                                    variability=Fmi2Variability.continuous))
+        self.register_variable(Real("y", causality=Fmi2Causality.output,
+                                    variability=Fmi2Variability.continuous))
+
+    def do_step(self, current_time, step_size):
+        self.y = float(numpy.sqrt(self.x))
+        return True
+'''
+VR_X, VR_Y = 0, 1
+CLEAN_ENV = {"PATH": "/usr/bin:/bin"}
+
+
+def _load_make_standalone():
+    spec = importlib.util.spec_from_file_location("make_standalone", MAKE_STANDALONE)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def _unpack(fmu: Path, dest: Path) -> Path:
+    with zipfile.ZipFile(fmu) as zf:
+        zf.extractall(dest)
+    return dest
+
+
+def _guid(fmu: Path) -> str:
+    with zipfile.ZipFile(fmu) as zf:
+        return ElementTree.fromstring(zf.read("modelDescription.xml")).attrib["guid"]
+
+
+def _run_host(host: Path, unpacked: Path, guid: str, *args: str) -> subprocess.CompletedProcess:
+    # env -i: nothing inherited (no VIRTUAL_ENV, PYTHONPATH, PYTHONHOME, LD_*)
+    return subprocess.run(
+        ["env", "-i", "PATH=/usr/bin:/bin", str(host), str(unpacked), MODEL, guid, *args],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        env=CLEAN_ENV,
+    )
+
+
+def _values(stdout: str) -> dict[int, float]:
+    out = {}
+    for line in stdout.splitlines():
+        parts = line.split()
+        if len(parts) == 2 and parts[0].isdigit():
+            out[int(parts[0])] = float(parts[1])
+    return out
+
+
+@pytest.fixture(scope="module")
+def built(tmp_path_factory):
+    work = tmp_path_factory.mktemp("chost")
+    script = work / f"{MODULE}.py"
+    script.write_text(textwrap.dedent(SLAVE_SOURCE))
+    subprocess.run(
+        [sys.executable, "-m", "pythonfmu", "build", "-f", str(script), "-d", str(work / "plain")],
+        check=True,
+        cwd=work,
+        capture_output=True,
+    )
+    plain = work / "plain" / f"{MODEL}.fmu"
+    standalone = work / f"{MODEL}.fmu"
+    shutil.copy(plain, standalone)
+    _load_make_standalone().make_standalone(standalone)
+
+    host = work / "fmi2_host"
+    subprocess.run(["gcc", "-O2", "-o", str(host), str(HOST_SOURCE), "-ldl"], check=True)
+    return {"work": work, "plain": plain, "fmu": standalone, "host": host, "guid": _guid(standalone)}
+
+
+def test_fmu_layout(built):
+    with zipfile.ZipFile(built["fmu"]) as zf:
+        names = set(zf.namelist())
+        config = zf.read("resources/python_env.txt").decode()
+    assert f"binaries/linux64/{MODEL}.so" in names
+    assert f"binaries/linux64/{MODEL}_pythonfmu.so" in names
+    assert f"binaries/win64/{MODEL}.dll" in names  # untouched
+    assert "libpython=" in config and "executable=" in config
+    assert "require=numpy" in config
+
+
+def test_plain_pythonfmu_binary_fails_in_c_host(built, tmp_path):
+    """The problem being solved: without the shim, dlopen fails."""
+    unpacked = _unpack(built["plain"], tmp_path / "plain")
+    proc = _run_host(built["host"], unpacked, built["guid"], f"{VR_X}=2", str(VR_Y))
+    assert proc.returncode == 2
+    assert "undefined symbol" in proc.stderr
+
+
+@pytest.mark.parametrize("x", [2.0, 9.0, 1e-3])
+def test_runs_in_plain_c_host(built, tmp_path, x):
+    unpacked = _unpack(built["fmu"], tmp_path / "fmu")
+    proc = _run_host(built["host"], unpacked, built["guid"], "--steps", "3", f"{VR_X}={x!r}", str(VR_Y))
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    assert _values(proc.stdout) == {VR_Y: math.sqrt(x)}
+
+
+def test_runs_in_fmpy(built, tmp_path):
+    """Same standalone FMU in a Python host: the shim uses the running interpreter."""
+    code = textwrap.dedent(
+        f"""
+        import sys
+        from fmpy import simulate_fmu, read_model_description, extract
+        from fmpy.fmi2 import FMU2Slave
+        fmu = sys.argv[1]
+        res = simulate_fmu(fmu, stop_time=0.01, output_interval=0.001, start_values={{"x": 16.0}})
+        assert res["y"][-1] == 4.0, res["y"]
+        md = read_model_description(fmu)
+        s = FMU2Slave(guid=md.guid, unzipDirectory=extract(fmu), modelIdentifier="{MODEL}")
+        s.instantiate()
+        s.setupExperiment(startTime=0.0)
+        s.enterInitializationMode()
+        s.exitInitializationMode()
+        s.setReal([{VR_X}], [6.25])
+        s.doStep(0.0, 0.1)
+        print("y", repr(s.getReal([{VR_Y}])[0]))
+        s.terminate()
+        s.freeInstance()
+        """
+    )
+    proc = subprocess.run([sys.executable, "-c", code, str(built["fmu"])], capture_output=True, text=True,
+                          timeout=120)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    assert "y 2.5" in proc.stdout
+
+
+def _with_config(built, tmp_path, edit) -> Path:
+    unpacked = _unpack(built["fmu"], tmp_path / "broken")
+    cfg = unpacked / "resources" / "python_env.txt"
+    cfg.write_text(edit(cfg.read_text()))
+    return unpacked
+
+
+def test_missing_libpython_gives_log_message_and_null(built, tmp_path):
+    bogus = "/nonexistent/python/lib/libpython3.11.so.1.0"
+    unpacked = _with_config(
+        built, tmp_path,
+        lambda text: "\n".join(f"libpython={bogus}" if line.startswith("libpython=") else line
+                               for line in text.splitlines()) + "\n",
+    )
+    proc = _run_host(built["host"], unpacked, built["guid"], f"{VR_X}=4", str(VR_Y))
+    assert proc.returncode == 3, proc.stdout + proc.stderr  # NULL instance, no crash
+    assert "INSTANTIATE_FAILED" in proc.stdout
+    log = [line for line in proc.stdout.splitlines() if line.startswith("LOG ")]
+    assert any("cannot load the Python shared library" in line and bogus in line
+               and "python_env.txt" in line for line in log), proc.stdout
+
+
+def test_missing_module_gives_log_message_and_null(built, tmp_path):
+    unpacked = _with_config(
+        built, tmp_path,
+        lambda text: text + "require=no_such_module_for_chost_test\n",
+    )
+    proc = _run_host(built["host"], unpacked, built["guid"], f"{VR_X}=4", str(VR_Y))
+    assert proc.returncode == 3, proc.stdout + proc.stderr
+    assert any("no_such_module_for_chost_test" in line and "ModuleNotFoundError" in line
+               for line in proc.stdout.splitlines() if line.startswith("LOG ")), proc.stdout
+
+
+def test_missing_config_gives_log_message_and_null(built, tmp_path):
+    unpacked = _unpack(built["fmu"], tmp_path / "nocfg")
+    (unpacked / "resources" / "python_env.txt").unlink()
+    proc = _run_host(built["host"], unpacked, built["guid"], f"{VR_X}=4", str(VR_Y))
+    assert proc.returncode == 3, proc.stdout + proc.stderr
+    assert "python_env.txt" in proc.stdout and "needs a Python interpreter" in proc.stdout
+
+
+def test_make_standalone_is_idempotent(built, tmp_path):
+    again = tmp_path / f"{MODEL}.fmu"
+    shutil.copy(built["fmu"], again)
+    _load_make_standalone().make_standalone(again)
+    with zipfile.ZipFile(again) as zf:
+        names = zf.namelist()
+        assert zf.read(f"binaries/linux64/{MODEL}_pythonfmu.so") == \
+            zipfile.ZipFile(built["plain"]).read(f"binaries/linux64/{MODEL}.so")
+    assert len(names) == len(set(names))
+    proc = _run_host(built["host"], _unpack(again, tmp_path / "again"), built["guid"], f"{VR_X}=2", str(VR_Y))
+    assert proc.returncode == 0 and _values(proc.stdout) == {VR_Y: math.sqrt(2.0)}

@@ -1,0 +1,152 @@
+"""SpherePlateImpact.fmu through fmpy: interface, numbers against the package, feedthrough,
+caching and bad input."""
+import itertools
+import math
+import zipfile
+from xml.etree import ElementTree as ET
+
+import numpy as np
+import pytest
+from fmpy.validation import validate_fmu
+
+import restitution as r
+from restitution.cosim import FmiStatusError, FmuInstance, impact_fmu_parameters
+
+CONTRACT = {  # name: (causality, unit, start) from the public interface table
+    "v_approach": ("input", "m/s", 1.0),
+    "sphere.E": ("parameter", "Pa", 207e9), "sphere.nu": ("parameter", "1", 0.30),
+    "sphere.Sy": ("parameter", "Pa", 2.0e9), "sphere.rho": ("parameter", "kg/m3", 7861.0),
+    "sphere.d": ("parameter", "m", 6.35e-3),
+    "plate.E": ("parameter", "Pa", 69e9), "plate.nu": ("parameter", "1", 0.33),
+    "plate.Sy": ("parameter", "Pa", 0.290e9), "plate.rho": ("parameter", "kg/m3", 2700.0),
+    "plate.t": ("parameter", "m", 6.35e-3),
+    "restitution_model": ("parameter", None, 1), "zener_method": ("parameter", None, 1),
+    "plasticity": ("parameter", None, 2), "plate_waves": ("parameter", None, 2),
+    "effect_tolerance": ("parameter", "1", 1e-6),
+    "e": ("output", "1", None), "v_rebound": ("output", "m/s", None), "jgm.e": ("output", "1", None),
+    "jgm.V_c": ("output", "m/s", None), "jgm.V_star": ("output", "1", None), "zener.e": ("output", "1", None),
+    "zener.lambda": ("output", "1", None), "zener.tau0": ("output", "1", None),
+    "zener.t_contact": ("output", "s", None), "plate.m_eff": ("output", "kg", None),
+    "plate.v_after": ("output", "m/s", None), "valid": ("output", None, None),
+}
+REAL_OUTPUTS = {"e": "e", "v_rebound": "v_rebound", "jgm.e": "e_ep", "jgm.V_c": "V_c", "jgm.V_star": "V_star",
+                "zener.e": "e_ze", "zener.lambda": "lam", "zener.tau0": "tau0", "zener.t_contact": "t_contact",
+                "plate.m_eff": "m_eff", "plate.v_after": "v_plate"}
+
+
+def test_validates_and_keeps_the_public_contract(impact_fmu):
+    assert validate_fmu(str(impact_fmu)) == []
+    with zipfile.ZipFile(impact_fmu) as z:
+        root = ET.fromstring(z.read("modelDescription.xml"))
+    units = {u.get("name") for u in root.find("UnitDefinitions")}
+    found = {}
+    for sv in root.find("ModelVariables"):
+        typ = sv[0]
+        assert sv.get("description"), sv.get("name")
+        found[sv.get("name")] = (sv.get("causality"), typ.get("unit"), typ.get("start"), typ.tag)
+        if typ.tag == "Real":
+            assert typ.get("unit") in units, sv.get("name")
+    for name, (causality, unit, start) in CONTRACT.items():
+        got = found[name]
+        assert got[0] == causality and got[1] == unit, name
+        if start is not None:
+            assert float(got[2]) == start, name
+    cosim = root.find("CoSimulation")
+    assert cosim.get("canGetAndSetFMUstate") == "true" and cosim.get("canSerializeFMUstate") == "true"
+    # direct feedthrough: every output but V_c depends on the input v_approach
+    index = {sv.get("name"): str(i + 1) for i, sv in enumerate(root.find("ModelVariables"))}
+    deps = {u.get("index"): u.get("dependencies") for u in root.find("ModelStructure/Outputs")}
+    assert deps[index["e"]] == index["v_approach"] and deps[index["jgm.V_c"]] == ""
+
+
+CASES = list(itertools.product(
+    [("s2_tool_steel", 6.35e-3, "al_6061"), ("tungsten_carbide", 4.76e-3, "al_6061"),
+     ("borosilicate_glass_t1", 6.35e-3, "borosilicate_glass_t1"), ("brass_260", 4.76e-3, "s7_tool_steel")],
+    [0.0, 1e-3, 0.5, 2.3, 6.9, 30.0],
+    [0.25, 1.0, 4.0],
+    [(1, 1), (2, 2), (1, 3), (2, 4)],
+))
+
+
+def test_fmu_matches_the_package_on_a_grid(impact_fmu):
+    with FmuInstance(impact_fmu) as fmu:
+        for (s_key, d, p_key), v, t_over_d, (model, method) in CASES:
+            sphere, plate = r.Sphere(r.MATERIALS[s_key], d), r.Plate(r.MATERIALS[p_key], t_over_d * d)
+            fmu.set(**impact_fmu_parameters(sphere, plate), restitution_model=model, zener_method=method,
+                    v_approach=v)
+            fmu.do_step(step_size=1e-3)
+            got = dict(zip(REAL_OUTPUTS, fmu.get_reals(list(REAL_OUTPUTS))))
+            ref = r.impact_between(sphere, plate, v, restitution_model=r.RESTITUTION_MODELS[model - 1],
+                                   zener_method=r.ZENER_METHODS[method - 1])
+            for name, field in REAL_OUTPUTS.items():
+                assert got[name] == pytest.approx(getattr(ref, field), rel=1e-12, abs=0.0) or \
+                    (math.isinf(got[name]) and math.isinf(getattr(ref, field))), (name, s_key, v, t_over_d, method)
+            assert fmu.get("valid")[0] == bool(ref.valid)
+
+
+def test_outputs_follow_set_real_before_any_step(impact_fmu):
+    """Direct feedthrough: after fmi2SetReal the outputs already match the new input."""
+    with FmuInstance(impact_fmu) as fmu:
+        fmu.do_step(0.0, 0.1)
+        for v in (0.3, 2.3, 9.0):
+            fmu.set(v_approach=v)
+            e, v_reb = fmu.get_reals(["e", "v_rebound"])
+            ref = r.impact_between(r.Sphere(r.MATERIALS["s2_tool_steel"], 6.35e-3),
+                                   r.Plate(r.MATERIALS["al_6061"], 6.35e-3), v)
+            assert e == pytest.approx(ref.e, rel=1e-12) and v_reb == pytest.approx(v * ref.e, rel=1e-12)
+
+
+def test_nothing_is_recomputed_when_nothing_changed(impact_fmu, monkeypatch):
+    """The slave caches: reading outputs again, or stepping with unchanged inputs, evaluates nothing."""
+    import sphere_plate_impact_slave as slave_module  # the module the FMU imported in this process
+
+    calls = []
+    real_impact = slave_module.impact
+    monkeypatch.setattr(slave_module, "impact", lambda *a, **k: calls.append(1) or real_impact(*a, **k))
+    with FmuInstance(impact_fmu) as fmu:
+        calls.clear()  # initialisation evaluated the start values
+        fmu.set(v_approach=2.0)
+        fmu.get_reals(list(REAL_OUTPUTS))
+        n = len(calls)
+        assert n == 1
+        for k in range(5):
+            fmu.do_step(step_size=0.01)
+            fmu.get_reals(list(REAL_OUTPUTS))
+            fmu.set(v_approach=2.0)
+        assert len(calls) == n
+        fmu.set(v_approach=2.5)
+        fmu.get_reals(["e", "v_rebound"])
+        assert len(calls) == n + 1
+
+
+@pytest.mark.parametrize("name,value", [("v_approach", -1.0), ("v_approach", math.nan), ("plate.nu", 0.5),
+                                        ("sphere.E", math.inf), ("plate.t", 0.0), ("zener_method", 7)])
+def test_bad_input_is_logged_and_discarded_not_fatal(impact_fmu, name, value):
+    with FmuInstance(impact_fmu, "bad") as bad, FmuInstance(impact_fmu, "good") as good:
+        good.set(v_approach=2.3)
+        bad.set(**{name: value})
+        with pytest.raises(FmiStatusError) as err:
+            bad.do_step(step_size=0.01)
+        assert err.value.status in (2, 3)  # fmi2Discard or fmi2Error, never fmi2Fatal (4)
+        logged = " ".join(m for _, m in bad.messages)
+        assert name in logged and repr(value) in logged and "allowed range" in logged
+        assert math.isnan(bad.get("e")[0])
+        good.do_step(step_size=0.01)  # the other instance is untouched
+        assert good.get("e")[0] == pytest.approx(0.5041903927, rel=1e-9)
+        bad.set(**{name: CONTRACT[name][2] if CONTRACT.get(name, (0, 0, None))[2] is not None else 1})
+        bad.set(v_approach=2.3)
+        bad.do_step(step_size=0.01)
+        assert bad.get("e")[0] == pytest.approx(0.5041903927, rel=1e-9)
+
+
+def test_state_round_trip(impact_fmu):
+    with FmuInstance(impact_fmu) as fmu:
+        fmu.set(v_approach=1.7, **{"plate.t": 3e-3})
+        before = fmu.get_reals(list(REAL_OUTPUTS))
+        state = fmu.slave.getFMUstate()
+        blob = fmu.slave.serializeFMUstate(state)
+        fmu.set(v_approach=4.0, **{"plate.t": 1e-2})
+        assert fmu.get_reals(["e"])[0] != before[0]
+        fmu.slave.setFMUstate(fmu.slave.deSerializeFMUstate(blob))
+        assert fmu.get_reals(list(REAL_OUTPUTS)) == before
+        fmu.slave.freeFMUstate(state)
