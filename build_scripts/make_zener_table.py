@@ -44,9 +44,13 @@ What is stored
    E_INF (the mean of e lambda^5 over the solves) and a Chebyshev series of g on
    [0, LAM_ASYM^(-5/3)] are fitted to direct solves at Chebyshev nodes in u (lambda from 6
    to ~300).  This representation is valid for all lambda >= 6, up to infinity.
-3. The runtime table: cubic Hermite data (value and d/dlambda of e_ze and tau0) on the
-   uniform grid lambda_k = k h, k = 0..K, K h >= 100 + h (h = 1/128 by default), taken from
-   1. below LAM_ASYM and from 2. above.  The runtime module builds the cubic pieces from it.
+3. The runtime table: cubic Hermite data (value and d/dlambda of e_ze and tau0) at nodes
+   lambda = k h (h = 1/128 by default) taken from 1. below LAM_ASYM and from 2. above.  The
+   values are first computed on the whole fine grid k = 0..K (K h >= 100 + h); then nodes are
+   chosen greedily with dyadic widths (1, 2, 4, ... fine cells, aligned) such that the cubic
+   Hermite error bound max|f^(4)/f| (h w)^4 / 384 stays below --tol (3e-10) for both
+   functions (~2150 nodes instead of 12800: e_ze ~ lambda^-5 flattens at large lambda).  The
+   runtime module builds the cubic pieces from them.
 
 The script prints the achieved maximum relative errors of the final (interpolated) values
 on a check grid between nodes, both against representations 1./2. (densely) and against
@@ -220,17 +224,50 @@ class LargeLambda:
 # ---------------------------------------------------------------------------------------------
 # Hermite table and its evaluation (same formulas as restitution.zener_exact)
 # ---------------------------------------------------------------------------------------------
-def hermite_coefficients(f, df, h):
-    """Cubic pieces a0 + t (a1 + t (a2 + t a3)), t = (lam - lam_k)/h in [0, 1]."""
-    f0, f1, d0, d1 = f[:-1], f[1:], h * df[:-1], h * df[1:]
-    return np.stack([f0, d0, 3.0 * (f1 - f0) - 2.0 * d0 - d1, 2.0 * (f0 - f1) + d0 + d1])
+def select_nodes(f_list, h, k_max, tol, k_end):
+    """Greedy dyadic node selection on the fine grid k h, k = 0..k_max, up to past k_end.
+
+    Interval widths are powers of 2 (in fine cells, <= 128) and start at multiples of their
+    width; an interval is accepted if the cubic Hermite error bound max|f^(4)/f| (h w)^4/384,
+    with f^(4) from 4th differences on the fine grid over the interval and its neighbours,
+    is <= tol for every f in f_list.  Returns the node indices (k_0 = 0, last > k_end).
+    """
+    r = np.zeros(k_max + 1)
+    for f in f_list:
+        q = np.zeros(k_max + 1)
+        q[2:-2] = np.abs(np.diff(f, 4)) / h**4 / np.abs(f[2:-2])
+        q[:2], q[-2:] = q[2], q[-3]
+        r = np.maximum(r, q)
+    nodes, k = [0], 0
+    while k <= k_end:
+        best = 1
+        w = 2
+        while w <= 128 and k % w == 0 and k + w <= k_max:
+            if r[max(k - w, 0):min(k + 2 * w, k_max) + 1].max() * (w * h) ** 4 / 384.0 > tol:
+                break
+            best, w = w, 2 * w
+        k += best
+        nodes.append(k)
+    return np.array(nodes, dtype=np.int64)
 
 
-def hermite_eval(coef, h, lam):
+def hermite_pieces(k, f, df, h):
+    """Cubic pieces a0 + t (a1 + t (a2 + t a3)) with t = lam/h - k_j in [0, k_{j+1} - k_j).
+
+    (Same formulas as restitution.zener_exact; w is a power of 2, so dividing by it is exact.)
+    """
+    w = np.diff(k).astype(float)
+    hw = h * w
+    f0, f1, d0, d1 = f[:-1], f[1:], hw * df[:-1], hw * df[1:]
+    return np.stack([f0, d0 / w, (3.0 * (f1 - f0) - 2.0 * d0 - d1) / w**2,
+                     (2.0 * (f0 - f1) + d0 + d1) / w**3])
+
+
+def hermite_eval(k, coef, h, lam):
     x = np.asarray(lam, dtype=float) / h
-    i = np.minimum(x.astype(np.intp), coef.shape[1] - 1)
-    t = x - i
-    a0, a1, a2, a3 = coef[:, i]
+    j = np.searchsorted(k, x, side="right") - 1
+    t = x - k[j]
+    a0, a1, a2, a3 = coef[:, j]
     return a0 + t * (a1 + t * (a2 + t * a3))
 
 
@@ -238,7 +275,9 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--out", default=DEFAULT_OUT)
     ap.add_argument("--h", type=float, default=1.0 / 128.0,
-                    help="grid step of the runtime table (use a power of 2)")
+                    help="finest grid step of the runtime table (use a power of 2)")
+    ap.add_argument("--tol", type=float, default=3e-10,
+                    help="Hermite error bound used to choose the (dyadic) node spacing")
     ap.add_argument("--jobs", type=int, default=min(2, os.cpu_count() or 1))
     ap.add_argument("--n-check", type=int, default=60,
                     help="number of fresh reference solves between nodes for the final check")
@@ -262,26 +301,29 @@ def main(argv=None):
         print(f"  at lambda = {lam}: small/large - 1: e {a[0] / b[0] - 1:.1e}, "
               f"tau0 {a[2] / b[2] - 1:.1e}, de {a[1] / b[1] - 1:.1e}, dtau0 {a[3] / b[3] - 1:.1e}")
 
-    K = int(math.ceil((LAM_TABLE + h) / h - 1e-9))
+    K = int(math.ceil((LAM_TABLE + h) / h - 1e-9))  # fine grid k h, k = 0..K, K h > 100
     grid = np.arange(K + 1) * h
-    nodes = np.array([small(x) if x <= LAM_ASYM else large(x) for x in grid])
-    nodes[0, 0] = 1.0  # e(0) = 1 exactly (the representation gives 1 - O(1e-14))
-    nodes[0, 2] = tau_hertz  # tau0(0), closed form
-    e, de, tau0, dtau0 = nodes.T
-    if not (np.all(np.diff(e) < 0) and np.all(np.diff(tau0) > 0)):
-        raise RuntimeError("tabulated e_ze / tau0 not monotonic")
+    fine = np.array([small(x) if x <= LAM_ASYM else large(x) for x in grid])
+    fine[0, 0] = 1.0  # e(0) = 1 exactly (the representation gives 1 - O(1e-14))
+    fine[0, 2] = tau_hertz  # tau0(0), closed form
+    if not (np.all(np.diff(fine[:, 0]) < 0) and np.all(np.diff(fine[:, 2]) > 0)):
+        raise RuntimeError("e_ze / tau0 not monotonic on the fine grid")
+    k_end = int(round(LAM_TABLE / h))
+    k = select_nodes([fine[:, 0], fine[:, 2]], h, K, args.tol, k_end)
+    e, de, tau0, dtau0 = fine[k].T
+    widths, counts = np.unique(np.diff(k), return_counts=True)
+    print(f"nodes: {k.size} of the {K + 1} fine-grid points (h = {h:g}); interval widths "
+          + ", ".join(f"{w}h: {c}" for w, c in zip(widths, counts)))
+    ce, ct = hermite_pieces(k, e, de, h), hermite_pieces(k, tau0, dtau0, h)
 
-    ce, ct = hermite_coefficients(e, de, h), hermite_coefficients(tau0, dtau0, h)
-
-    # check 1: interpolation error vs the representations, 7 points inside every interval
+    # check 1: interpolation error vs the representations, 7 points inside every fine cell
     tt = (np.arange(1, 8) / 8.0)
     lam_c = (np.arange(K)[:, None] + tt[None, :]).ravel() * h
     lam_c = lam_c[lam_c <= LAM_TABLE]
     ref = np.array([small(x) if x <= LAM_ASYM else large(x) for x in lam_c])
-    rel_e = hermite_eval(ce, h, lam_c) / ref[:, 0] - 1.0
-    rel_t = hermite_eval(ct, h, lam_c) / ref[:, 2] - 1.0
-    print(f"check 1: cubic Hermite (h = {h:g}) vs representations at {lam_c.size} points "
-          "between nodes:")
+    rel_e = hermite_eval(k, ce, h, lam_c) / ref[:, 0] - 1.0
+    rel_t = hermite_eval(k, ct, h, lam_c) / ref[:, 2] - 1.0
+    print(f"check 1: cubic Hermite vs representations at {lam_c.size} points between nodes:")
     for lo, hi in ((0.0, 1.5), (1.5, LAM_ASYM), (LAM_ASYM, LAM_TABLE)):
         m = (lam_c >= lo) & (lam_c <= hi)
         print(f"  lambda in [{lo:g}, {hi:g}]: max |rel err| e {np.abs(rel_e[m]).max():.2e}, "
@@ -296,8 +338,8 @@ def main(argv=None):
                                                  args.n_check - n1))])
     lam_chk = np.sort(np.append(lam_chk, [LAM_TABLE]))
     vals = _solve_many(lam_chk, args.jobs)
-    rel_e = hermite_eval(ce, h, lam_chk) / vals[:, 0] - 1.0
-    rel_t = hermite_eval(ct, h, lam_chk) / vals[:, 1] - 1.0
+    rel_e = hermite_eval(k, ce, h, lam_chk) / vals[:, 0] - 1.0
+    rel_t = hermite_eval(k, ct, h, lam_chk) / vals[:, 1] - 1.0
     print(f"check 2: table vs {lam_chk.size} fresh reference solves between nodes:")
     for lo, hi in ((0.0, 1.5), (1.5, LAM_TABLE)):
         m = (lam_chk >= lo) & (lam_chk <= hi) if lo == 0.0 else (lam_chk > lo) & (lam_chk <= hi)
@@ -314,23 +356,24 @@ def main(argv=None):
     os.makedirs(os.path.dirname(os.path.abspath(args.out)), exist_ok=True)
     np.savez(
         args.out,
-        format_version=np.int64(1),
+        format_version=np.int64(2),
         h=np.float64(h),
         lam_table_max=np.float64(LAM_TABLE),
-        e=e, de=de, tau0=tau0, dtau0=dtau0,
+        k=k, e=e, de=de, tau0=tau0, dtau0=dtau0,
         asym_lam_min=np.float64(LAM_ASYM),
         asym_E_inf=np.float64(large.E_inf),
         asym_u_max=np.float64(large.u_max),
         asym_g_cheb=np.asarray(large.g_cheb, dtype=float),
         info=np.array(
             "Zener Eq. (10)-(11) of I. Green, Nonlinear Dyn (2022): e_ze = -sigma'(tau0) and tau0 "
-            "[1]. e, de, tau0, dtau0: values and d/dlambda at lambda = k*h, k = 0..K, for cubic "
-            "Hermite interpolation. For lambda >= asym_lam_min: e = asym_E_inf*lambda^-5, "
+            "[1]. e, de, tau0, dtau0: values and d/dlambda at the nodes lambda = k*h (k: int "
+            "array, widths powers of 2), for cubic Hermite interpolation. For lambda >= "
+            "asym_lam_min: e = asym_E_inf*lambda^-5, "
             "tau0 = lambda*(5 ln lambda + g(u)), u = lambda^(-5/3), g = chebval(2u/asym_u_max - 1, "
             "asym_g_cheb). Made by build_scripts/make_zener_table.py."),
     )
     size = os.path.getsize(args.out)
-    print(f"wrote {os.path.abspath(args.out)}: {K + 1} nodes, h = {h:g}, {size / 1024:.0f} KiB, "
+    print(f"wrote {os.path.abspath(args.out)}: {k.size} nodes, h = {h:g}, {size / 1024:.0f} KiB, "
           f"in {time.time() - t_start:.0f} s")
     return 0
 

@@ -7,11 +7,14 @@ returns e_ze = -sigma'(tau0) [1] (the quantity fitted by Eq. (13)) and the conta
 
 How
 ---
-* 0 <= lambda <= 100: C^1 piecewise-cubic Hermite interpolation of e_ze and tau0 on the
-  uniform grid lambda = k/128, from values and slopes tabulated offline
-  (data/zener_table.npz, made by build_scripts/make_zener_table.py from rtol = 1e-13
-  solves).  Measured relative error against fresh independent solves between the nodes:
-  <= 4e-10 for e_ze and <= 3e-11 for tau0 (bound 1e-8).  The table reproduces
+* 0 <= lambda <= 100: C^1 piecewise-cubic Hermite interpolation of e_ze and tau0 from
+  values and slopes tabulated offline (data/zener_table.npz, 90 kB, made by
+  build_scripts/make_zener_table.py from rtol = 1e-13 solves) at 2148 nodes on the grid
+  lambda = k/128, spaced 1/128 where e_ze is most curved (lambda < ~5) and wider as
+  e_ze ~ lambda^-5 flattens (widths 2^n/128, 1/4 at most).  A list over all 12801 cells of
+  width 1/128 points at the shared pieces, so locating a piece is one multiply and int().
+  Measured relative error against fresh independent solves between the nodes:
+  <= 4.1e-10 for e_ze and <= 3e-11 for tau0 (bound 1e-8).  The table reproduces
   e_ze(0) = 1 and tau0(0) = 2 (5/4)^(2/5) (2/5) B(2/5, 1/2) = 3.2180655 exactly.
 * lambda > 100: a verified large-lambda form (no ODE solve).  The substitution
   sigma = lambda^-4 S, p = lambda^-5 P, tau = lambda T maps the problem onto the lambda = 1
@@ -30,12 +33,12 @@ How
   at lambda = 100, whose nodes above lambda = 6 come from the same form.  e_ze underflows
   to 0 only for lambda > ~1e61.
 
-Cost (measured, Python 3.11, numpy 2.4): a Python float in [0, 100] takes ~0.35 us, 1.8-2.0x
-the closed-form fit math.exp(-1.68374 lambda), 3.215 math.exp(0.318 lambda^1.5) of Eqs. (13)/
-(13a) (~0.19 us); other scalars (int, numpy scalars) ~0.6 us, lambda > 100 ~1.7 us.  Arrays:
-~25 ns per element for 1e5 elements, 0.7-1.1x the numpy evaluation of the same fit.  The
-table costs ~17 ms and ~6 MB (mostly Python floats for the scalar path) at import; the
-file is 0.4 MB.
+Cost (measured, Python 3.11, numpy 2.4, 2-core AMD EPYC VM): a Python float in [0, 100]
+takes ~0.34 us, 1.8x the closed-form fit math.exp(-1.68374 lambda), 3.215 math.exp(0.318
+lambda^1.5) of Eqs. (13)/(13a) (~0.18 us), also for random lambda over [0, 100]; other
+scalars (int, numpy scalars) ~0.6 us, lambda > 100 ~1.7 us.  Arrays of 1e5 elements:
+~25-45 ns per element, 1.05-1.2x the numpy evaluation of the same fit.  Import: ~20 ms,
+~2 MB.
 """
 
 from __future__ import annotations
@@ -64,10 +67,16 @@ def _load_table():
         return {k: d[k] for k in d.files}
 
 
-def _hermite(f, df, h):
-    """Coefficients of a0 + t (a1 + t (a2 + t a3)), t = (lambda - lambda_k)/h in [0, 1]."""
-    f0, f1, d0, d1 = f[:-1], f[1:], h * df[:-1], h * df[1:]
-    return f0, d0, 3.0 * (f1 - f0) - 2.0 * d0 - d1, 2.0 * (f0 - f1) + d0 + d1
+def _hermite(k, f, df, h):
+    """Pieces a0 + t (a1 + t (a2 + t a3)), t = lambda/h - k_j in [0, w_j), w_j = k_{j+1} - k_j.
+
+    The widths w_j are powers of 2, so the divisions below are exact.
+    """
+    w = np.diff(k).astype(float)
+    hw = h * w
+    f0, f1, d0, d1 = f[:-1], f[1:], hw * df[:-1], hw * df[1:]
+    return (f0, d0 / w, (3.0 * (f1 - f0) - 2.0 * d0 - d1) / w**2,
+            (2.0 * (f0 - f1) + d0 + d1) / w**3)
 
 
 _T = _load_table()
@@ -81,13 +90,23 @@ E_INF = float(_T["asym_E_inf"])
 TAU0_LAMBDA0 = float(_T["tau0"][0])
 _U_MAX = float(_T["asym_u_max"])
 _G_CHEB = [float(c) for c in _T["asym_g_cheb"]]
-# (n_intervals, 8): e coefficients a0..a3, then tau0 coefficients b0..b3
-_COEF_ARR = np.ascontiguousarray(
-    np.stack(_hermite(_T["e"], _T["de"], _H) + _hermite(_T["tau0"], _T["dtau0"], _H), axis=1)
-)
-_COEF = [tuple(row) for row in _COEF_ARR.tolist()]
-if LAMBDA_TABLE_MAX * _INV_H >= len(_COEF):  # lambda = LAMBDA_TABLE_MAX needs one more interval
-    raise RuntimeError(f"{_DATA_NAME}: table does not extend past lambda = {LAMBDA_TABLE_MAX}")
+
+
+def _build_pieces(T):
+    k = np.asarray(T["k"], dtype=np.int64)
+    if k[0] != 0 or np.any(np.diff(k) <= 0) or k[-1] * _H <= LAMBDA_TABLE_MAX:
+        raise RuntimeError(f"{_DATA_NAME}: bad node layout")
+    # one row per piece: (k_j, a0..a3 for e_ze, b0..b3 for tau0)
+    rows = np.stack((k[:-1].astype(float),) + _hermite(k, T["e"], T["de"], _H)
+                    + _hermite(k, T["tau0"], T["dtau0"], _H), axis=1)
+    cell_to_piece = np.repeat(np.arange(len(rows)), np.diff(k))  # fine cell -> piece
+    # scalar path: a list over fine cells whose entries share the piece tuples (small, and
+    # an index costs one multiply and int()); array path: the same rows, expanded
+    pieces = [tuple(r) for r in rows.tolist()]
+    return [pieces[j] for j in cell_to_piece.tolist()], np.ascontiguousarray(rows[cell_to_piece])
+
+
+_COEF, _COEF_ARR = _build_pieces(_T)
 del _T
 
 
@@ -119,30 +138,28 @@ def _scalar_general(lam):
         raise _bad_lambda(x)
     if x <= LAMBDA_TABLE_MAX:
         y = x * _INV_H
-        i = int(y)
-        t = y - i
-        a0, a1, a2, a3, b0, b1, b2, b3 = _COEF[i]
+        k, a0, a1, a2, a3, b0, b1, b2, b3 = _COEF[int(y)]
+        t = y - k
         return a0 + t * (a1 + t * (a2 + t * a3)), b0 + t * (b1 + t * (b2 + t * b3))
     return _asym_scalar(x)
 
 
 def _table_array(lam):
     x = lam * _INV_H
-    i = x.astype(np.intp)
-    t = x - i
-    c = _COEF_ARR[i]  # gather (..., 8)
-    e = c[..., 3] * t
+    c = _COEF_ARR[x.astype(np.intp)]  # gather (..., 9)
+    t = x - c[..., 0]
+    e = c[..., 4] * t
+    e += c[..., 3]
+    e *= t
     e += c[..., 2]
     e *= t
     e += c[..., 1]
-    e *= t
-    e += c[..., 0]
-    tau = c[..., 7] * t
+    tau = c[..., 8] * t
+    tau += c[..., 7]
+    tau *= t
     tau += c[..., 6]
     tau *= t
     tau += c[..., 5]
-    tau *= t
-    tau += c[..., 4]
     return e, tau
 
 
@@ -191,14 +208,16 @@ def zener_exact(lam):
 
     The "exact" method: the solution of I. Green, Nonlinear Dyn (2022), Eq. (10) with
     Eq. (11) (Zener 1941), tabulated offline and interpolated for 0 <= lambda <= 100
-    (relative error <= 1e-9), and a verified large-lambda form above (see module doc).
+    (relative error <= 5e-10), and a verified large-lambda form above (see module doc).
 
     Parameters
     ----------
     lam : float or array_like
         Zener's "inelasticity" parameter lambda [1], Eq. (12); finite and >= 0.
         A Python (or numpy) scalar gives Python floats; an array (any shape, including
-        0-d) or a list gives ndarrays of that shape.
+        0-d) or a list gives ndarrays of that shape.  Array and scalar results are
+        identical bit for bit up to lambda = 100 (above, numpy's log/pow may differ
+        from the C library's in the last bit).
 
     Returns
     -------
@@ -217,9 +236,8 @@ def zener_exact(lam):
     """
     if lam.__class__ is float and 0.0 <= lam <= 100.0:  # fast path (LAMBDA_TABLE_MAX = 100)
         x = lam * _INV_H
-        i = int(x)
-        t = x - i
-        a0, a1, a2, a3, b0, b1, b2, b3 = _COEF[i]
+        k, a0, a1, a2, a3, b0, b1, b2, b3 = _COEF[int(x)]
+        t = x - k
         return a0 + t * (a1 + t * (a2 + t * a3)), b0 + t * (b1 + t * (b2 + t * b3))
     if isinstance(lam, (int, float, np.number)) and not isinstance(lam, np.complexfloating):
         return _scalar_general(lam)

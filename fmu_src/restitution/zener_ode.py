@@ -26,7 +26,7 @@ e_ze = -sigma'(tau0) = -p(tau0) (the paper's sign convention after Eq. (13)).
 
 Implementation notes
 --------------------
-* The first ~1e-5 of tau is covered by the analytic start series
+* The first (at most 1e-5) of tau is covered by the analytic start series
   sigma = tau - (2/5) lam tau^(5/2) - (4/35) tau^(7/2) + (3/20) lam^2 tau^4,
   p     = 1 - (2/5) tau^(5/2) + (3/20) lam tau^4,
   (truncation error below 1e-17 relative), so the integration starts at
@@ -37,14 +37,15 @@ Implementation notes
   rtol for rtol in [1e-12, 1e-6]).  For larger lambda the trajectory creeps
   down a strongly attracting slow manifold (lambda sigma^(3/2) ~ p) for a
   time ~ 5 lambda ln(lambda); the problem is stiff (an explicit method needs
-  ~4.5 lambda^(5/3) steps: 0.4 s at lambda = 100, hours at 1e4) and LSODA
+  ~4.5 lambda^(5/3) steps: 0.4 s at lambda = 100, ~15 min at 1e4) and LSODA
   (automatic Adams/BDF switching, analytic Jacobian) is used instead.  LSODA
   is ~10-20x cheaper than Radau here (<= 0.2 s up to lambda = 1e4 even at
-  rtol = 1e-13, ~0.35 s at 1e8) but less faithful to its tolerance: its achieved relative
-  error is about 10-50 rtol (measured ~5e-11 at rtol = 1e-12, ~1e-11 at
-  rtol = 1e-13).  Should LSODA fail (seen at rtol = 1e-3 for lambda >= 1e6),
-  the solve is repeated with Radau.  Pass method='Radau' or 'DOP853' to
-  override.  Checked from lambda = 0 to 1e8 for rtol in [1e-13, 1e-3].
+  rtol = 1e-13, ~0.35 s at 1e8) but less faithful to its tolerance: its
+  achieved relative error is about 10-50 rtol (measured ~5e-11 at
+  rtol = 1e-12, ~1e-11 at rtol = 1e-13).  Should LSODA fail (seen at
+  rtol = 1e-3 for lambda >= 1e6), the solve is repeated with Radau.  Pass
+  method='Radau' or 'DOP853' to override.  Checked from lambda = 0 to 1e8
+  for rtol in [1e-13, 1e-3].
 * For large lambda the final values are tiny (e_ze ~ 0.679 lambda^-5), so
   the default absolute tolerance scales with that size.
 """
