@@ -1,0 +1,101 @@
+"""Command line: ``python -m restitution.scene {check,run,report} ...``.
+
+    check FILE...                      load and check scene files, print what they contain
+    run FILE [--out DIR] [--all-on] [--zener-method M] [--fmu PATH] [--rebuild] [--no-plot]
+                                       simulate a scene; write DIR/<stem>.csv, <stem>_summary.csv, <stem>.png
+    report FILE... [--out docs/scenes.md] [--repeat N] [--methods exact,ode]
+                                       auto vs every effect on: effect counts, wall times, differences
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from .loader import SceneError, load_scene
+
+
+def _check(args) -> int:
+    for path in args.files:
+        scene = load_scene(path)
+        plasticity, waves = scene.effect_modes()
+        print(f"{path}: {scene.name!r}: {len(scene.plates)} plates, {len(scene.balls)} balls, "
+              f"{len(scene.drops())} drops; outputs {', '.join(scene.outputs)} (tolerance {scene.tolerance:g}); "
+              f"plasticity = {plasticity}, plate_waves = {waves}, zener_method = {scene.model.zener_method}")
+    return 0
+
+
+def _run(args) -> int:
+    from .runner import run_scene
+
+    scene = load_scene(args.file)
+    result = run_scene(scene, fmu=args.fmu, effects="all_on" if args.all_on else "scene",
+                       zener_method=args.zener_method, progress=False if args.no_progress else None,
+                       rebuild=args.rebuild)
+    out = Path(args.out) if args.out else Path("scene-results") / scene.stem
+    out.mkdir(parents=True, exist_ok=True)
+    suffix = "_all_on" if args.all_on else ""
+    written = [result.write_csv(out / f"{scene.stem}{suffix}.csv"),
+               result.write_summary_csv(out / f"{scene.stem}{suffix}_summary.csv")]
+    if not args.no_plot:
+        written.append(result.plot(out / f"{scene.stem}{suffix}.png"))
+    print(result.summary())
+    print("wrote " + ", ".join(str(p) for p in written))
+    return 0
+
+
+def _report(args) -> int:
+    from .report import write_report
+
+    methods = args.methods.split(",") if args.methods else None
+    reports, table = write_report(args.files, out=args.out, fmu=args.fmu, repeat=args.repeat, methods=methods,
+                                  progress=False if args.no_progress else None,
+                                  log=lambda text: print(text, file=sys.stderr))
+    print(table)
+    if args.out:
+        print(f"wrote {args.out}", file=sys.stderr)
+    bad = [r.scene.stem for r in reports if not r.within_tolerance]
+    if bad:
+        print(f"outside the declared tolerance: {', '.join(bad)}", file=sys.stderr)
+        return 1
+    return 0
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m restitution.scene", description=__doc__.split("\n\n")[0])
+    sub = parser.add_subparsers(dest="command", required=True)
+
+    p = sub.add_parser("check", help="load and check scene files")
+    p.add_argument("files", nargs="+", type=Path)
+    p.set_defaults(func=_check)
+
+    p = sub.add_parser("run", help="simulate one scene through the FMU")
+    p.add_argument("file", type=Path)
+    p.add_argument("--out", type=Path, default=None, help="output directory (default scene-results/<stem>)")
+    p.add_argument("--fmu", type=Path, default=None, help="FMU to use (default: build or reuse dist/)")
+    p.add_argument("--rebuild", action="store_true", help="rebuild dist/SpherePlateImpact.fmu first")
+    p.add_argument("--all-on", action="store_true", help="every effect on (the reference run)")
+    p.add_argument("--zener-method", choices=("exact", "paper_fit", "linear", "ode"), default=None)
+    p.add_argument("--no-plot", action="store_true")
+    p.add_argument("--no-progress", action="store_true")
+    p.set_defaults(func=_run)
+
+    p = sub.add_parser("report", help="auto vs every effect on, as a Markdown table")
+    p.add_argument("files", nargs="+", type=Path)
+    p.add_argument("--out", type=Path, default=None, help="Markdown file to write or refresh")
+    p.add_argument("--fmu", type=Path, default=None)
+    p.add_argument("--repeat", type=int, default=3, help="timing repeats (best of N)")
+    p.add_argument("--methods", default=None, help="Zener methods to compare (default: the scene's and ode)")
+    p.add_argument("--no-progress", action="store_true")
+    p.set_defaults(func=_report)
+
+    args = parser.parse_args(argv)
+    try:
+        return args.func(args)
+    except SceneError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())

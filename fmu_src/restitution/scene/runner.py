@@ -1,0 +1,447 @@
+"""Run a scene through SpherePlateImpact.fmu with an event-exact fmpy master.
+
+Each drop (ball, plate, drop height) is a bouncing-ball simulation: free flight in closed
+form, impact instants located exactly, and the FMU asked for the rebound **only at impact
+events** (``v_approach`` is set at the impact; the first impact's speed is already set in
+initialization mode, so the evaluation at fmi2ExitInitializationMode is the first impact's;
+the fmi2DoStep calls that carry the FMU across each flight reuse the cached result).
+
+Only the outputs the scene requested are read, plus ``v_rebound`` (the master needs it to
+fly on) and the two Boolean outputs ``effects.plasticity`` / ``effects.plate_waves`` (to
+report which effects each impact used):
+
+================== ==================================
+requested          FMU outputs read at each impact
+================== ==================================
+bounce_heights     (apex from v_rebound)
+cor                e, jgm.e, zener.e
+contact_durations  zener.t_contact
+================== ==================================
+
+The effect modes are the scene's (default ``auto``), with ``plate_waves = on`` when
+contact durations are requested (a skipped Zener evaluation would report the Hertz
+half-space duration). ``effects="all_on"`` runs the same scene with every effect on, the
+reference the report compares against.
+"""
+from __future__ import annotations
+
+import csv
+import math
+import subprocess
+import sys
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..jgm import (critical_interference, critical_load, critical_pressure, critical_velocity,
+                   effective_modulus, sphere_mass)
+from ..model import EFFECT_MODES, RESTITUTION_MODELS, ZENER_SLOPE_BOUND
+from ..zener import ZENER_METHODS, inelasticity_parameter
+from .loader import Drop, Scene
+
+__all__ = ["DropResult", "SceneResult", "run_scene", "ensure_fmu", "open_instance", "COLUMNS",
+           "READ_OUTPUTS", "drop_parameters"]
+
+#: requested output -> (FMU output names, result column names, units)
+READ_OUTPUTS = {
+    "bounce_heights": ((), ("apex",), ("m",)),
+    "cor": (("e", "jgm.e", "zener.e"), ("e", "e_ep", "e_ze"), ("1", "1", "1")),
+    "contact_durations": (("zener.t_contact",), ("t_contact",), ("s",)),
+}
+#: column -> CSV header
+COLUMNS = {"apex": "apex_m", "e": "e", "e_ep": "e_ep", "e_ze": "e_ze", "t_contact": "t_contact_s"}
+
+_FMU_NAME = "SpherePlateImpact.fmu"
+
+
+# --- the FMU ---------------------------------------------------------------------------------
+
+def _repo_root() -> Path | None:
+    for parent in Path(__file__).resolve().parents:
+        if (parent / "build_scripts" / "build_fmu.py").is_file():
+            return parent
+    return None
+
+
+def _sources(root: Path):
+    """Files the FMU is built from (host-only subpackages excluded)."""
+    yield root / "fmu_src" / "sphere_plate_impact_slave.py"
+    pkg = root / "fmu_src" / "restitution"
+    for path in pkg.rglob("*"):
+        rel = path.relative_to(pkg).parts
+        if path.is_file() and rel[0] not in ("cosim", "scene", "__pycache__") and path.suffix in (".py", ".npz"):
+            yield path
+
+
+def ensure_fmu(fmu=None, rebuild: bool = False, log=None) -> Path:
+    """Path of the FMU to run: ``fmu`` as given, else dist/SpherePlateImpact.fmu of the source
+    checkout, (re)built with build_scripts/build_fmu.py when missing, older than any of its
+    sources, or when ``rebuild`` is true."""
+    if fmu is not None:
+        path = Path(fmu)
+        if not path.is_file():
+            raise FileNotFoundError(f"FMU {path} not found")
+        return path
+    root = _repo_root()
+    if root is None:
+        raise FileNotFoundError("no FMU given and build_scripts/build_fmu.py not found: pass --fmu PATH")
+    path = root / "dist" / _FMU_NAME
+    stale = not path.is_file() or rebuild
+    if not stale:
+        built = path.stat().st_mtime
+        stale = any(src.stat().st_mtime > built for src in _sources(root))
+    if stale:
+        if log is not None:
+            log(f"building {path} ...")
+        subprocess.run([sys.executable, str(root / "build_scripts" / "build_fmu.py"), "--out", str(path.parent)],
+                       check=True, stdout=subprocess.DEVNULL)
+    return path
+
+
+def open_instance(fmu_path):
+    """One FmuInstance reused for every drop of a scene (parameters are set per drop)."""
+    from ..cosim import FmuInstance
+
+    # Import scipy.integrate in the host before the FMU can: zener_method = ode imports it
+    # lazily, and when that first import happens inside an FMU callback the process aborted
+    # at exit ("corrupted double-linked list") in 5 of 100 runs here (0 of 100 with this import).
+    import scipy.integrate  # noqa: F401
+
+    return FmuInstance(fmu_path, instance_name="scene")
+
+
+def drop_parameters(scene: Scene, drop: Drop, plasticity: str, plate_waves: str, zener_method: str) -> dict:
+    ms, mp = drop.ball.material, drop.plate.material
+    return {
+        "sphere.E": ms.E, "sphere.nu": ms.nu, "sphere.Sy": ms.Sy, "sphere.rho": ms.rho, "sphere.d": drop.ball.diameter,
+        "plate.E": mp.E, "plate.nu": mp.nu, "plate.Sy": mp.Sy, "plate.rho": mp.rho, "plate.t": drop.plate.thickness,
+        "restitution_model": RESTITUTION_MODELS.index(scene.model.restitution_model) + 1,
+        "zener_method": ZENER_METHODS.index(zener_method) + 1,
+        "plasticity": EFFECT_MODES.index(plasticity), "plate_waves": EFFECT_MODES.index(plate_waves),
+        "effect_tolerance": scene.model.effect_tolerance,
+    }
+
+
+# --- results -----------------------------------------------------------------------------------
+
+@dataclass
+class DropResult:
+    """Every impact of one drop; arrays indexed by impact number."""
+
+    drop: Drop
+    time: np.ndarray  #: impact instants [s]
+    v_approach: np.ndarray  #: [m/s]
+    v_rebound: np.ndarray  #: [m/s]
+    columns: dict  #: requested columns (apex, e, e_ep, e_ze, t_contact) -> arrays
+    plasticity: np.ndarray  #: effects.plasticity at each impact
+    plate_waves: np.ndarray  #: effects.plate_waves at each impact
+    stop_reason: str  #: "v_min", "e<=0" or "max_bounces"
+    gravity: float = 9.80665  #: [m/s2]
+
+    @property
+    def n_impacts(self) -> int:
+        return int(self.time.size)
+
+    @property
+    def rest_time(self) -> float:
+        return float(self.time[-1]) if self.time.size else 0.0
+
+    def height(self, t):
+        """Ball height [m] at times ``t`` [s] (parabolas between impacts)."""
+        g = self.gravity
+        t = np.asarray(t, dtype=float)
+        starts = np.concatenate([[0.0], self.time])
+        v0 = np.concatenate([[0.0], np.maximum(self.v_rebound, 0.0)])
+        h0 = np.concatenate([[self.drop.drop_height], np.zeros(self.time.size)])
+        k = np.clip(np.searchsorted(starts, t, side="right") - 1, 0, starts.size - 1)
+        dt = t - starts[k]
+        h = np.where(t >= self.rest_time, 0.0, h0[k] + v0[k] * dt - 0.5 * g * dt * dt)
+        return np.maximum(h, 0.0)
+
+
+@dataclass
+class SceneResult:
+    scene: Scene
+    drops: list  #: DropResult per drop, in scene order
+    plasticity_mode: str
+    plate_waves_mode: str
+    zener_method: str
+    wall_time: float  #: seconds spent simulating the drops (FMU instantiation excluded)
+    fmu_path: Path | None = None
+    notes: list = field(default_factory=list)
+
+    @property
+    def n_impacts(self) -> int:
+        return sum(d.n_impacts for d in self.drops)
+
+    def effect_counts(self) -> dict:
+        """Impacts in total and where each effect was active."""
+        return {"impacts": self.n_impacts,
+                "plasticity": int(sum(d.plasticity.sum() for d in self.drops)),
+                "plate_waves": int(sum(d.plate_waves.sum() for d in self.drops))}
+
+    def columns(self) -> list:
+        return [c for out in self.scene.outputs for c in READ_OUTPUTS[out][1]]
+
+    def write_csv(self, path) -> Path:
+        """One row per impact: drop, impact instant and speed, requested outputs, effects used."""
+        path = Path(path)
+        cols = self.columns()
+        with path.open("w", newline="") as f:
+            w = csv.writer(f)
+            w.writerow(["ball", "plate", "drop_height_m", "impact", "time_s", "v_approach_m_s",
+                        *(COLUMNS[c] for c in cols), "plasticity", "plate_waves"])
+            for d in self.drops:
+                for i in range(d.n_impacts):
+                    w.writerow([d.drop.ball.name, d.drop.plate.name, f"{d.drop.drop_height:.9g}", i + 1,
+                                f"{d.time[i]:.12g}", f"{d.v_approach[i]:.12g}",
+                                *(f"{d.columns[c][i]:.12g}" for c in cols),
+                                int(d.plasticity[i]), int(d.plate_waves[i])])
+        return path
+
+    def write_summary_csv(self, path) -> Path:
+        path = Path(path)
+        with path.open("w", newline="") as f:
+            w = csv.writer(f)
+            w.writerow(["ball", "plate", "drop_height_m", "impacts", "rest_time_s", "stop_reason",
+                        "plasticity_impacts", "plate_wave_impacts"])
+            for d in self.drops:
+                w.writerow([d.drop.ball.name, d.drop.plate.name, f"{d.drop.drop_height:.9g}", d.n_impacts,
+                            f"{d.rest_time:.9g}", d.stop_reason, int(d.plasticity.sum()), int(d.plate_waves.sum())])
+        return path
+
+    def summary(self) -> str:
+        """Text table of the drops and of what was left out and why."""
+        lines = [f"{self.scene.name}: {len(self.drops)} drops, {self.n_impacts} impacts, "
+                 f"{self.wall_time:.3f} s (zener_method = {self.zener_method}, plasticity = {self.plasticity_mode}, "
+                 f"plate_waves = {self.plate_waves_mode})"]
+        width = max(len(d.drop.label) for d in self.drops)
+        lines.append(f"  {'drop':<{width}}  impacts  plasticity  plate waves  stop")
+        for d in self.drops:
+            lines.append(f"  {d.drop.label:<{width}}  {d.n_impacts:7d}  {int(d.plasticity.sum()):10d}  "
+                         f"{int(d.plate_waves.sum()):11d}  {d.stop_reason}")
+        lines += [f"  {line}" for line in explain(self)]
+        return "\n".join(lines)
+
+    def plot(self, path) -> Path:
+        """One panel per requested output (bounce heights vs time, COR and contact durations vs speed)."""
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+
+        outs = self.scene.outputs
+        fig, axes = plt.subplots(len(outs), 1, figsize=(8, 3.2 * len(outs)), squeeze=False)
+        colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+        for ax, out in zip(axes[:, 0], outs):
+            balls = [b.name for b in self.scene.balls]
+            for k, d in enumerate(self.drops):
+                color = colors[k % len(colors)]
+                style = ("-", "--", ":", "-.")[balls.index(d.drop.ball.name) % 4]
+                if out == "bounce_heights":
+                    t = np.linspace(0.0, d.rest_time * 1.02 if d.rest_time > 0 else 1.0, 2000)
+                    ax.plot(t, d.height(t) * 1e3, style, color=color, lw=1, label=d.drop.label)
+                elif out == "cor":
+                    ax.plot(d.v_approach, d.columns["e"], "o-", color=color, ms=3, lw=1, label=d.drop.label)
+                    ax.plot(d.v_approach, d.columns["e_ep"], "v:", color=color, ms=3, lw=1)
+                    ax.plot(d.v_approach, d.columns["e_ze"], "^--", color=color, ms=3, lw=1)
+                else:
+                    ax.plot(d.v_approach, d.columns["t_contact"] * 1e6, "o-", color=color, ms=3, lw=1,
+                            label=d.drop.label)
+            if out == "bounce_heights":
+                ax.set(xlabel="time [s]", ylabel="height [mm]", title="bounce heights")
+            elif out == "cor":
+                ax.set(xlabel="approach speed [m/s]", ylabel="COR [1]",
+                       title="COR: e (o, solid), e_ep (v, dotted), e_ze (^, dashed)")
+                ax.axhline(0.0, color="0.6", lw=0.5)
+            else:
+                ax.set(xlabel="approach speed [m/s]", ylabel="contact duration [µs]", title="contact durations")
+                ax.set_yscale("log")
+            ax.grid(alpha=0.3)
+        axes[0, 0].legend(fontsize=7, loc="best")
+        fig.suptitle(f"{self.scene.name} (plasticity = {self.plasticity_mode}, plate_waves = {self.plate_waves_mode}, "
+                     f"zener_method = {self.zener_method})", fontsize=9)
+        fig.tight_layout()
+        path = Path(path)
+        fig.savefig(path, dpi=120)
+        plt.close(fig)
+        return path
+
+
+# --- why effects were left out ---------------------------------------------------------------
+
+def critical_velocity_of(drop: Drop) -> float:
+    """V_c [m/s] of the ball/plate pair, Eq. (6) (host side, for the explanations only)."""
+    ms, mp = drop.ball.material, drop.plate.material
+    E_prime = effective_modulus(ms.E, ms.nu, mp.E, mp.nu)
+    CSy = critical_pressure(ms.nu, ms.Sy, mp.nu, mp.Sy)
+    R = 0.5 * drop.ball.diameter
+    return float(critical_velocity(critical_interference(CSy, E_prime, R), critical_load(CSy, E_prime, R),
+                                   sphere_mass(ms.rho, drop.ball.diameter)))
+
+
+def zener_lambda_of(drop: Drop, v) -> np.ndarray:
+    ms, mp = drop.ball.material, drop.plate.material
+    return inelasticity_parameter(np.asarray(v, dtype=float), ms.E, ms.nu, ms.rho, drop.ball.diameter,
+                                  mp.E, mp.nu, mp.rho, drop.plate.thickness)
+
+
+def explain(result: SceneResult) -> list[str]:
+    """What was left out of the scene and why, computed host side from the impact speeds
+    (the FMU is not asked for anything more)."""
+    scene, tol = result.scene, result.scene.model.effect_tolerance
+    counts = result.effect_counts()
+    n = counts["impacts"]
+    lines = []
+    skipped = n - counts["plasticity"]
+    if result.plasticity_mode == "off":
+        lines.append("plasticity: off (scene setting)")
+    elif skipped == 0:
+        lines.append(f"plasticity: active at all {n} impacts")
+    else:
+        below = brittle = 0
+        for d in result.drops:
+            inactive = ~d.plasticity
+            if d.drop.ball.material.brittle and d.drop.plate.material.brittle:
+                brittle += int(inactive.sum())
+            else:
+                below += int(np.sum(inactive & (d.v_approach <= critical_velocity_of(d.drop))))
+        small = skipped - below - brittle
+        parts = [f"{brittle} where neither body can yield (both brittle, V* << 1)" if brittle else "",
+                 f"{below} where V* <= 1" if below else "",
+                 f"{small} where 1 - e_ep < effect_tolerance = {tol:g}" if small else ""]
+        lines.append(f"plasticity: skipped at {skipped} of {n} impacts: " + "; ".join(p for p in parts if p))
+    skipped = n - counts["plate_waves"]
+    if result.plate_waves_mode == "off":
+        lines.append("plate waves: off (scene setting)")
+    elif result.plate_waves_mode == "on":
+        why = ("contact durations requested: Zener's tau0 is needed" if "contact_durations" in scene.outputs
+               and scene.model.plate_waves == "auto" else "plate_waves = on")
+        lines.append(f"plate waves: computed at all {n} impacts ({why})")
+    elif skipped == 0:
+        lines.append(f"plate waves: needed at all {n} impacts (1.731 lambda >= effect_tolerance = {tol:g})")
+    else:
+        lam_max = max(float(np.max(zener_lambda_of(d.drop, d.v_approach[~d.plate_waves])))
+                      for d in result.drops if np.any(~d.plate_waves))
+        lines.append(f"plate waves: skipped at {skipped} of {n} impacts: 1 - e_ze <= {ZENER_SLOPE_BOUND} lambda "
+                     f"<= {ZENER_SLOPE_BOUND * lam_max:.2g} < effect_tolerance = {tol:g}")
+    return lines
+
+
+# --- the master ----------------------------------------------------------------------------------
+
+def _run_drop(instance, scene: Scene, drop: Drop, params: dict, read_names, read_cols) -> DropResult:
+    sim = scene.simulation
+    g, v_min = sim.gravity, sim.v_min
+    slave = instance.slave
+    # Reset, then set the parameters and the first impact's speed in initialization mode: the
+    # evaluation at fmi2ExitInitializationMode is then the first impact's, not a wasted one.
+    v_first = math.sqrt(2.0 * g * drop.drop_height)
+    slave.reset()
+    slave.setupExperiment(startTime=0.0)
+    slave.enterInitializationMode()
+    instance.set(**params, v_approach=v_first)
+    slave.exitInitializationMode()
+
+    vr_in = [instance.vr("v_approach")]
+    vr_real = [instance.vr(n) for n in ("v_rebound", *read_names)]
+    vr_bool = [instance.vr("effects.plasticity"), instance.vr("effects.plate_waves")]
+    get_real, get_bool, set_real, do_step = slave.getReal, slave.getBoolean, slave.setReal, slave.doStep
+
+    times, speeds, rows, flags = [], [], [], []
+    t, v_up, h = 0.0, 0.0, drop.drop_height
+    stop = "max_bounces"
+    for _ in range(sim.max_bounces):
+        v_impact = math.sqrt(v_up * v_up + 2.0 * g * h)
+        flight = (v_up + v_impact) / g
+        do_step(t, flight)  # carries the FMU across the flight; no evaluation (inputs unchanged)
+        t += flight
+        set_real(vr_in, [v_impact])
+        values = get_real(vr_real)
+        flags.append(get_bool(vr_bool))
+        times.append(t)
+        speeds.append(v_impact)
+        rows.append(values)
+        v_reb = values[0]
+        if not all(math.isfinite(x) for x in values):
+            raise RuntimeError(f"{drop.label}: the FMU returned NaN at impact {len(rows)} "
+                               f"(v_approach = {v_impact!r} m/s); FMU log: {instance.last_message()}")
+        if v_reb <= 0.0:  # e <= 0: the ball stays with the plate
+            stop = "e<=0"
+            break
+        if v_reb < v_min:
+            stop = "v_min"
+            break
+        v_up, h = v_reb, 0.0
+    data = np.array(rows, dtype=float).reshape(len(rows), 1 + len(read_names))
+    flags = np.array(flags, dtype=bool).reshape(len(rows), 2)
+    v_reb = data[:, 0]
+    columns = {}
+    if "bounce_heights" in scene.outputs:
+        columns["apex"] = np.where(v_reb > 0.0, v_reb * v_reb / (2.0 * g), 0.0)
+    for j, col in enumerate(read_cols):
+        columns[col] = data[:, 1 + j]
+    return DropResult(drop=drop, time=np.array(times), v_approach=np.array(speeds), v_rebound=v_reb,
+                      columns=columns, plasticity=flags[:, 0], plate_waves=flags[:, 1], stop_reason=stop,
+                      gravity=g)
+
+
+def run_scene(scene: Scene, fmu=None, *, effects: str = "scene", zener_method: str | None = None,
+              instance=None, progress: bool | None = None, rebuild: bool = False) -> SceneResult:
+    """Simulate every drop of ``scene`` through the FMU.
+
+    ``effects``: ``"scene"`` (the scene's modes, auto by default, see :meth:`Scene.effect_modes`)
+    or ``"all_on"`` (plasticity = plate_waves = on, the reference). ``zener_method`` overrides
+    the scene's. ``instance``: an open :class:`~restitution.cosim.FmuInstance` to reuse
+    (else one is opened on ``fmu`` or the built/reused dist/ FMU, and closed afterwards).
+    ``progress``: a tqdm bar (None: shown only when the run takes more than a second).
+    """
+    if effects == "scene":
+        plasticity, plate_waves = scene.effect_modes()
+    elif effects == "all_on":
+        plasticity, plate_waves = "on", "on"
+    else:
+        raise ValueError(f"effects = {effects!r} is not 'scene' or 'all_on'")
+    method = zener_method or scene.model.zener_method
+    if method not in ZENER_METHODS:
+        raise ValueError(f"zener_method = {method!r} is not one of {ZENER_METHODS}")
+    read_names = [n for out in scene.outputs for n in READ_OUTPUTS[out][0]]
+    read_cols = [c for out in scene.outputs for c in READ_OUTPUTS[out][1] if c != "apex"]
+
+    own = instance is None
+    fmu_path = None
+    if own:
+        fmu_path = ensure_fmu(fmu, rebuild=rebuild)
+        instance = open_instance(fmu_path)
+    drops = scene.drops()
+    try:
+        bar = _progress(drops, scene, progress, method)
+        results = []
+        start = time.perf_counter()
+        for drop in bar:
+            params = drop_parameters(scene, drop, plasticity, plate_waves, method)
+            result = _run_drop(instance, scene, drop, params, read_names, read_cols)
+            results.append(result)
+            if hasattr(bar, "set_postfix_str"):
+                bar.set_postfix_str(f"{sum(r.n_impacts for r in results)} impacts")
+        wall = time.perf_counter() - start
+        if hasattr(bar, "close"):
+            bar.close()
+    finally:
+        if own:
+            instance.close()
+    return SceneResult(scene=scene, drops=results, plasticity_mode=plasticity, plate_waves_mode=plate_waves,
+                       zener_method=method, wall_time=wall, fmu_path=fmu_path)
+
+
+def _progress(drops, scene, progress, method):
+    if progress is False:
+        return drops
+    try:
+        from tqdm import tqdm
+    except ModuleNotFoundError:  # the bar is a convenience, not a requirement
+        return drops
+    return tqdm(drops, desc=f"{scene.stem} ({method})", unit="drop", delay=0.0 if progress else 1.0,
+                leave=False, file=sys.stderr)
