@@ -47,9 +47,11 @@
 #include <dlfcn.h>
 #include <errno.h>
 #include <limits.h>
+#include <link.h>
 #include <pthread.h>
 #include <stdarg.h>
 #include <stddef.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -542,6 +544,40 @@ __attribute__((destructor)) static void shim_unload(void)
 }
 
 
+/* pythonfmu 0.7 bug at process exit: its static std::shared_ptr<PyState> pyState is
+ * destroyed by the exit handlers (__cxa_atexit), then its __attribute__((destructor))
+ * onLibraryUnload assigns nullptr to the destroyed object and so releases the already
+ * freed control block again (valgrind: invalid read in finalizePythonInterpreter). That
+ * write into freed heap memory made plain C hosts abort at exit ("free(): corrupted
+ * unsorted chunks", in libgfortran's fini) once scipy had loaded libgfortran. The handler
+ * below is registered right after the pythonfmu binary is loaded, so it runs before that
+ * binary's static destructors (exit handlers run last-in, first-out): it empties the
+ * shared_ptr (pointer and control block, two words), after which both the destructor and
+ * onLibraryUnload do nothing; the PyState is left to the process exit (the interpreter is
+ * never finalized anyway). make_standalone.py finds the symbol's offset in the binary's
+ * symbol table at build time; the binary's size guards against a different binary. */
+#if defined(SHIM_PYSTATE_OFFSET) && defined(SHIM_REAL_SIZE)
+static void *g_pystate_slot = NULL;
+
+static void disarm_pythonfmu_pystate(void)
+{
+    if (g_pystate_slot) memset(g_pystate_slot, 0, 2 * sizeof(void *));
+    g_pystate_slot = NULL;
+}
+
+static void arm_pystate_exit_fix(const char *real_path)
+{
+    struct stat st;
+    struct link_map *map = NULL;
+    if (stat(real_path, &st) != 0 || st.st_size != (off_t)SHIM_REAL_SIZE) return;
+    if (dlinfo(g_real, RTLD_DI_LINKMAP, &map) != 0 || !map) return;
+    g_pystate_slot = (void *)(map->l_addr + (uintptr_t)SHIM_PYSTATE_OFFSET);
+    atexit(disarm_pythonfmu_pystate);
+}
+#else
+static void arm_pystate_exit_fix(const char *real_path) { (void)real_path; }
+#endif
+
 /* ------------------------------------------------------------------------ */
 /* Interpreter start-up (GIL held on return, caller releases it)            */
 /* ------------------------------------------------------------------------ */
@@ -812,6 +848,7 @@ static int ensure_ready(fmi2String instanceName, fmi2String resourceLocation, co
             g_real = NULL;
             return 0;
         }
+        arm_pystate_exit_fix(path);
     }
     g_ready = 1;
     return 1;

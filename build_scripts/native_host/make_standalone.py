@@ -167,7 +167,36 @@ def _config_text(info: dict, requires: Sequence[str]) -> str:
     return "\n".join(lines) + "\n"
 
 
-def _compile_shim(output: Path, real_name: str, include_dir: str, compiler: str) -> None:
+#: pythonfmu's ``(anonymous namespace)::pyState`` (a std::shared_ptr, two words): see
+#: arm_pystate_exit_fix in fmi2_shim.c, which empties it before pythonfmu's exit-time double release.
+PYSTATE_SYMBOL = b"_ZN12_GLOBAL__N_17pyStateE"
+
+
+def _pystate_offset(binary: bytes) -> Optional[int]:
+    """st_value of PYSTATE_SYMBOL in the ELF64 (little-endian) binary's .symtab, if it has one of 16 bytes."""
+    import struct
+
+    if binary[:4] != b"\x7fELF" or binary[4] != 2 or binary[5] != 1:
+        return None
+    shoff, = struct.unpack_from("<Q", binary, 0x28)
+    shentsize, shnum = struct.unpack_from("<HH", binary, 0x3A)
+    sections = [struct.unpack_from("<IIQQQQIIQQ", binary, shoff + i * shentsize) for i in range(shnum)]
+    for _name, sh_type, _flags, _addr, offset, size, link, _info, _align, entsize in sections:
+        if sh_type != 2 or not entsize:  # SHT_SYMTAB
+            continue
+        str_offset, str_size = sections[link][4], sections[link][5]
+        strtab = binary[str_offset:str_offset + str_size]
+        for k in range(size // entsize):
+            st_name, _st_info, _st_other, st_shndx, st_value, st_size = struct.unpack_from(
+                "<IBBHQQ", binary, offset + k * entsize)
+            end = strtab.find(b"\0", st_name)
+            if strtab[st_name:end] == PYSTATE_SYMBOL and st_size == 16 and st_shndx != 0:
+                return st_value
+    return None
+
+
+def _compile_shim(output: Path, real_name: str, include_dir: str, compiler: str,
+                  real_binary: Optional[bytes] = None) -> None:
     cmd = [
         compiler,
         "-shared",
@@ -177,6 +206,9 @@ def _compile_shim(output: Path, real_name: str, include_dir: str, compiler: str)
         f'-DSHIM_REAL_BINARY="{real_name}"',
         f'-DSHIM_CONFIG_NAME="{CONFIG_NAME}"',
     ]
+    offset = _pystate_offset(real_binary) if real_binary else None
+    if offset is not None:
+        cmd += [f"-DSHIM_PYSTATE_OFFSET={offset:#x}", f"-DSHIM_REAL_SIZE={len(real_binary)}"]
     if include_dir and (Path(include_dir) / "Python.h").is_file():
         cmd += ["-DSHIM_HAVE_PYTHON_H", f"-I{include_dir}"]
     cmd += [str(SHIM_SOURCE), "-o", str(output), "-ldl", "-lpthread"]
@@ -249,7 +281,7 @@ def make_standalone(
 
     with tempfile.TemporaryDirectory(prefix="fmi2shim_") as tmp:
         shim_so = Path(tmp) / f"{model_id}.so"
-        _compile_shim(shim_so, f"{model_id}{REAL_SUFFIX}.so", info["include"], compiler)
+        _compile_shim(shim_so, f"{model_id}{REAL_SUFFIX}.so", info["include"], compiler, real_binary)
         shim_binary = shim_so.read_bytes()
 
     new_entries: dict[str, bytes] = {}

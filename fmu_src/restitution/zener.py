@@ -15,7 +15,7 @@ import math
 
 import numpy as np
 
-from ._num import exp, is_scalar, sqrt, where
+from ._num import exp, is_scalar, minimum, sqrt, where
 from .jgm import reduced_modulus
 from .zener_exact import zener_exact
 from .zener_ode import solve_zener_ode
@@ -76,8 +76,15 @@ def zener_paper_fit(lam):
     e_ze = exp(-1.68374 lambda), tau0 = 3.215 exp(0.318 lambda^(3/2)).
     Fitted on 0 <= lambda <= 1.5: absolute error in e up to 0.0136 (relative 20 %
     at lambda = 1.5); tau0 within ~1 % there but diverging above lambda ~ 2.
+    Extension: tau0 is held at its value for lambda = _PAPER_FIT_LAMBDA_CAP (~169,
+    tau0 ~ 3e304) beyond it, where the formula would overflow (the result is far outside
+    the fit's range and flagged there anyway); it stays finite and non-decreasing.
     """
-    return exp(-1.68374 * lam), 3.215 * exp(0.318 * lam ** 1.5)
+    return exp(-1.68374 * lam), 3.215 * exp(0.318 * minimum(lam, _PAPER_FIT_LAMBDA_CAP) ** 1.5)
+
+
+#: lambda above which Eq. (13a)'s exponent 0.318 lambda^1.5 would pass 700 (exp overflows at ~709.8).
+_PAPER_FIT_LAMBDA_CAP = (700.0 / 0.318) ** (2.0 / 3.0)
 
 
 def zener_linear(lam):

@@ -1,0 +1,262 @@
+/*
+ * Scriptable FMI 2.0 co-simulation host in plain C: drives several instances of one FMU
+ * through a script read from stdin, the way C/C++ simulation tools call an FMU.
+ *
+ * The binary is opened with dlopen(RTLD_LAZY | RTLD_LOCAL); the process knows nothing
+ * about Python.
+ *
+ * Usage:  fmi2_script_host <unpacked_fmu_dir> <modelIdentifier> <guid> < script
+ *
+ * Script: one command per line (S is an instance slot, numbered from 0 in the order of
+ * "instantiate"; values are parsed with strtod, so nan and inf are accepted):
+ *   instantiate NAME          fmi2Instantiate (co-simulation, loggingOn)
+ *   setup S T0                fmi2SetupExperiment(S, no tolerance, T0, no stop time)
+ *   enter_init S | exit_init S | terminate S | reset S | free S
+ *   set_real S VR VALUE       set_integer S VR VALUE       set_boolean S VR 0|1
+ *   get_real S VR...          get_integer S VR...          get_boolean S VR...
+ *   step S T H                fmi2DoStep(S, T, H, noSetFMUStatePriorToCurrentPoint = true)
+ *   get_state S | set_state S | free_state S                (one stored state per slot)
+ *   serialize S | deserialize S   via the slot's byte buffer (size, serialize, deserialize)
+ *
+ * Output (stdout, line-buffered):
+ *   LOG <instance> <status> <category>: <message>      every logger callback
+ *   STATUS <command> <slot> <OK|Warning|Discard|Error|Fatal>   every fmi2 call
+ *   REAL <slot> <vr> <%.17g>, INTEGER <slot> <vr> <%d>, BOOLEAN <slot> <vr> <0|1>
+ *   SERIALIZED <slot> <bytes>
+ *   INSTANCE <slot> <name>    or INSTANTIATE_FAILED (then exit code 3)
+ *
+ * Exit codes: 0 script done, 1 usage/script error, 2 dlopen/dlsym failure, 3 fmi2Instantiate
+ * returned NULL.
+ *
+ * Build: gcc -O2 -o fmi2_script_host fmi2_script_host.c -ldl
+ */
+#include <dlfcn.h>
+#include <limits.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef void *fmi2Component;
+typedef void *fmi2ComponentEnvironment;
+typedef void *fmi2FMUstate;
+typedef unsigned int fmi2ValueReference;
+typedef double fmi2Real;
+typedef int fmi2Integer;
+typedef int fmi2Boolean;
+typedef char fmi2Byte;
+typedef const char *fmi2String;
+typedef enum { fmi2OK, fmi2Warning, fmi2Discard, fmi2Error, fmi2Fatal, fmi2Pending } fmi2Status;
+typedef enum { fmi2ModelExchange, fmi2CoSimulation } fmi2Type;
+
+typedef void (*fmi2CallbackLogger)(fmi2ComponentEnvironment, fmi2String, fmi2Status, fmi2String, fmi2String, ...);
+typedef struct {
+    fmi2CallbackLogger logger;
+    void *(*allocateMemory)(size_t, size_t);
+    void (*freeMemory)(void *);
+    void (*stepFinished)(fmi2ComponentEnvironment, fmi2Status);
+    fmi2ComponentEnvironment componentEnvironment;
+} fmi2CallbackFunctions;
+
+typedef fmi2Component (*InstantiateT)(fmi2String, fmi2Type, fmi2String, fmi2String, const fmi2CallbackFunctions *,
+                                      fmi2Boolean, fmi2Boolean);
+typedef void (*FreeInstanceT)(fmi2Component);
+typedef fmi2Status (*SetupT)(fmi2Component, fmi2Boolean, fmi2Real, fmi2Real, fmi2Boolean, fmi2Real);
+typedef fmi2Status (*ComponentOnlyT)(fmi2Component);
+typedef fmi2Status (*SetRealT)(fmi2Component, const fmi2ValueReference[], size_t, const fmi2Real[]);
+typedef fmi2Status (*GetRealT)(fmi2Component, const fmi2ValueReference[], size_t, fmi2Real[]);
+typedef fmi2Status (*SetIntT)(fmi2Component, const fmi2ValueReference[], size_t, const fmi2Integer[]);
+typedef fmi2Status (*GetIntT)(fmi2Component, const fmi2ValueReference[], size_t, fmi2Integer[]);
+typedef fmi2Status (*DoStepT)(fmi2Component, fmi2Real, fmi2Real, fmi2Boolean);
+typedef fmi2Status (*GetStateT)(fmi2Component, fmi2FMUstate *);
+typedef fmi2Status (*SetStateT)(fmi2Component, fmi2FMUstate);
+typedef fmi2Status (*StateSizeT)(fmi2Component, fmi2FMUstate, size_t *);
+typedef fmi2Status (*SerializeT)(fmi2Component, fmi2FMUstate, fmi2Byte[], size_t);
+typedef fmi2Status (*DeserializeT)(fmi2Component, const fmi2Byte[], size_t, fmi2FMUstate *);
+
+#define MAX_SLOTS 16
+#define MAX_VRS 256
+
+static const char *status_name(fmi2Status s)
+{
+    static const char *names[] = {"OK", "Warning", "Discard", "Error", "Fatal", "Pending"};
+    return ((unsigned)s < 6u) ? names[s] : "?";
+}
+
+static void logger(fmi2ComponentEnvironment env, fmi2String instance, fmi2Status status, fmi2String category,
+                   fmi2String message, ...)
+{
+    (void)env;
+    va_list ap;
+    printf("LOG %s %s %s: ", instance ? instance : "?", status_name(status), category ? category : "");
+    va_start(ap, message);
+    vprintf(message ? message : "", ap);
+    va_end(ap);
+    printf("\n");
+    fflush(stdout);
+}
+
+static void *lib;
+static void *sym(const char *name)
+{
+    void *p = dlsym(lib, name);
+    if (!p) {
+        fprintf(stderr, "fmi2_script_host: missing symbol %s: %s\n", name, dlerror());
+        exit(2);
+    }
+    return p;
+}
+
+static void report(const char *cmd, int slot, fmi2Status st)
+{
+    printf("STATUS %s %d %s\n", cmd, slot, status_name(st));
+}
+
+int main(int argc, char **argv)
+{
+    if (argc != 4) {
+        fprintf(stderr, "usage: %s <unpacked_fmu_dir> <modelIdentifier> <guid> < script\n", argv[0]);
+        return 1;
+    }
+    setvbuf(stdout, NULL, _IOLBF, 0);
+    char dir[PATH_MAX];
+    if (!realpath(argv[1], dir)) {
+        perror(argv[1]);
+        return 1;
+    }
+    char lib_path[PATH_MAX + 256], resources[PATH_MAX + 64];
+    snprintf(lib_path, sizeof lib_path, "%s/binaries/linux64/%s.so", dir, argv[2]);
+    snprintf(resources, sizeof resources, "file://%s/resources", dir);
+    lib = dlopen(lib_path, RTLD_LAZY | RTLD_LOCAL);
+    if (!lib) {
+        fprintf(stderr, "fmi2_script_host: dlopen failed: %s\n", dlerror());
+        return 2;
+    }
+    InstantiateT instantiate = (InstantiateT)sym("fmi2Instantiate");
+    FreeInstanceT free_instance = (FreeInstanceT)sym("fmi2FreeInstance");
+    SetupT setup = (SetupT)sym("fmi2SetupExperiment");
+    ComponentOnlyT enter_init = (ComponentOnlyT)sym("fmi2EnterInitializationMode");
+    ComponentOnlyT exit_init = (ComponentOnlyT)sym("fmi2ExitInitializationMode");
+    ComponentOnlyT terminate = (ComponentOnlyT)sym("fmi2Terminate");
+    ComponentOnlyT reset = (ComponentOnlyT)sym("fmi2Reset");
+    SetRealT set_real = (SetRealT)sym("fmi2SetReal");
+    GetRealT get_real = (GetRealT)sym("fmi2GetReal");
+    SetIntT set_integer = (SetIntT)sym("fmi2SetInteger");
+    GetIntT get_integer = (GetIntT)sym("fmi2GetInteger");
+    SetIntT set_boolean = (SetIntT)sym("fmi2SetBoolean");
+    GetIntT get_boolean = (GetIntT)sym("fmi2GetBoolean");
+    DoStepT do_step = (DoStepT)sym("fmi2DoStep");
+    GetStateT get_state = (GetStateT)sym("fmi2GetFMUstate");
+    SetStateT set_state = (SetStateT)sym("fmi2SetFMUstate");
+    GetStateT free_state = (GetStateT)sym("fmi2FreeFMUstate");
+    StateSizeT state_size = (StateSizeT)sym("fmi2SerializedFMUstateSize");
+    SerializeT serialize = (SerializeT)sym("fmi2SerializeFMUstate");
+    DeserializeT deserialize = (DeserializeT)sym("fmi2DeSerializeFMUstate");
+
+    fmi2CallbackFunctions cb = {logger, calloc, free, NULL, NULL};
+    fmi2Component inst[MAX_SLOTS] = {0};
+    fmi2FMUstate state[MAX_SLOTS] = {0};
+    fmi2Byte *blob[MAX_SLOTS] = {0};
+    size_t blob_size[MAX_SLOTS] = {0};
+    int nslots = 0;
+
+    char line[8192];
+    while (fgets(line, sizeof line, stdin)) {
+        char *save = NULL;
+        char *cmd = strtok_r(line, " \t\r\n", &save);
+        if (!cmd || cmd[0] == '#') continue;
+        if (!strcmp(cmd, "instantiate")) {
+            char *name = strtok_r(NULL, " \t\r\n", &save);
+            if (!name || nslots == MAX_SLOTS) return 1;
+            inst[nslots] = instantiate(name, fmi2CoSimulation, argv[3], resources, &cb, 0, 1);
+            if (!inst[nslots]) {
+                printf("INSTANTIATE_FAILED\n");
+                return 3;
+            }
+            printf("INSTANCE %d %s\n", nslots, name);
+            nslots++;
+            continue;
+        }
+        char *slot_text = strtok_r(NULL, " \t\r\n", &save);
+        if (!slot_text) return 1;
+        int s = atoi(slot_text);
+        if (s < 0 || s >= nslots || !inst[s]) {
+            fprintf(stderr, "fmi2_script_host: bad slot in '%s'\n", cmd);
+            return 1;
+        }
+        fmi2Component c = inst[s];
+        char *a = strtok_r(NULL, " \t\r\n", &save);
+        char *b = a ? strtok_r(NULL, " \t\r\n", &save) : NULL;
+        if (!strcmp(cmd, "setup")) {
+            report(cmd, s, setup(c, 0, 0.0, a ? strtod(a, NULL) : 0.0, 0, 0.0));
+        } else if (!strcmp(cmd, "enter_init")) {
+            report(cmd, s, enter_init(c));
+        } else if (!strcmp(cmd, "exit_init")) {
+            report(cmd, s, exit_init(c));
+        } else if (!strcmp(cmd, "terminate")) {
+            report(cmd, s, terminate(c));
+        } else if (!strcmp(cmd, "reset")) {
+            report(cmd, s, reset(c));
+        } else if (!strcmp(cmd, "free")) {
+            free_instance(c);
+            inst[s] = NULL;
+            printf("FREED %d\n", s);
+        } else if (!strcmp(cmd, "set_real") && a && b) {
+            fmi2ValueReference vr = (fmi2ValueReference)strtoul(a, NULL, 10);
+            fmi2Real v = strtod(b, NULL);
+            report(cmd, s, set_real(c, &vr, 1, &v));
+        } else if ((!strcmp(cmd, "set_integer") || !strcmp(cmd, "set_boolean")) && a && b) {
+            fmi2ValueReference vr = (fmi2ValueReference)strtoul(a, NULL, 10);
+            fmi2Integer v = (fmi2Integer)strtol(b, NULL, 10);
+            report(cmd, s, (cmd[4] == 'i' ? set_integer : set_boolean)(c, &vr, 1, &v));
+        } else if (!strncmp(cmd, "get_", 4) && a && strcmp(cmd, "get_state")) {
+            fmi2ValueReference vrs[MAX_VRS];
+            size_t n = 0;
+            for (char *t = a; t && n < MAX_VRS; t = (t == a ? b : strtok_r(NULL, " \t\r\n", &save)))
+                vrs[n++] = (fmi2ValueReference)strtoul(t, NULL, 10);
+            if (!strcmp(cmd, "get_real")) {
+                fmi2Real out[MAX_VRS];
+                fmi2Status st = get_real(c, vrs, n, out);
+                report(cmd, s, st);
+                for (size_t i = 0; i < n && st <= fmi2Warning; i++) printf("REAL %d %u %.17g\n", s, vrs[i], out[i]);
+            } else {
+                fmi2Integer out[MAX_VRS];
+                int is_int = !strcmp(cmd, "get_integer");
+                fmi2Status st = (is_int ? get_integer : get_boolean)(c, vrs, n, out);
+                report(cmd, s, st);
+                for (size_t i = 0; i < n && st <= fmi2Warning; i++)
+                    printf("%s %d %u %d\n", is_int ? "INTEGER" : "BOOLEAN", s, vrs[i], out[i]);
+            }
+        } else if (!strcmp(cmd, "step") && a && b) {
+            report(cmd, s, do_step(c, strtod(a, NULL), strtod(b, NULL), 1));
+        } else if (!strcmp(cmd, "get_state")) {
+            report(cmd, s, get_state(c, &state[s]));
+        } else if (!strcmp(cmd, "set_state")) {
+            report(cmd, s, set_state(c, state[s]));
+        } else if (!strcmp(cmd, "free_state")) {
+            report(cmd, s, free_state(c, &state[s]));
+        } else if (!strcmp(cmd, "serialize")) {
+            size_t n = 0;
+            fmi2Status st = state_size(c, state[s], &n);
+            if (st <= fmi2Warning) {
+                free(blob[s]);
+                blob[s] = malloc(n ? n : 1);
+                blob_size[s] = n;
+                st = serialize(c, state[s], blob[s], n);
+            }
+            report(cmd, s, st);
+            printf("SERIALIZED %d %zu\n", s, blob_size[s]);
+        } else if (!strcmp(cmd, "deserialize")) {
+            /* the bytes of slot a (default: s) into slot s's state */
+            int from = a ? atoi(a) : s;
+            if (from < 0 || from >= nslots || !blob[from]) return 1;
+            report(cmd, s, deserialize(c, blob[from], blob_size[from], &state[s]));
+        } else {
+            fprintf(stderr, "fmi2_script_host: unknown or incomplete command '%s'\n", cmd);
+            return 1;
+        }
+    }
+    for (int s = 0; s < nslots; s++) free(blob[s]);
+    dlclose(lib);
+    return 0;
+}

@@ -1,0 +1,233 @@
+"""SpherePlateImpact.fmu in a plain C FMI 2.0 host, as a desktop simulation tool runs it.
+
+The host (tests/c_host/fmi2_script_host.c, compiled here with the system C compiler) opens
+the FMU binary with dlopen(RTLD_LOCAL) and runs with a minimal environment: ``env -i
+PATH=/usr/bin:/bin`` (no LD_PRELOAD, no PYTHONPATH/PYTHONHOME, no virtual environment). The
+FMU's loader must find the interpreter and packages it was built with by itself.
+
+Checked: instantiate, set up, initialise, set (Real and Integer), step, get (Real and
+Boolean), bad input (logged, fmi2Discard, recovery), FMU state and its serialization across
+instances, reset, terminate, free, a clean process exit; every number against the package
+(1e-12 relative). And when the interpreter or the packages are missing: a clear log message,
+a NULL instance, no crash.
+"""
+from __future__ import annotations
+
+import math
+import shutil
+import subprocess
+import sys
+import zipfile
+from pathlib import Path
+from xml.etree import ElementTree
+
+import pytest
+
+import restitution as r
+from restitution.cosim import impact_fmu_parameters
+
+ROOT = Path(__file__).resolve().parents[1]
+HOST_SOURCE = ROOT / "tests" / "c_host" / "fmi2_script_host.c"
+MODEL = "SpherePlateImpact"
+
+pytestmark = [
+    pytest.mark.skipif(not sys.platform.startswith("linux"), reason="Linux-only (linux64 shim)"),
+    pytest.mark.skipif(shutil.which("gcc") is None, reason="gcc not available"),
+]
+
+REALS = {"e": "e", "v_rebound": "v_rebound", "jgm.e": "e_ep", "jgm.V_c": "V_c", "jgm.V_star": "V_star",
+         "zener.e": "e_ze", "zener.lambda": "lam", "zener.tau0": "tau0", "zener.t_contact": "t_contact",
+         "plate.m_eff": "m_eff", "plate.v_after": "v_plate"}
+FLAGS = {"valid": "valid", "zener.in_range": "lambda_in_range", "jgm.in_range": "vstar_in_range",
+         "e_negative": "e_negative", "effects.plasticity": "plasticity_used", "effects.plate_waves": "plate_waves_used"}
+MATERIALS = [
+    (r.Sphere(r.MATERIALS["s2_tool_steel"], 6.35e-3), r.Plate(r.MATERIALS["al_6061"], 6.35e-3)),
+    (r.Sphere(r.MATERIALS["tungsten_carbide"], 4.76e-3), r.Plate(r.MATERIALS["borosilicate_glass"], 1.0e-3)),
+]
+SPEEDS = [0.0, 1e-3, 0.5, 2.3, 30.0]
+
+
+@pytest.fixture(scope="module")
+def host(tmp_path_factory):
+    exe = tmp_path_factory.mktemp("c_host") / "fmi2_script_host"
+    subprocess.run(["gcc", "-O2", "-Wall", "-o", str(exe), str(HOST_SOURCE), "-ldl"], check=True)
+    return exe
+
+
+@pytest.fixture(scope="module")
+def fmu_info(impact_fmu):
+    with zipfile.ZipFile(impact_fmu) as z:
+        root = ElementTree.fromstring(z.read("modelDescription.xml"))
+        config = z.read("resources/python_env.txt").decode()
+    variables = {sv.get("name"): int(sv.get("valueReference")) for sv in root.find("ModelVariables")}
+    types = {sv.get("name"): sv[0].tag for sv in root.find("ModelVariables")}
+    return {"guid": root.get("guid"), "vr": variables, "type": types, "config": config}
+
+
+def unpack(impact_fmu, dest: Path) -> Path:
+    with zipfile.ZipFile(impact_fmu) as z:
+        z.extractall(dest)
+    return dest
+
+
+class Run:
+    """One run of the C host: its exit code, statuses, values and log lines, in order."""
+
+    def __init__(self, proc):
+        self.returncode, self.stdout, self.stderr = proc.returncode, proc.stdout, proc.stderr
+        self.statuses, self.values, self.logs = [], [], []
+        for line in proc.stdout.splitlines():
+            head, _, rest = line.partition(" ")
+            if head == "STATUS":
+                self.statuses.append(tuple(rest.split()))
+            elif head in ("REAL", "BOOLEAN"):
+                slot, vr, value = rest.split()
+                self.values.append(float(value) if head == "REAL" else bool(int(value)))
+            elif head == "LOG":
+                self.logs.append(rest)
+
+
+def run_host(host, unpacked, guid, script: list[str]) -> Run:
+    proc = subprocess.run(["env", "-i", "PATH=/usr/bin:/bin", str(host), str(unpacked), MODEL, guid],
+                          input="\n".join(script) + "\n", capture_output=True, text=True, timeout=300,
+                          env={"PATH": "/usr/bin:/bin"})
+    return Run(proc)
+
+
+def same(got, want):
+    return got == want or (math.isnan(got) and math.isnan(want)) or got == pytest.approx(want, rel=1e-12, abs=0.0)
+
+
+def test_the_fmu_runs_in_a_plain_c_host_and_matches_the_package(host, impact_fmu, fmu_info, tmp_path):
+    vr = fmu_info["vr"]
+    script, expected = [], []  # expected: ("real"/"bool", reference value, context) per value printed
+
+    def set_all(slot, settings):
+        for name, value in settings.items():
+            if fmu_info["type"][name] == "Integer":
+                script.append(f"set_integer {slot} {vr[name]} {int(value)}")
+            else:
+                script.append(f"set_real {slot} {vr[name]} {float(value)!r}")
+
+    def read(slot, settings, context):
+        ref = reference(settings)
+        script.append(f"get_real {slot} " + " ".join(str(vr[n]) for n in REALS))
+        expected.extend(("real", getattr(ref, f), (context, n)) for n, f in REALS.items())
+        script.append(f"get_boolean {slot} " + " ".join(str(vr[n]) for n in FLAGS))
+        expected.extend(("bool", bool(getattr(ref, f)), (context, n)) for n, f in FLAGS.items())
+
+    settings = [dict(impact_fmu_parameters(*pair)) for pair in MATERIALS]
+    for slot, name in enumerate(("impact_a", "impact_b")):
+        script.append(f"instantiate {name}")
+    for slot in (0, 1):
+        script += [f"setup {slot} 0.0", f"enter_init {slot}"]
+        set_all(slot, settings[slot])
+        script.append(f"exit_init {slot}")
+    t = 0.0
+    for method in (1, 2, 3, 4):
+        for model in (1, 2):
+            for v in SPEEDS:
+                for slot in (0, 1):  # the two instances interleaved
+                    settings[slot].update(zener_method=method, restitution_model=model, v_approach=v)
+                    set_all(slot, {"zener_method": method, "restitution_model": model, "v_approach": v})
+                    script.append(f"step {slot} {t!r} 0.001")
+                    read(slot, settings[slot], (slot, method, model, v))
+                t += 0.001
+    # bad input in instance 1: logged, discarded, the other instance unaffected, then recovered
+    script += [f"set_real 1 {vr['plate.t']} nan", "step 1 1.0 0.001", f"get_real 1 {vr['e']}", "step 0 1.0 0.001"]
+    expected.append(("real", math.nan, "bad instance"))
+    read(0, settings[0], "bystander")
+    script += [f"set_real 1 {vr['plate.t']} {settings[1]['plate.t']!r}", "step 1 1.0 0.001"]
+    read(1, settings[1], "recovered")
+    # FMU state: saved, changed, restored; serialized from instance 0 into instance 1
+    script += ["get_state 0", "serialize 0", f"set_real 0 {vr['v_approach']} 7.5", f"set_real 0 {vr['plate.t']} 0.05"]
+    read(0, {**settings[0], "v_approach": 7.5, "plate.t": 0.05}, "changed")
+    script += ["set_state 0"]
+    read(0, settings[0], "restored")
+    script += ["deserialize 1 0", "set_state 1", "step 1 2.0 0.001"]
+    read(1, settings[0], "deserialized into the other instance")
+    # reset: start values again
+    script += ["reset 1", "setup 1 0.0", "enter_init 1", "exit_init 1", "step 1 0.0 0.001"]
+    read(1, {}, "after reset")
+    script += ["free_state 0", "free_state 1", "terminate 0", "terminate 1", "free 0", "free 1"]
+
+    run = run_host(host, unpack(impact_fmu, tmp_path / "fmu"), fmu_info["guid"], script)
+    assert run.returncode == 0, run.stdout[-3000:] + run.stderr  # also: no crash at process exit
+    assert any("native-host shim: started embedded Python" in line for line in run.logs), run.logs[:3]
+    bad = [s for s in run.statuses if s[2] != "OK"]
+    assert bad == [("step", "1", "Discard")], bad
+    assert any(line.startswith("impact_b Error") and "plate.t = nan is outside the allowed range: finite and > 0"
+               in line for line in run.logs), run.logs
+    assert len(run.values) == len(expected) > 800
+    for got, (kind, want, context) in zip(run.values, expected):
+        assert (got == want) if kind == "bool" else same(got, want), (context, got, want)
+
+
+def reference(settings):
+    s = {"v_approach": 1.0, **impact_fmu_parameters(*MATERIALS[0]), "zener_method": 1, "restitution_model": 1}
+    s.update(settings)
+    return r.impact(s["v_approach"], s["sphere.E"], s["sphere.nu"], s["sphere.Sy"], s["sphere.rho"], s["sphere.d"],
+                    s["plate.E"], s["plate.nu"], s["plate.Sy"], s["plate.rho"], s["plate.t"],
+                    zener_method=r.ZENER_METHODS[s["zener_method"] - 1],
+                    restitution_model=r.RESTITUTION_MODELS[s["restitution_model"] - 1])
+
+
+def test_the_fmu_requires_only_what_its_model_imports(fmu_info):
+    """The loader checks the required modules at start-up; host-side helpers (fmpy, dask, ...) are not bundled."""
+    lines = dict(line.split("=", 1) for line in fmu_info["config"].splitlines() if "=" in line and line[0] != "#")
+    required = set(lines["require"].split(","))
+    assert "numpy" in required and required <= {"numpy", "scipy"}, required
+    assert lines["use_environment"] == "0" and Path(lines["libpython"]).is_file()
+
+
+def _edit_config(unpacked: Path, **replace) -> None:
+    cfg = unpacked / "resources" / "python_env.txt"
+    lines = []
+    for line in cfg.read_text().splitlines():
+        key = line.split("=", 1)[0]
+        if key in replace:
+            if replace[key] is None:
+                continue
+            line = f"{key}={replace[key]}"
+        lines.append(line)
+    cfg.write_text("\n".join(lines) + "\n")
+
+
+def test_missing_interpreter_gives_a_clear_message_and_no_crash(host, impact_fmu, fmu_info, tmp_path):
+    """The FMU moved to a machine without its Python: NULL instance, a message saying what it needs."""
+    unpacked = unpack(impact_fmu, tmp_path / "moved")
+    gone = "/nonexistent/pyenv/versions/3.11.7"
+    _edit_config(unpacked, libpython=f"{gone}/lib/libpython3.11.so.1.0", executable="/nonexistent/venv/bin/python",
+                 home=gone)
+    run = run_host(host, unpacked, fmu_info["guid"], ["instantiate impact", "setup 0 0.0"])
+    assert run.returncode == 3, run.stdout + run.stderr  # NULL instance reported; no signal, no abort
+    assert "INSTANTIATE_FAILED" in run.stdout
+    errors = [line for line in run.logs if line.startswith("impact Error")]
+    assert len(errors) == 1, run.logs
+    message = errors[0]
+    for needed in ("cannot load the Python shared library", f"{gone}/lib/libpython3.11.so.1.0", "python_env.txt",
+                   "Python 3.11", "/nonexistent/venv/bin/python", "--enable-shared"):
+        assert needed in message, (needed, message)
+
+
+def test_environment_without_the_packages_names_them(host, impact_fmu, fmu_info, tmp_path):
+    """The recorded interpreter exists but its environment lacks numpy and scipy (a fresh venv)."""
+    venv = tmp_path / "empty_venv"
+    subprocess.run([sys.executable, "-m", "venv", "--without-pip", str(venv)], check=True)
+    site = next((venv / "lib").glob("python3*/site-packages"))
+    unpacked = unpack(impact_fmu, tmp_path / "fmu")
+    _edit_config(unpacked, executable=str(venv / "bin" / "python"), site=str(site))
+    run = run_host(host, unpacked, fmu_info["guid"], ["instantiate impact"])
+    assert run.returncode == 3 and "INSTANTIATE_FAILED" in run.stdout, run.stdout + run.stderr
+    message = next(line for line in run.logs if line.startswith("impact Error"))
+    for needed in ("numpy", "scipy", "ModuleNotFoundError", str(venv / "bin" / "python"), "pip install",
+                   "python_env.txt"):
+        assert needed in message, (needed, message)
+
+
+def test_missing_configuration_gives_a_clear_message(host, impact_fmu, fmu_info, tmp_path):
+    unpacked = unpack(impact_fmu, tmp_path / "nocfg")
+    (unpacked / "resources" / "python_env.txt").unlink()
+    run = run_host(host, unpacked, fmu_info["guid"], ["instantiate impact"])
+    assert run.returncode == 3 and "INSTANTIATE_FAILED" in run.stdout
+    assert any("needs a Python interpreter" in line and "python_env.txt" in line for line in run.logs), run.logs

@@ -1,0 +1,439 @@
+"""SpherePlateImpact.fmu under bad input, many instances, a foreign FMU, state round trips and
+a million steps (fmpy host).
+
+* Every input and parameter set to NaN, +inf, -inf, a negative value, zero where a positive
+  value is needed, nu >= 0.5, an integer code out of range: fmi2SetXXX succeeds and the FMU
+  logs one fmi2Error message naming the variable, its value and the allowed range; outputs
+  read NaN; fmi2DoStep returns fmi2Discard (never fmi2Fatal); another instance stepping
+  alongside is unaffected; a valid value again, or fmi2Reset, gives correct results again.
+* Eight instances with different materials stepped interleaved give the same bits as one at
+  a time, and the package's numbers.
+* It runs next to a different pythonfmu FMU (built here, own module name) in one process.
+* fmi2Get/SetFMUstate and (de)serialization round-trip every variable exactly.
+* One million steps in one instance: unchanged results, resident memory growing < 1 MiB.
+"""
+from __future__ import annotations
+
+import ctypes
+import gc
+import math
+import struct
+import subprocess
+import sys
+import textwrap
+import time
+
+import pytest
+from fmpy import extract
+
+import restitution as r
+from restitution.cosim import FmiStatusError, FmuInstance, impact_fmu_parameters
+
+FMI_OK, FMI_DISCARD, FMI_ERROR, FMI_FATAL = 0, 2, 3, 4
+
+# name: (start value, allowed-range text as logged) -- the public interface contract
+INPUTS = {
+    "v_approach": (1.0, "finite and >= 0"),
+    "sphere.E": (207e9, "finite and > 0"), "sphere.nu": (0.30, "0 <= value < 0.5"),
+    "sphere.Sy": (2.0e9, "finite and > 0"), "sphere.rho": (7861.0, "finite and > 0"),
+    "sphere.d": (6.35e-3, "finite and > 0"),
+    "plate.E": (69e9, "finite and > 0"), "plate.nu": (0.33, "0 <= value < 0.5"),
+    "plate.Sy": (0.290e9, "finite and > 0"), "plate.rho": (2700.0, "finite and > 0"),
+    "plate.t": (6.35e-3, "finite and > 0"),
+    "effect_tolerance": (1e-6, "finite and >= 0"),
+    "zener.ode_tolerance": (1e-10, "1e-14 <= value <= 1e-2"),
+    "restitution_model": (1, "1 = e45 or 2 = e44"),
+    "zener_method": (1, "1 = exact, 2 = paper_fit, 3 = linear or 4 = ode"),
+    "plasticity": (2, "0 = off, 1 = on or 2 = auto"),
+    "plate_waves": (2, "0 = off, 1 = on or 2 = auto"),
+}
+CODES = {"restitution_model": (1, 2), "zener_method": (1, 4), "plasticity": (0, 2), "plate_waves": (0, 2)}
+INF, NAN = math.inf, math.nan
+
+
+def _bad_values(name):
+    if name in CODES:
+        low, high = CODES[name]
+        return [low - 1, high + 1, 2 ** 31 - 1, -2 ** 31]
+    values = [NAN, INF, -INF]
+    if name.endswith(".nu"):
+        return values + [-0.1, 0.5, 0.7]
+    if name in ("v_approach", "effect_tolerance"):
+        return values + [-1.0, -5e-324]
+    if name == "zener.ode_tolerance":
+        return values + [-1e-10, 0.0, 1e-15, 0.1]
+    return values + [-1.0, 0.0]
+
+
+BAD = [(name, value) for name in INPUTS for value in _bad_values(name)]
+REAL_OUTPUTS = {"e": "e", "v_rebound": "v_rebound", "jgm.e": "e_ep", "jgm.V_c": "V_c", "jgm.V_star": "V_star",
+                "zener.e": "e_ze", "zener.lambda": "lam", "zener.tau0": "tau0", "zener.t_contact": "t_contact",
+                "plate.m_eff": "m_eff", "plate.v_after": "v_plate"}
+OUTPUT_NAMES = list(REAL_OUTPUTS)
+BOOL_OUTPUTS = ["valid", "zener.in_range", "jgm.in_range", "e_negative", "effects.plasticity", "effects.plate_waves"]
+MODELS, METHODS, MODES = r.RESTITUTION_MODELS, r.ZENER_METHODS, r.EFFECT_MODES
+
+
+def reference(settings: dict):
+    """The package's result for a dict of FMU settings (defaults for anything not given)."""
+    s = {name: start for name, (start, _text) in INPUTS.items()}
+    s.update(settings)
+    return r.impact(s["v_approach"], *(s[f"{body}.{k}"] for body in ("sphere", "plate")
+                                       for k in ("E", "nu", "Sy", "rho", "d" if body == "sphere" else "t")),
+                    restitution_model=MODELS[s["restitution_model"] - 1], zener_method=METHODS[s["zener_method"] - 1],
+                    plasticity=MODES[s["plasticity"]], plate_waves=MODES[s["plate_waves"]],
+                    effect_tolerance=s["effect_tolerance"], ode_rtol=s["zener.ode_tolerance"])
+
+
+def assert_outputs(fmu, settings, context=""):
+    got = fmu.get_reals(OUTPUT_NAMES)
+    ref = reference(settings)
+    for name, value in zip(OUTPUT_NAMES, got):
+        want = getattr(ref, REAL_OUTPUTS[name])
+        assert value == want or value == pytest.approx(want, rel=1e-12, abs=0.0), (name, context)
+
+
+@pytest.fixture(scope="module")
+def unzipped(impact_fmu, tmp_path_factory):
+    return extract(str(impact_fmu), str(tmp_path_factory.mktemp("unzipped")))
+
+
+GOOD_SETTINGS = {**impact_fmu_parameters(r.Sphere(r.MATERIALS["tungsten_carbide"], 4.76e-3),
+                                         r.Plate(r.MATERIALS["brass_260"], 2e-3)), "v_approach": 3.1}
+
+
+@pytest.fixture(scope="module")
+def bystander(impact_fmu, unzipped):
+    """An instance that keeps stepping, with valid values, next to every misbehaving one."""
+    with FmuInstance(impact_fmu, "bystander", unzip_dir=unzipped, parameters=GOOD_SETTINGS) as fmu:
+        yield fmu
+
+
+def _message_for(name, value, allowed):
+    return f"{name} = {value!r} is outside the allowed range: {allowed}"
+
+
+@pytest.mark.parametrize("name,value", BAD, ids=[f"{n}={v!r}" for n, v in BAD])
+def test_bad_value_is_logged_discarded_and_recoverable(impact_fmu, unzipped, bystander, name, value):
+    start, allowed = INPUTS[name]
+    with FmuInstance(impact_fmu, "bad", unzip_dir=unzipped) as bad:
+        bad.set(v_approach=2.3)
+        bad.do_step(step_size=1e-3)
+        bystander.do_step(step_size=1e-3)
+        n_before = len(bad.messages)
+
+        bad.set(**{name: value})  # fmi2SetReal/Integer itself succeeds (fmpy raises otherwise)
+        logged = bad.messages[n_before:]
+        assert logged == [(FMI_ERROR, _message_for(name, value, allowed))]
+        assert all(math.isnan(x) for x in bad.get_reals(OUTPUT_NAMES))
+        assert bad.get(*BOOL_OUTPUTS) == [False] * len(BOOL_OUTPUTS)
+        for _ in range(2):  # discarded, not fatal, every time, with the reason
+            with pytest.raises(FmiStatusError) as err:
+                bad.do_step(step_size=1e-3)
+            assert err.value.status == FMI_DISCARD
+            assert bad.messages[-1][0] == FMI_DISCARD and name in bad.messages[-1][1] and allowed in bad.messages[-1][1]
+        assert FMI_FATAL not in [status for status, _ in bad.messages]
+
+        # the other instance is unaffected (and re-evaluates: its input changes every time)
+        v = 3.1 + 1e-3 * len(bad.messages) + bystander.time
+        bystander.set(v_approach=v)
+        bystander.do_step(step_size=1e-3)
+        assert_outputs(bystander, {**GOOD_SETTINGS, "v_approach": v}, "bystander")
+
+        # a valid value again: correct results again, no new complaint
+        n_before = len(bad.messages)
+        bad.set(**{name: start})
+        bad.set(v_approach=2.3)
+        bad.do_step(step_size=1e-3)
+        assert_outputs(bad, {"v_approach": 2.3}, "after a valid value")
+        assert all(status < FMI_ERROR for status, _ in bad.messages[n_before:])
+
+        # or fmi2Reset: back to the start values
+        bad.set(**{name: value})
+        bad.reset()
+        bad.do_step(step_size=1e-3)
+        assert_outputs(bad, {}, "after reset")
+
+
+@pytest.mark.parametrize("name,value", [("plate.t", NAN), ("sphere.nu", 0.5), ("zener_method", 9), ("v_approach", -INF)])
+def test_bad_value_during_initialization(impact_fmu, unzipped, name, value):
+    """Set between fmi2EnterInitializationMode and fmi2ExitInitializationMode: same behaviour."""
+    with FmuInstance(impact_fmu, "init", unzip_dir=unzipped, parameters={name: value}) as fmu:
+        assert (FMI_ERROR, _message_for(name, value, INPUTS[name][1])) in fmu.messages
+        with pytest.raises(FmiStatusError) as err:
+            fmu.do_step(step_size=1e-3)
+        assert err.value.status == FMI_DISCARD
+        fmu.set(**{name: INPUTS[name][0]})
+        fmu.do_step(step_size=1e-3)
+        assert_outputs(fmu, {}, name)
+
+
+@pytest.mark.parametrize("name,value", [("sphere.E", 1e308), ("plate.t", 1e-300), ("sphere.d", 5e-324),
+                                        ("plate.E", 5e-324), ("v_approach", 1e300), ("sphere.rho", 1e300)])
+def test_valid_but_absurd_values_are_never_fatal(impact_fmu, unzipped, name, value):
+    """In range but physically absurd: either finite results, or a logged evaluation failure and
+    fmi2Discard; never fmi2Fatal, and valid values recover."""
+    with FmuInstance(impact_fmu, "absurd", unzip_dir=unzipped) as fmu:
+        fmu.set(**{name: value})
+        try:
+            fmu.do_step(step_size=1e-3)
+            outcome = "ok"
+        except FmiStatusError as err:
+            assert err.status == FMI_DISCARD
+            assert any(status == FMI_ERROR and "evaluation failed" in text and name in text
+                       for status, text in fmu.messages)
+            outcome = "discard"
+        values = fmu.get_reals(OUTPUT_NAMES)
+        if outcome == "ok":
+            assert_outputs(fmu, {name: value}, name)
+        else:
+            assert all(math.isnan(x) for x in values)
+        assert FMI_FATAL not in [status for status, _ in fmu.messages]
+        fmu.set(**{name: INPUTS[name][0]})
+        fmu.do_step(step_size=1e-3)
+        assert_outputs(fmu, {}, name)
+
+
+# --- many instances --------------------------------------------------------------------------------
+EIGHT = [  # (sphere, d, plate, t, zener_method, restitution_model)
+    ("s2_tool_steel", 6.35e-3, "al_6061", 6.35e-3, 1, 1),
+    ("tungsten_carbide", 4.76e-3, "al_6061", 1.0e-3, 1, 2),
+    ("borosilicate_glass", 6.35e-3, "borosilicate_glass", 6.35e-2, 2, 1),
+    ("brass_260", 4.76e-3, "s7_tool_steel", 3.0e-3, 3, 1),
+    ("chrome_steel", 4.76e-3, "stainless_440c", 2.0e-2, 1, 2),
+    ("low_carbon_steel", 6.35e-3, "al_1100_h16", 0.5e-3, 1, 1),
+    ("nitinol_60", 6.35e-3, "nitinol_60", 6.35e-3, 4, 1),
+    ("al_1100_h16", 6.35e-3, "s7_tool_steel", 1.0e-1, 2, 2),
+]
+
+
+def _eight_settings():
+    out = []
+    for s, d, p, t, method, model in EIGHT:
+        settings = impact_fmu_parameters(r.Sphere(r.MATERIALS[s], d), r.Plate(r.MATERIALS[p], t))
+        settings.update(zener_method=method, restitution_model=model)
+        out.append(settings)
+    return out
+
+
+def _speeds(i, n=40):
+    return [0.01 + 0.37 * i + 0.25 * k + 1e-3 * k * k for k in range(n)]
+
+
+def test_eight_instances_interleaved_equal_one_at_a_time(impact_fmu, unzipped):
+    settings = _eight_settings()
+    n = 40
+
+    def make(i):
+        return FmuInstance(impact_fmu, f"m{i}", unzip_dir=unzipped, parameters=settings[i])
+
+    interleaved = [[] for _ in settings]
+    instances = [make(i) for i in range(len(settings))]
+    try:
+        for k in range(n):
+            for i, fmu in enumerate(instances):
+                fmu.set(v_approach=_speeds(i)[k])
+                fmu.do_step(step_size=1e-3)
+                interleaved[i].append(tuple(fmu.get_reals(OUTPUT_NAMES)) + tuple(fmu.get(*BOOL_OUTPUTS)))
+    finally:
+        for fmu in instances:
+            fmu.close()
+
+    for i in range(len(settings)):
+        with make(i) as fmu:
+            alone = []
+            for k in range(n):
+                fmu.set(v_approach=_speeds(i)[k])
+                fmu.do_step(step_size=1e-3)
+                alone.append(tuple(fmu.get_reals(OUTPUT_NAMES)) + tuple(fmu.get(*BOOL_OUTPUTS)))
+            assert alone == interleaved[i], EIGHT[i]
+            for k in (0, n // 2, n - 1):
+                ref = reference({**settings[i], "v_approach": _speeds(i)[k]})
+                for name, value in zip(OUTPUT_NAMES, alone[k]):
+                    want = getattr(ref, REAL_OUTPUTS[name])
+                    assert value == want or value == pytest.approx(want, rel=1e-12), (EIGHT[i], name)
+    # the eight really differ
+    assert len({row[0][0] for row in interleaved}) == len(settings)
+
+
+# --- next to another pythonfmu FMU ---------------------------------------------------------------
+TOY_MODULE = "robustness_toy_gain_counter_slave"  # unique: FMU scripts sharing a module name clash
+TOY_SOURCE = '''
+import math
+from pythonfmu import Fmi2Causality, Fmi2Slave, Fmi2Variability, Integer, Real
+
+
+class RobustnessToyGainCounter(Fmi2Slave):
+    """y = gain * x, steps = number of doStep calls (a different pythonfmu FMU)."""
+    author = "tests"
+    description = "toy"
+
+    def __init__(self, **kwargs):
+        super().__init__(**kwargs)
+        self.x = 1.0
+        self.gain = 3.0
+        self.y = 3.0
+        self.steps = 0
+        self.register_variable(Real("x", causality=Fmi2Causality.input, variability=Fmi2Variability.continuous))
+        self.register_variable(Real("gain", causality=Fmi2Causality.parameter, variability=Fmi2Variability.tunable))
+        self.register_variable(Real("y", causality=Fmi2Causality.output, variability=Fmi2Variability.continuous))
+        self.register_variable(Integer("steps", causality=Fmi2Causality.output,
+                                       variability=Fmi2Variability.discrete))
+
+    def do_step(self, current_time, step_size):
+        self.y = self.gain * math.sqrt(self.x)
+        self.steps += 1
+        return True
+'''
+
+
+@pytest.fixture(scope="module")
+def toy_fmu(tmp_path_factory):
+    work = tmp_path_factory.mktemp("toy")
+    script = work / f"{TOY_MODULE}.py"
+    script.write_text(textwrap.dedent(TOY_SOURCE))
+    subprocess.run([sys.executable, "-m", "pythonfmu", "build", "-f", str(script), "-d", str(work)],
+                   check=True, cwd=work, capture_output=True)
+    return work / "RobustnessToyGainCounter.fmu"
+
+
+def test_runs_next_to_a_different_pythonfmu_fmu(impact_fmu, unzipped, toy_fmu):
+    settings = _eight_settings()[1]
+    with FmuInstance(toy_fmu, "toy", parameters={"gain": 2.5}) as toy, \
+            FmuInstance(impact_fmu, "impact", unzip_dir=unzipped, parameters=settings) as impact, \
+            FmuInstance(toy_fmu, "toy2") as toy2:
+        for k in range(50):
+            x = 0.5 + 0.1 * k
+            toy.set(x=x)
+            impact.set(v_approach=x)
+            toy2.set(x=4.0 * x)
+            for fmu in (impact, toy, toy2):
+                fmu.do_step(step_size=1e-2)
+            assert toy.get("y", "steps") == [2.5 * math.sqrt(x), k + 1]
+            assert toy2.get("y", "steps") == [3.0 * math.sqrt(4.0 * x), k + 1]
+            assert impact.get_reals(["e"])[0] == reference({**settings, "v_approach": x}).e
+        assert not any(status >= FMI_ERROR for status, _ in impact.messages + toy.messages)
+
+
+# --- FMU state --------------------------------------------------------------------------------------
+ALL_VARIABLES = list(INPUTS) + OUTPUT_NAMES + BOOL_OUTPUTS
+
+
+def _snapshot(fmu):
+    return [struct.pack("<d", x) if isinstance(x, float) else x for x in fmu.get(*ALL_VARIABLES)]
+
+
+STATE_CASES = {
+    "thin plate, e44, linear": {**_eight_settings()[1], "v_approach": 7.25, "zener_method": 3, "restitution_model": 2},
+    "half-space (m_eff = inf)": {"plate_waves": 0, "v_approach": 1e-12},
+    "no impact (v = 0)": {"v_approach": 0.0, "plate.t": 1e-4},
+    "ode, odd digits": {"zener_method": 4, "zener.ode_tolerance": 3.3e-9, "v_approach": 0.1 + 0.2,
+                        "sphere.nu": 0.499, "plate.nu": 0.0, "effect_tolerance": 0.0},
+}
+
+
+@pytest.mark.parametrize("case", list(STATE_CASES))
+def test_state_get_set_and_serialize_round_trip_exactly(impact_fmu, unzipped, case):
+    settings = STATE_CASES[case]
+    with FmuInstance(impact_fmu, "state", unzip_dir=unzipped, parameters=settings) as fmu, \
+            FmuInstance(impact_fmu, "other", unzip_dir=unzipped) as other:
+        fmu.do_step(0.0, 0.5)
+        before = _snapshot(fmu)
+        state = fmu.slave.getFMUstate()
+        blob = fmu.slave.serializeFMUstate(state)
+        assert 0 < len(blob) < 10_000
+
+        fmu.set(**_eight_settings()[6], v_approach=4.0, plasticity=1)  # change everything
+        fmu.do_step(0.5, 0.5)
+        changed = _snapshot(fmu)
+        assert changed != before
+
+        fmu.slave.setFMUstate(state)  # in memory
+        assert _snapshot(fmu) == before
+        fmu.do_step(1.0, 0.5)
+        assert_outputs(fmu, settings, case)
+
+        copy = fmu.slave.deSerializeFMUstate(blob)  # serialized, into a different fresh instance
+        other.slave.setFMUstate(copy)
+        assert _snapshot(other) == before
+        other.do_step(0.0, 0.5)
+        assert_outputs(other, settings, case)
+        assert fmu.slave.serializeFMUstate(copy) == blob  # and again, byte for byte
+        fmu.slave.freeFMUstate(copy)
+        fmu.slave.freeFMUstate(state)
+
+
+def test_state_captured_while_invalid_restores_the_complaint(impact_fmu, unzipped):
+    with FmuInstance(impact_fmu, "state", unzip_dir=unzipped) as fmu:
+        good = fmu.slave.getFMUstate()
+        fmu.set(**{"plate.t": NAN})
+        bad_blob = fmu.slave.serializeFMUstate(fmu.slave.getFMUstate())
+        fmu.slave.setFMUstate(good)
+        fmu.do_step(0.0, 0.1)
+        assert_outputs(fmu, {}, "good state")
+        fmu.slave.setFMUstate(fmu.slave.deSerializeFMUstate(bad_blob))
+        assert fmu.messages[-1] == (FMI_ERROR, _message_for("plate.t", NAN, "finite and > 0"))
+        with pytest.raises(FmiStatusError) as err:
+            fmu.do_step(0.1, 0.1)
+        assert err.value.status == FMI_DISCARD
+        fmu.slave.setFMUstate(good)
+        fmu.do_step(0.2, 0.1)
+        assert_outputs(fmu, {}, "good state again")
+
+
+# --- a long run -------------------------------------------------------------------------------------
+def _rss_kib() -> int:
+    with open("/proc/self/status") as status:
+        for line in status:
+            if line.startswith("VmRSS:"):
+                return int(line.split()[1])
+    raise RuntimeError("no VmRSS in /proc/self/status")
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc/self/status")
+def test_one_million_steps_unchanged_results_flat_memory(impact_fmu, unzipped, record_property):
+    """1e6 x (fmi2SetReal v, fmi2DoStep, fmi2GetReal e, v_rebound), v cycling through four values so
+    that every step evaluates the model; raw FMI calls through fmpy's bindings (no per-call arrays)."""
+    from fmpy.fmi2 import fmi2Real, fmi2ValueReference
+
+    speeds = [2.3, 0.05, 11.0, 0.7]
+    with FmuInstance(impact_fmu, "long", unzip_dir=unzipped, parameters=_eight_settings()[0]) as fmu:
+        expected = []
+        for v in speeds:
+            ref = reference({**_eight_settings()[0], "v_approach": v})
+            expected.append((ref.e, ref.v_rebound))
+        s = fmu.slave
+        set_real, get_real, do_step, c = s.fmi2SetReal, s.fmi2GetReal, s.fmi2DoStep, s.component
+        vr_in = (fmi2ValueReference * 1)(fmu.vr("v_approach"))
+        vr_out = (fmi2ValueReference * 2)(fmu.vr("e"), fmu.vr("v_rebound"))
+        value, out = (fmi2Real * 1)(), (fmi2Real * 2)()
+        h = 1e-3
+
+        def run(first, count):
+            wrong = 0
+            for k in range(first, first + count):
+                value[0] = speeds[k & 3]
+                set_real(c, vr_in, 1, value)
+                do_step(c, k * h, h, 1)
+                get_real(c, vr_out, 2, out)
+                e, v_reb = expected[k & 3]
+                if out[0] != e or out[1] != v_reb:
+                    wrong += 1
+            return wrong
+
+        assert run(0, 50_000) == 0  # warm-up: caches, allocator pools, lazy imports
+        gc.collect()
+        rss0 = _rss_kib()
+        t0 = time.perf_counter()
+        wrong = run(50_000, 1_000_000)
+        elapsed = time.perf_counter() - t0
+        gc.collect()
+        growth = _rss_kib() - rss0
+        record_property("steps_per_second", round(1e6 / elapsed))
+        record_property("rss_growth_kib", growth)
+        print(f"\n1e6 steps: {1e6 / elapsed:,.0f} steps/s, RSS growth {growth} KiB")
+        assert wrong == 0
+        assert growth < 1024, f"resident memory grew by {growth} KiB over 1e6 steps"
+        assert not any(status >= FMI_ERROR for status, _ in fmu.messages)
+        assert_outputs(fmu, {**_eight_settings()[0], "v_approach": speeds[(50_000 + 1_000_000 - 1) & 3]})
