@@ -1,0 +1,177 @@
+"""Command line: ``python -m restitution.sweep [SPEC.toml|SPEC.json] [options]`` (see --help, docs/sweeps.md)."""
+from __future__ import annotations
+
+import argparse
+import contextlib
+import sys
+from pathlib import Path
+
+from ..materials import MATERIALS, TABLE4_CASES
+from .spec import CODES, INPUTS, T_OVER_D, SweepSpec, canonical_name, load_spec
+
+EXAMPLES = """examples:
+  # e over speed and t/d for two material pairs, on a local Dask cluster (one worker per core)
+  python -m restitution.sweep --pair s2_tool_steel/al_6061 --pair chrome_steel/s7_tool_steel \\
+      --grid v_approach=geomspace:0.1:10:60 --grid t_over_d=geomspace:0.1:10:50 --out map.csv
+
+  # Monte Carlo: 10000 draws of scattered speed and moduli, checked through the FMU itself
+  python -m restitution.sweep --pair brass_260/al_6061 --random v_approach=uniform:0.5:3 \\
+      --random sphere.E=normal_rel:0.03 --random plate.E=normal_rel:0.03 --samples 10000 \\
+      --backend fmu --out mc.csv
+
+  # the same sweep on an existing cluster
+  python -m restitution.sweep spec.toml --scheduler tcp://scheduler-host:8786
+"""
+
+
+def _pairs(items):
+    out = {}
+    for item in items or []:
+        name, sep, value = item.partition("=")
+        if not sep:
+            raise SystemExit(f"expected NAME=VALUE, got {item!r}")
+        out[name.strip()] = value.strip()
+    return out
+
+
+def _list() -> str:
+    lines = ["inputs and parameters (FMU name, impact() keyword, start value):"]
+    for name, kw, vtype, start in INPUTS:
+        codes = f"  codes: {', '.join(f'{k}={v}' for k, v in CODES[name].items())}" if name in CODES else ""
+        lines.append(f"  {name:22s} {kw:18s} {start!r:>10}{codes}")
+    lines.append(f"  {T_OVER_D:22s} (derived: plate.t = t_over_d * sphere.d)")
+    lines.append("material keys (pairs are sphere/plate, or table4:A1 ... table4:B4):")
+    lines.append("  " + ", ".join(sorted(MATERIALS)))
+    lines.append("  " + ", ".join(f"table4:{c}" for c in TABLE4_CASES))
+    return "\n".join(lines)
+
+
+def build_spec(args) -> tuple[SweepSpec, dict]:
+    data = load_spec(args.spec) if args.spec else {}
+    run = dict(data.pop("run", {}) or {})
+    data = {k: (dict(v) if isinstance(v, dict) else v) for k, v in data.items()}
+    if args.pair:
+        data["pairs"] = list(args.pair)
+    for section, items in (("grid", args.grid), ("random", args.random), ("fixed", args.set)):
+        for name, value in _pairs(items).items():
+            key = canonical_name(name)
+            for other in ("grid", "random", "fixed"):  # a command-line value replaces the file's
+                for k in list(data.get(other, {})):
+                    if canonical_name(k) == key:
+                        del data[other][k]
+            data.setdefault(section, {})[key] = value
+    if args.samples is not None:
+        data["samples"] = args.samples
+    if args.seed is not None:
+        data["seed"] = args.seed
+    return SweepSpec.from_dict(data), run
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(
+        prog="python -m restitution.sweep", formatter_class=argparse.RawDescriptionHelpFormatter,
+        description="Sweep the apparent COR (Green 2022) over material pairs, FMU parameters and the "
+                    "approach speed, on Dask; write a table and a COR map.", epilog=EXAMPLES)
+    parser.add_argument("spec", nargs="?", help="TOML or JSON spec file (pairs, [grid], [random], [fixed], "
+                                                "samples, seed, [run]); options below add to or override it")
+    parser.add_argument("--pair", action="append", metavar="SPHERE/PLATE",
+                        help="material pair, e.g. s2_tool_steel/al_6061 or table4:A1 (repeat for more)")
+    parser.add_argument("--grid", action="append", metavar="NAME=VALUES",
+                        help="grid axis: 'a,b,c', 'linspace:a:b:n' or 'geomspace:a:b:n' (repeat)")
+    parser.add_argument("--random", action="append", metavar="NAME=DIST",
+                        help="random parameter: uniform:lo:hi, loguniform:lo:hi, normal:mean:sd, "
+                             "normal_rel:sd, uniform_rel:h, choice:a,b (repeat)")
+    parser.add_argument("--set", action="append", metavar="NAME=VALUE", help="fixed value (repeat)")
+    parser.add_argument("--samples", type=int, help="random cases per grid point")
+    parser.add_argument("--seed", type=int, help="seed of the random draws")
+    parser.add_argument("--backend", choices=("package", "fmu", "both"),
+                        help="package: vectorized (default); fmu: the FMU itself; both: run both and "
+                             "compare (exit 1 if they differ by more than --tolerance)")
+    parser.add_argument("--fmu", help="FMU for the fmu back end (default: dist/SpherePlateImpact.fmu, "
+                                      "built if missing)")
+    parser.add_argument("--scheduler", help="address of a running dask.distributed scheduler "
+                                            "(tcp://host:8786), 'local' (new LocalCluster) or 'serial' "
+                                            "(no Dask); default: $DASK_SCHEDULER_ADDRESS, else local")
+    parser.add_argument("--workers", type=int, help="LocalCluster worker processes (default: one per core)")
+    parser.add_argument("--chunk-size", type=int, help="cases per Dask task")
+    parser.add_argument("--columns", help="keep only these comma-separated columns (plus case and pair), "
+                                          "e.g. v_approach,t_over_d,e,valid for a big sweep")
+    parser.add_argument("--out", help="table: .csv or .parquet (default: sweep.parquet with pyarrow, else sweep.csv)")
+    parser.add_argument("--plot", help="COR map image (default: <out>_cor_map.png)")
+    parser.add_argument("--no-plot", action="store_true", help="skip the COR map")
+    parser.add_argument("--no-progress", action="store_true", help="no progress bar")
+    parser.add_argument("--tolerance", type=float, default=1e-12,
+                        help="--backend both: largest allowed difference (relative, floor 1; default 1e-12)")
+    parser.add_argument("--dry-run", action="store_true", help="print what the sweep covers and stop")
+    parser.add_argument("--list", action="store_true", help="list parameter names and materials and stop")
+    args = parser.parse_args(argv)
+
+    if args.list:
+        print(_list())
+        return 0
+    try:
+        spec, run = build_spec(args)
+    except ValueError as exc:
+        parser.error(str(exc))
+    backend = args.backend or run.get("backend", "package")
+    scheduler = args.scheduler or run.get("scheduler")
+    workers = args.workers or run.get("workers")
+    chunk = args.chunk_size or run.get("chunk_size")
+    fmu = args.fmu or run.get("fmu")
+    out = args.out or run.get("out")
+    if out is None:
+        try:
+            import pyarrow  # noqa: F401
+            out = "sweep.parquet"
+        except ModuleNotFoundError:
+            out = "sweep.csv"
+    out = Path(out)
+    if out.suffix.lower() == ".parquet":
+        try:
+            import pyarrow  # noqa: F401
+        except ModuleNotFoundError:
+            parser.error(f"--out {out}: writing Parquet needs pyarrow (pip install pyarrow); or write .csv")
+    plot = None if (args.no_plot or run.get("plot") is False) else Path(
+        args.plot or run.get("plot") or out.with_name(out.stem + "_cor_map.png"))
+    print(f"sweep: {spec.describe()}")
+    if args.dry_run:
+        return 0
+
+    from .run import compare_results, open_client, run_sweep
+
+    progress = not args.no_progress
+    columns = args.columns or run.get("columns")
+    if isinstance(columns, str):
+        columns = [c.strip() for c in columns.split(",") if c.strip()]
+    status = 0
+    with contextlib.ExitStack() as stack:
+        target = "serial" if scheduler == "serial" else stack.enter_context(open_client(scheduler, workers))
+        backends = ("package", "fmu") if backend == "both" else (backend,)
+        results = {}
+        for name in backends:
+            res = run_sweep(spec, name, fmu=fmu, scheduler=target, chunk_size=chunk, progress=progress,
+                            columns=columns)
+            print(res.summary())
+            results[name] = res
+    if backend == "both":
+        diffs = compare_results(results["fmu"], results["package"])
+        worst = max(diffs.items(), key=lambda kv: kv[1])
+        print("largest difference fmu vs package per output: "
+              + ", ".join(f"{k} {v:.2g}" for k, v in diffs.items()))
+        if not worst[1] <= args.tolerance:
+            print(f"FAIL: {worst[0]} differs by {worst[1]:.3g} > {args.tolerance:g}", file=sys.stderr)
+            status = 1
+        else:
+            print(f"the FMU and the package agree within {args.tolerance:g}")
+    result = results[backends[0]]
+    print(f"table: {result.write(out)}")
+    if plot is not None:
+        try:
+            print(f"COR map: {result.plot(plot)}")
+        except ModuleNotFoundError as exc:
+            print(f"no COR map ({exc}; pip install matplotlib)", file=sys.stderr)
+    return status
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,376 @@
+"""The two ways a sweep evaluates its cases: the vectorized package and the FMU itself.
+
+Both take the case columns of :meth:`SweepSpec.cases` and return the FMU's outputs by name
+(plus ``ok``: inputs in range and the evaluation succeeded). Invalid inputs give NaN reals
+and false flags in both, as the FMU reads them.
+
+:class:`FmuBackend` runs ``SpherePlateImpact.fmu`` through fmpy's ``FMU2Slave``: one
+instance per worker process (per thread, where a worker runs several), loaded on first use
+and reused across chunks with ``fmi2Reset``, as fmpy's parameter-variation example does.
+The FMU file travels with the sweep (as bytes, once per worker), so workers on other
+machines need no shared file system.
+
+A pythonfmu FMU runs in the host's interpreter and imports its bundled ``restitution``
+package by name. A worker that already imported ``restitution`` (to run this module) would
+hand the FMU that copy instead. The instance is therefore created with the host's
+``restitution`` modules set aside, so the FMU imports and keeps its own bundled code; the
+back end checks that the FMU's ``impact`` comes from the extracted FMU and reports the
+bundled code's fingerprint with the results.
+"""
+from __future__ import annotations
+
+import atexit
+import hashlib
+import os
+import shutil
+import sys
+import tempfile
+import threading
+from pathlib import Path
+
+import numpy as np
+
+from .spec import CODES, INPUTS, INTEGER_INPUTS, OUTPUTS
+
+__all__ = ["Backend", "PackageBackend", "FmuBackend", "get_backend", "code_fingerprint", "release_fmus"]
+
+_REAL_OUT = [name for name, _f, t in OUTPUTS if t == "Real"]
+_BOOL_OUT = [name for name, _f, t in OUTPUTS if t == "Boolean"]
+_OPTION_NAMES = ("restitution_model", "zener_method", "plasticity", "plate_waves", "effect_tolerance",
+                 "zener.ode_tolerance")
+
+
+def code_fingerprint(package_dir=None) -> str:
+    """sha256 (first 12 hex digits) of a ``restitution`` package's physics: its top-level
+    ``.py`` files and ``data/``. Default: the package this process imported."""
+    if package_dir is None:
+        package_dir = Path(__file__).resolve().parent.parent
+    package_dir = Path(package_dir)
+    h = hashlib.sha256()
+    files = sorted(package_dir.glob("*.py")) + sorted((package_dir / "data").glob("*"))
+    for f in files:
+        if f.is_file():
+            h.update(f.relative_to(package_dir).as_posix().encode())
+            h.update(f.read_bytes())
+    return h.hexdigest()[:12]
+
+
+_FINGERPRINT = None
+
+
+def _own_fingerprint() -> str:
+    global _FINGERPRINT
+    if _FINGERPRINT is None:
+        _FINGERPRINT = code_fingerprint()
+    return _FINGERPRINT
+
+
+def _empty_outputs(n: int) -> dict:
+    out = {name: np.full(n, np.nan) for name in _REAL_OUT}
+    out.update({name: np.zeros(n, dtype=bool) for name in _BOOL_OUT})
+    out["ok"] = np.zeros(n, dtype=bool)
+    return out
+
+
+def inputs_ok(cases: dict) -> np.ndarray:
+    """Cases whose inputs the FMU accepts (its ``allowed_range``): the others read NaN."""
+    ok = np.ones(np.size(cases["v_approach"]), dtype=bool)
+    with np.errstate(invalid="ignore"):
+        for name, _kw, _type, _start in INPUTS:
+            x = np.asarray(cases[name], dtype=float)
+            if name in CODES:
+                codes = sorted(CODES[name].values())
+                good = (x >= codes[0]) & (x <= codes[-1]) & (x == np.round(x))
+            elif name.endswith(".nu"):
+                good = (x >= 0.0) & (x < 0.5)
+            elif name in ("v_approach", "effect_tolerance"):
+                good = (x >= 0.0) & np.isfinite(x)
+            elif name == "zener.ode_tolerance":
+                good = (x >= 1e-14) & (x <= 1e-2)
+            else:
+                good = (x > 0.0) & np.isfinite(x)
+            ok &= good
+    return ok
+
+
+class Backend:
+    """How a chunk of cases is evaluated. Subclasses are small and picklable."""
+
+    name = "backend"
+    #: Cases per Dask task when the caller does not choose (about a second of work).
+    default_chunk = 10_000
+
+    def payload(self):
+        """What each task needs besides the cases (sent to the workers once)."""
+        return None
+
+    def evaluate(self, cases: dict, payload=None, outputs=None) -> tuple[dict, dict]:
+        """(output columns, info) for the case columns; ``outputs``: the output names needed
+        (None: all), which a back end may use to skip work."""
+        raise NotImplementedError
+
+    def describe(self) -> str:
+        return self.name
+
+
+class PackageBackend(Backend):
+    """:func:`restitution.impact` on whole arrays: the fast path."""
+
+    name = "package"
+    default_chunk = 100_000
+
+    def evaluate(self, cases: dict, payload=None, outputs=None):
+        from ..model import EFFECT_MODES, RESTITUTION_MODELS, ZENER_METHODS, impact
+
+        n = np.size(cases["v_approach"])
+        out = _empty_outputs(n)
+        ok = inputs_ok(cases)
+        if ok.any():
+            options = np.stack([np.asarray(cases[k], dtype=float) for k in _OPTION_NAMES], axis=1)
+            groups, inverse = np.unique(options[ok], axis=0, return_inverse=True)
+            rows = np.flatnonzero(ok)
+            for g, opt in enumerate(groups):
+                sel = rows[inverse.ravel() == g]
+                kwargs = {kw: np.asarray(cases[name], dtype=float)[sel]
+                          for name, kw, _t, _s in INPUTS if name not in _OPTION_NAMES}
+                result = impact(**kwargs,
+                                restitution_model=RESTITUTION_MODELS[int(opt[0]) - 1],
+                                zener_method=ZENER_METHODS[int(opt[1]) - 1],
+                                plasticity=EFFECT_MODES[int(opt[2])], plate_waves=EFFECT_MODES[int(opt[3])],
+                                effect_tolerance=float(opt[4]), ode_rtol=float(opt[5]), validate=False)
+                values = result.as_dict()
+                for name, field_name, _t in OUTPUTS:
+                    out[name][sel] = values[field_name]
+                out["ok"][sel] = True
+        return out, {"code": _own_fingerprint(), "pid": os.getpid()}
+
+
+# --- the FMU back end --------------------------------------------------------------------
+_LOCK = threading.Lock()
+_EXTRACTED: dict = {}  # sha -> (unzip dir, created-by-us dir or None)
+_INSTANCES: dict = {}  # (sha, thread id) -> _LoadedFmu
+
+
+class _LoadedFmu:
+    """One FMU2Slave with its value references, created with the FMU's own bundled code."""
+
+    def __init__(self, unzip_dir: str):
+        from fmpy import read_model_description
+        from fmpy.fmi2 import FMU2Slave
+
+        md = read_model_description(unzip_dir)
+        self.unzip_dir = unzip_dir
+        variables = {v.name: v for v in md.modelVariables}
+        self.vr = {name: variables[name].valueReference for name in variables}
+        missing = [name for name, _kw, _t, _s in INPUTS if name not in variables]
+        missing += [name for name, _f, _t in OUTPUTS if name not in variables]
+        if missing:
+            raise ValueError(f"{unzip_dir}: not a SpherePlateImpact FMU (no variable(s) {missing})")
+        self.slave = FMU2Slave(guid=md.guid, unzipDirectory=unzip_dir,
+                               modelIdentifier=md.coSimulation.modelIdentifier,
+                               instanceName=f"sweep-{os.getpid()}-{threading.get_ident()}")
+        self.code_file = _instantiate_with_bundled_code(self.slave, unzip_dir)
+        self.code = code_fingerprint(Path(self.code_file).parent)
+        self.slave.setupExperiment(startTime=0.0)
+        self.slave.enterInitializationMode()
+        self.slave.exitInitializationMode()
+
+    def reset(self):
+        s = self.slave
+        s.reset()
+        s.setupExperiment(startTime=0.0)
+        s.enterInitializationMode()
+        s.exitInitializationMode()
+
+    def evaluate(self, cases: dict, outputs=None) -> dict:
+        """Set every input of every case (the varying ones case by case), read the outputs
+        (``outputs``: names to read, default all; ``e`` is always read, for ``ok``)."""
+        n = np.size(cases["v_approach"])
+        self.reset()
+        reals = [name for name, _kw, t, _s in INPUTS if t == "Real"]
+        columns = {name: np.asarray(cases[name], dtype=float) for name, _kw, _t, _s in INPUTS}
+        varying = {name for name, col in columns.items() if n and not np.all(col == col[0])}
+        s = self.slave
+        if n:
+            # Case 0 sets everything; constant columns then stay as set.
+            s.setReal([self.vr[k] for k in reals], [float(columns[k][0]) for k in reals])
+            s.setInteger([self.vr[k] for k in INTEGER_INPUTS], [int(columns[k][0]) for k in INTEGER_INPUTS])
+        var_real = [k for k in reals if k in varying]
+        var_int = [k for k in INTEGER_INPUTS if k in varying]
+        vr_real = [self.vr[k] for k in var_real]
+        vr_int = [self.vr[k] for k in var_int]
+        real_rows = np.stack([columns[k] for k in var_real], axis=1).tolist() if var_real else None
+        int_rows = np.stack([columns[k] for k in var_int], axis=1).astype(int).tolist() if var_int else None
+        real_names = [k for k in _REAL_OUT if outputs is None or k in outputs or k == "e"]
+        bool_names = [k for k in _BOOL_OUT if outputs is None or k in outputs]
+        real_vrs = [self.vr[k] for k in real_names]
+        bool_vrs = [self.vr[k] for k in bool_names]
+        real_out = np.empty((n, len(real_vrs)))
+        bool_out = np.empty((n, len(bool_vrs)), dtype=bool)
+        get_real, get_bool, set_real, set_int = s.getReal, s.getBoolean, s.setReal, s.setInteger
+        for i in range(n):
+            if real_rows is not None:
+                set_real(vr_real, real_rows[i])
+            if int_rows is not None:
+                set_int(vr_int, int_rows[i])
+            real_out[i] = get_real(real_vrs)
+            if bool_vrs:
+                bool_out[i] = get_bool(bool_vrs)
+        out = {name: real_out[:, j] for j, name in enumerate(real_names)}
+        out.update({name: bool_out[:, j] for j, name in enumerate(bool_names)})
+        out["ok"] = ~np.isnan(out["e"])
+        return out
+
+    def close(self):
+        if self.slave is not None:
+            try:
+                self.slave.terminate()
+                self.slave.freeInstance()
+            except Exception:  # noqa: BLE001 - best effort at shutdown
+                pass
+            self.slave = None
+
+
+_CALLBACKS = None
+
+
+def _quiet_callbacks():
+    """FMI callbacks whose logger drops messages: a bad case shows as NaN outputs and ok = False."""
+    global _CALLBACKS
+    if _CALLBACKS is None:
+        from fmpy.fmi2 import (calloc, fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE,
+                               fmi2CallbackFunctions, fmi2CallbackLoggerTYPE, free)
+
+        callbacks = fmi2CallbackFunctions()
+        callbacks.logger = fmi2CallbackLoggerTYPE(lambda *args: None)
+        callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
+        callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
+        _CALLBACKS = callbacks
+    return _CALLBACKS
+
+
+def _instantiate_with_bundled_code(slave, unzip_dir: str) -> str:
+    """fmi2Instantiate with the host's ``restitution`` (and slave) modules set aside, so the FMU
+    imports its bundled copy; the file of the ``impact`` the FMU runs, checked to be inside the FMU."""
+    resources = os.path.join(unzip_dir, "resources")
+    module_file = os.path.join(resources, "slavemodule.txt")
+    slave_module = Path(module_file).read_text().strip() if os.path.isfile(module_file) else None
+    shadowed = lambda k: k == "restitution" or k.startswith("restitution.") or k == slave_module  # noqa: E731
+    with _LOCK:
+        saved = {k: sys.modules.pop(k) for k in list(sys.modules) if shadowed(k)}
+        path_before = list(sys.path)
+        try:
+            slave.instantiate(loggingOn=False, callbacks=_quiet_callbacks())
+            fmu_module = sys.modules.get(slave_module) if slave_module else None
+            impact_fn = getattr(fmu_module, "impact", None)
+            code_file = getattr(getattr(impact_fn, "__code__", None), "co_filename", None)
+        finally:
+            for k in [k for k in sys.modules if shadowed(k)]:
+                del sys.modules[k]
+            sys.modules.update(saved)
+            sys.path[:] = path_before  # pythonfmu prepends resources/; the FMU's modules are loaded
+    if code_file is None or not os.path.realpath(code_file).startswith(os.path.realpath(resources) + os.sep):
+        raise RuntimeError(f"the FMU in {unzip_dir} does not run its bundled restitution package "
+                           f"(impact() comes from {code_file})")
+    return code_file
+
+
+def _fmu_dir(payload) -> str:
+    """Unzip directory of the FMU given as (sha, bytes) or (sha, path), extracted once per process."""
+    sha, data = payload
+    with _LOCK:
+        if sha in _EXTRACTED:
+            return _EXTRACTED[sha][0]
+    from fmpy import extract
+
+    base = None
+    try:
+        from distributed import get_worker
+        base = get_worker().local_directory
+    except Exception:  # noqa: BLE001 - not in a Dask worker
+        pass
+    own = tempfile.mkdtemp(prefix=f"restitution-sweep-{sha[:8]}-", dir=base)
+    if isinstance(data, (bytes, bytearray)):
+        fmu_file = os.path.join(own, "model.fmu")
+        with open(fmu_file, "wb") as f:
+            f.write(data)
+    else:
+        fmu_file = str(data)
+    unzip = extract(fmu_file, unzipdir=os.path.join(own, "unzipped"))
+    with _LOCK:
+        _EXTRACTED.setdefault(sha, (unzip, own))
+        return _EXTRACTED[sha][0]
+
+
+def _instance(payload) -> _LoadedFmu:
+    key = (payload[0], threading.get_ident())
+    with _LOCK:
+        loaded = _INSTANCES.get(key)
+    if loaded is None:
+        loaded = _LoadedFmu(_fmu_dir(payload))
+        with _LOCK:
+            _INSTANCES[key] = loaded
+    return loaded
+
+
+def release_fmus() -> int:
+    """Free every FMU instance this process holds and delete their extracted files; the count freed."""
+    with _LOCK:
+        instances = list(_INSTANCES.values())
+        _INSTANCES.clear()
+        dirs = [own for _unzip, own in _EXTRACTED.values()]
+        _EXTRACTED.clear()
+    for inst in instances:
+        inst.close()
+    for d in dirs:
+        shutil.rmtree(d, ignore_errors=True)
+    return len(instances)
+
+
+atexit.register(release_fmus)
+
+
+class FmuBackend(Backend):
+    """``SpherePlateImpact.fmu`` through fmpy, one reused instance per worker process.
+
+    ``fmu``: path of the FMU (default: dist/SpherePlateImpact.fmu, built if missing).
+    """
+
+    name = "fmu"
+    default_chunk = 2_000
+
+    def __init__(self, fmu=None):
+        if fmu is None:
+            from ..cosim.fmu import build_default_fmu
+            fmu = build_default_fmu()
+        self.path = Path(fmu).resolve()
+        data = self.path.read_bytes()
+        self.sha = hashlib.sha256(data).hexdigest()
+
+    def payload(self):
+        return (self.sha, self.path.read_bytes())
+
+    def local_payload(self):
+        """Payload for an in-process run: the path instead of the bytes."""
+        return (self.sha, str(self.path))
+
+    def evaluate(self, cases: dict, payload=None, outputs=None):
+        if payload is None:
+            payload = self.local_payload()
+        fmu = _instance(payload)
+        out = fmu.evaluate(cases, outputs)
+        return out, {"code": fmu.code, "pid": os.getpid(), "fmu_code_file": fmu.code_file}
+
+    def describe(self) -> str:
+        return f"fmu ({self.path.name}, sha256 {self.sha[:12]})"
+
+
+def get_backend(name: str = "package", fmu=None) -> Backend:
+    """A back end by name: 'package' (vectorized) or 'fmu' (``fmu``: path of the FMU)."""
+    if isinstance(name, Backend):
+        return name
+    if name in ("package", "vector", "vectorized", "numpy"):
+        return PackageBackend()
+    if name == "fmu":
+        return FmuBackend(fmu)
+    raise ValueError(f"back end {name!r}: use 'package' or 'fmu'")

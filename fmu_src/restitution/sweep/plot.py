@@ -1,0 +1,144 @@
+"""COR map of a sweep: e against approach speed and t/d, one panel per material pair (matplotlib)."""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+from .spec import pair_label
+
+__all__ = ["plot_cor_map"]
+
+LAMBDA_MAX = 1.5  #: Zener's studied range, lambda <= 1.5
+VSTAR_MAX = 1000.0  #: range of the JGM fits, V* <= 1000
+
+
+def _log_axis(values) -> bool:
+    v = values[np.isfinite(values)]
+    return v.size > 1 and v.min() > 0 and v.max() / v.min() > 20
+
+
+def _edges(centres, log):
+    c = np.log10(centres) if log else centres
+    if c.size == 1:
+        e = np.array([c[0] - 0.5, c[0] + 0.5])
+    else:
+        mid = 0.5 * (c[1:] + c[:-1])
+        e = np.concatenate([[c[0] - (mid[0] - c[0])], mid, [c[-1] + (c[-1] - mid[-1])]])
+    return 10 ** e if log else e
+
+
+def plot_cor_map(result, path, title: str | None = None, dpi: int = 120) -> Path:
+    """Draw e over (v_approach, t/d) for each material pair of a :class:`SweepResult` into ``path``.
+
+    A grid sweep gives a colour map (each cell the mean e of its cases, with e contours and
+    a dashed line where the validity range ends: lambda <= 1.5 and V* <= 1000); scattered
+    (random) cases are drawn as coloured points; a sweep over only one of the two is drawn
+    as curves.
+    """
+    import matplotlib
+
+    matplotlib.use("Agg", force=False)
+    import matplotlib.pyplot as plt
+    from matplotlib.colors import Normalize
+
+    cols = result.columns if hasattr(result, "columns") else result
+    pairs = list(dict.fromkeys(cols["pair"].tolist()))
+    missing = {"e", "v_approach", "t_over_d"} - set(cols)
+    if missing:
+        raise ValueError(f"the COR map needs the column(s) {sorted(missing)}")
+    n_all = np.size(cols["e"])
+    ok = np.asarray(cols["ok"], dtype=bool) if "ok" in cols else np.isfinite(cols["e"])
+    valid_all = np.asarray(cols["valid"], dtype=bool) if "valid" in cols else np.ones(n_all, dtype=bool)
+    e_all = np.asarray(cols["e"], dtype=float)[ok]
+    lo = min(0.0, float(np.nanmin(e_all))) if e_all.size else 0.0
+    hi = max(1.0, float(np.nanmax(e_all))) if e_all.size else 1.0
+    norm = Normalize(vmin=lo, vmax=hi)
+    n = max(1, len(pairs))
+    ncols = min(3, n)
+    nrows = math.ceil(n / ncols)
+    fig, axes = plt.subplots(nrows, ncols, figsize=(4.6 * ncols + 0.8, 3.9 * nrows), squeeze=False,
+                             constrained_layout=True)
+    mappable = None
+    boundary = False
+    scattered = bool(getattr(getattr(result, "spec", None), "random", None))  # random draws: points
+    for k, pair in enumerate(pairs):
+        ax = axes[k // ncols][k % ncols]
+        sel = (cols["pair"] == pair) & ok
+        v = np.asarray(cols["v_approach"], dtype=float)[sel]
+        td = np.asarray(cols["t_over_d"], dtype=float)[sel]
+        e = np.asarray(cols["e"], dtype=float)[sel]
+        valid = valid_all[sel]
+        ax.set_title(pair_label(pair), fontsize=10)
+        if e.size == 0:
+            ax.text(0.5, 0.5, "no case with inputs in range", ha="center", va="center", transform=ax.transAxes)
+            continue
+        uv, iv = np.unique(v, return_inverse=True)
+        ut, it = np.unique(td, return_inverse=True)
+        if uv.size > 1 and ut.size > 1:
+            logv, logt = _log_axis(uv), _log_axis(ut)
+            cells = uv.size * ut.size
+            gridded = not scattered and cells <= 4 * e.size and np.unique(iv * ut.size + it).size == cells
+            if gridded:
+                flat = iv.ravel() * ut.size + it.ravel()
+                count = np.bincount(flat, minlength=cells)
+                emap = (np.bincount(flat, weights=e, minlength=cells) / count).reshape(uv.size, ut.size).T
+                nan = np.full(n_all, np.nan)
+                lam = np.asarray(cols.get("zener.lambda", nan), dtype=float)[sel]
+                vstar = np.asarray(cols.get("jgm.V_star", nan), dtype=float)[sel]
+                lmap = (np.bincount(flat, weights=lam, minlength=cells) / count).reshape(uv.size, ut.size).T
+                smap = (np.bincount(flat, weights=vstar, minlength=cells) / count).reshape(uv.size, ut.size).T
+                mappable = ax.pcolormesh(_edges(uv, logv), _edges(ut, logt), emap, cmap="viridis", norm=norm,
+                                         shading="flat")
+                if uv.size > 2 and ut.size > 2:
+                    levels = [x for x in np.round(np.arange(-1.0, 1.0001, 0.1), 1) if emap.min() < x < emap.max()]
+                    if levels:
+                        cs = ax.contour(uv, ut, emap, levels=levels, colors="white", linewidths=0.6, alpha=0.8)
+                        ax.clabel(cs, fmt=lambda x: f"{round(x, 1) + 0.0:.1f}", fontsize=7)
+                    for m, limit in ((lmap, LAMBDA_MAX), (smap, VSTAR_MAX)):
+                        if np.isfinite(m).all() and m.min() < limit < m.max():
+                            ax.contour(uv, ut, m, levels=[limit], colors="red", linewidths=1.0, linestyles="--")
+                            boundary = True
+                if count.max() > 1:
+                    ax.text(0.02, 0.02, f"mean of {count.max()} cases per cell", transform=ax.transAxes,
+                            fontsize=7, color="white")
+            else:
+                mappable = ax.scatter(v, td, c=e, s=6, cmap="viridis", norm=norm, linewidths=0)
+                if not valid.all():
+                    ax.scatter(v[~valid], td[~valid], s=10, facecolors="none", edgecolors="red", linewidths=0.3,
+                               alpha=0.6)
+            ax.set_xscale("log" if logv else "linear")
+            ax.set_yscale("log" if logt else "linear")
+            ax.set_xlabel("approach speed v [m/s]")
+            ax.set_ylabel("plate thickness / sphere diameter t/d")
+        else:
+            x, name = (v, "approach speed v [m/s]") if uv.size > 1 else (td, "t/d")
+            order = np.argsort(x, kind="stable")
+            if np.unique(x).size == x.size and not scattered:
+                ax.plot(x[order], e[order], "-", lw=1.2)
+            else:
+                ax.plot(x, e, ".", ms=2, alpha=0.5)
+            if not valid.all():
+                ax.plot(x[~valid], e[~valid], "rx", ms=4, label="outside validated range")
+                ax.legend(fontsize=7)
+            ax.set_xscale("log" if _log_axis(x) else "linear")
+            ax.set_xlabel(name)
+            ax.set_ylabel("apparent COR e")
+            ax.grid(alpha=0.3)
+    for k in range(len(pairs), nrows * ncols):
+        axes[k // ncols][k % ncols].set_visible(False)
+    if mappable is not None:
+        fig.colorbar(mappable, ax=axes, label="apparent COR e", shrink=0.9)
+    if title is None:
+        title = f"Apparent COR e (Green 2022), {len(ok)} cases"
+        if boundary:
+            title += "; red dashes: edge of the validated range (lambda <= 1.5, V* <= 1000)"
+        elif not valid_all.all():
+            title += "; red marks: outside the validated range"
+    fig.suptitle(title, fontsize=10)
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=dpi)
+    plt.close(fig)
+    return path

@@ -1,0 +1,360 @@
+"""Run a sweep on Dask (a local cluster, or an existing scheduler) or serially, and keep the table.
+
+    from restitution.sweep import SweepSpec, run_sweep
+    spec = SweepSpec(pairs=["s2_tool_steel/al_6061"], grid={"v_approach": {"geomspace": [0.1, 10, 50]},
+                                                              "t_over_d": {"geomspace": [0.1, 10, 40]}})
+    result = run_sweep(spec)                             # LocalCluster sized to this machine
+    result = run_sweep(spec, scheduler="tcp://10.0.0.5:8786", backend="fmu")   # an existing cluster
+    result.write("map.parquet"); result.plot("map.png")
+
+The work is cut into chunks of consecutive case indices; each Dask task builds its cases
+from the spec (nothing large travels to the workers) and evaluates them with the back end.
+"""
+from __future__ import annotations
+
+import contextlib
+import logging
+import math
+import os
+import time
+import warnings
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .backends import Backend, FmuBackend, code_fingerprint, get_backend, release_fmus
+from .spec import INPUT_NAMES, INTEGER_INPUTS, OUTPUT_NAMES, T_OVER_D, SweepSpec
+
+__all__ = ["run_sweep", "SweepResult", "open_client", "machine_workers", "compare_results", "COLUMNS"]
+
+#: Column order of a result table.
+COLUMNS = ("case", "pair", *INPUT_NAMES, T_OVER_D, *OUTPUT_NAMES, "ok")
+
+
+def machine_workers() -> int:
+    """Worker processes for a local cluster: the cores this process may use."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:  # not Linux
+        return max(1, os.cpu_count() or 1)
+
+
+@contextlib.contextmanager
+def open_client(scheduler=None, n_workers: int | None = None, threads_per_worker: int = 1, **cluster_kwargs):
+    """A ``distributed.Client`` for a sweep, closed (with any cluster it started) on exit.
+
+    ``scheduler``: a ``Client`` (used as is, left open), a scheduler address
+    (``"tcp://host:8786"``), or None / ``"local"``: the scheduler named by Dask's config
+    (``DASK_SCHEDULER_ADDRESS``) if set, else a new ``LocalCluster`` of ``n_workers``
+    single-threaded processes (default: one per core).
+    """
+    from distributed import Client, LocalCluster
+
+    if isinstance(scheduler, Client):
+        yield scheduler
+        return
+    if scheduler in (None, "local"):
+        import dask
+
+        address = dask.config.get("scheduler-address", None) if scheduler is None else None
+        if address:
+            scheduler = address
+    if scheduler not in (None, "local"):
+        with Client(scheduler) as client:
+            yield client
+        return
+    kwargs = dict(n_workers=n_workers or machine_workers(), threads_per_worker=threads_per_worker,
+                  processes=True, dashboard_address=None, silence_logs=logging.ERROR)
+    kwargs.update(cluster_kwargs)
+    with LocalCluster(**kwargs) as cluster, Client(cluster) as client:
+        yield client
+
+
+def _run_chunk(start: int, stop: int, spec: SweepSpec, backend: Backend, payload=None, keep=None):
+    cpu = time.thread_time()
+    cases = spec.cases(start, stop)
+    outputs, info = backend.evaluate(cases, payload, keep)
+    info["cpu"] = time.thread_time() - cpu
+    cases.update(outputs)
+    if keep is not None:
+        cases = {k: v for k, v in cases.items() if k in keep}
+    return cases, info
+
+
+@dataclass
+class SweepResult:
+    """The table of a sweep (``columns``: name -> array, in :data:`COLUMNS` order) and how it ran."""
+
+    columns: dict
+    spec: SweepSpec
+    backend: str
+    scheduler: str
+    n_workers: int
+    elapsed: float  #: wall time of the evaluation (tasks submitted -> results gathered) [s]
+    #: ``info``: ``code`` (fingerprints of the restitution code that ran), ``processes`` (how many
+    #: worker processes took part), ``cpu_seconds`` (CPU time of the tasks: building the cases and
+    #: evaluating them), ``fmu_code_files`` (FMU back end: the bundled model.py that ran).
+    n_chunks: int
+    info: dict = field(default_factory=dict)
+
+    def __len__(self):
+        return int(np.size(self.columns["case"]))
+
+    def __getitem__(self, name):
+        return self.columns[name]
+
+    @property
+    def cases_per_second(self) -> float:
+        return len(self) / self.elapsed if self.elapsed > 0 else math.inf
+
+    def summary(self) -> str:
+        text = (f"{len(self)} cases with the {self.backend} back end on {self.scheduler} "
+                f"({self.n_workers} worker(s), {self.n_chunks} chunk(s)): {self.elapsed:.3g} s, "
+                f"{self.cases_per_second:,.0f} cases/s")
+        if "ok" in self.columns:
+            ok = int(np.count_nonzero(self.columns["ok"]))
+            text += f"; {ok} evaluated, {len(self) - ok} with inputs out of range"
+        if "valid" in self.columns:
+            text += f"; {int(np.count_nonzero(self.columns['valid']))} inside the models' validated ranges"
+        return text
+
+    # --- output ---
+    def write(self, path) -> Path:
+        """Write the table: ``.parquet`` (needs pyarrow) or ``.csv``."""
+        path = Path(path)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        if path.suffix.lower() == ".parquet":
+            return self.to_parquet(path)
+        return self.to_csv(path)
+
+    def to_csv(self, path) -> Path:
+        path = Path(path)
+        names = list(self.columns)
+        cols = []
+        for name in names:
+            col = self.columns[name]
+            if col.dtype == bool:
+                cols.append(np.where(col, "True", "False"))
+            elif col.dtype.kind in "iu":
+                cols.append(col.astype(str))
+            elif col.dtype.kind == "f":
+                cols.append(np.array([repr(float(x)) for x in col.tolist()], dtype=object))
+            else:
+                cols.append(np.array([_csv_text(x) for x in col.tolist()], dtype=object))
+        with open(path, "w", encoding="utf-8", newline="") as f:
+            f.write(",".join(names) + "\n")
+            for row in zip(*cols):
+                f.write(",".join(row) + "\n")
+        return path
+
+    def to_parquet(self, path) -> Path:
+        try:
+            import pyarrow as pa
+            import pyarrow.parquet as pq
+        except ModuleNotFoundError:
+            raise RuntimeError("writing Parquet needs pyarrow (pip install pyarrow); or write .csv") from None
+        path = Path(path)
+        table = pa.table({name: (col.tolist() if col.dtype == object else col)
+                          for name, col in self.columns.items()})
+        pq.write_table(table, path)
+        return path
+
+    def to_pandas(self):
+        import pandas as pd
+
+        return pd.DataFrame(self.columns)
+
+    def plot(self, path, **kwargs) -> Path:
+        """The COR map (see :func:`restitution.sweep.plot.plot_cor_map`)."""
+        from .plot import plot_cor_map
+
+        return plot_cor_map(self, path, **kwargs)
+
+
+def _csv_text(x) -> str:
+    text = str(x)
+    return f'"{text}"' if ("," in text or '"' in text) else text
+
+
+def read_table(path) -> dict:
+    """Columns of a table written by :meth:`SweepResult.write` (CSV or Parquet)."""
+    path = Path(path)
+    if path.suffix.lower() == ".parquet":
+        import pyarrow.parquet as pq
+
+        table = pq.read_table(path)
+        return {name: np.asarray(table.column(name).to_pylist() if table.column(name).type == "string"
+                                 else table.column(name).to_numpy()) for name in table.column_names}
+    import csv
+
+    with open(path, encoding="utf-8", newline="") as f:
+        rows = list(csv.reader(f))
+    header, body = rows[0], rows[1:]
+    out = {}
+    for j, name in enumerate(header):
+        values = [r[j] for r in body]
+        if name == "pair":
+            out[name] = np.array(values, dtype=object)
+        elif values and values[0] in ("True", "False"):
+            out[name] = np.array([v == "True" for v in values])
+        elif name == "case" or name in INTEGER_INPUTS:
+            out[name] = np.array(values, dtype=np.int64)
+        else:
+            out[name] = np.array(values, dtype=float)
+    return out
+
+
+def compare_results(a, b, names=None) -> dict:
+    """Largest difference per output between two results (or column dicts) of the same spec.
+
+    Reals: max |a - b| / max(1, |b|) over cases where both are finite (NaN and inf must match
+    exactly, else the difference is inf); Booleans: number of cases that differ. ``names``:
+    default, every output both have.
+    """
+    ca = a.columns if isinstance(a, SweepResult) else a
+    cb = b.columns if isinstance(b, SweepResult) else b
+    if not np.array_equal(ca["case"], cb["case"]):
+        raise ValueError("the two results cover different cases")
+    out = {}
+    if names is None:
+        names = [n for n in (*OUTPUT_NAMES, "ok") if n in ca and n in cb]
+    for name in names:
+        x, y = np.asarray(ca[name]), np.asarray(cb[name])
+        if x.dtype == bool or y.dtype == bool:
+            out[name] = int(np.count_nonzero(x.astype(bool) != y.astype(bool)))
+            continue
+        finite = np.isfinite(x) & np.isfinite(y)
+        same_special = (np.isnan(x) & np.isnan(y)) | (x == y)
+        if not np.all(finite | same_special):
+            out[name] = math.inf
+            continue
+        diff = np.abs(x[finite] - y[finite]) / np.maximum(1.0, np.abs(y[finite]))
+        out[name] = float(diff.max()) if diff.size else 0.0
+    return out
+
+
+def _chunks(n: int, chunk_size: int):
+    return [(s, min(s + chunk_size, n)) for s in range(0, n, chunk_size)]
+
+
+def _assemble(spec: SweepSpec, parts, keep) -> dict:
+    names = [c for c in COLUMNS if keep is None or c in keep]
+    if parts:
+        columns = {name: np.concatenate([p[name] for p in parts]) for name in names}
+    else:
+        columns = {name: np.empty(0) for name in names}
+    labels = np.array(list(spec.pairs) + [""], dtype=object)
+    columns["pair"] = labels[np.asarray(columns["pair"], dtype=np.int64)]
+    for name in INTEGER_INPUTS:
+        if name in columns:
+            columns[name] = np.asarray(columns[name]).astype(np.int64)
+    return columns
+
+
+def _keep(columns):
+    if columns is None:
+        return None
+    unknown = set(columns) - set(COLUMNS)
+    if unknown:
+        raise ValueError(f"unknown column(s) {sorted(unknown)}; the table has {', '.join(COLUMNS)}")
+    return frozenset(("case", "pair", *columns))
+
+
+def run_sweep(spec: SweepSpec | dict, backend: str | Backend = "package", *, fmu=None, scheduler=None,
+              n_workers: int | None = None, chunk_size: int | None = None, progress: bool = False,
+              columns=None, release: bool = True) -> SweepResult:
+    """Evaluate every case of ``spec`` and return the table.
+
+    ``backend``: "package" (vectorized :func:`restitution.impact`) or "fmu" (the FMU at ``fmu``,
+    default dist/SpherePlateImpact.fmu). ``scheduler``: None (Dask's configured scheduler
+    address, else a LocalCluster of ``n_workers`` processes, default one per core),
+    "local" (always a new LocalCluster), a scheduler address, a ``distributed.Client``, or
+    "serial" (no Dask: one loop in this process, for reference and debugging).
+    ``chunk_size``: cases per task (default: the back end's, at most a quarter of each worker's
+    share so the work spreads and progress moves). ``progress``: show Dask's progress bar.
+    ``columns``: keep only these columns (besides ``case`` and ``pair``), for sweeps whose
+    full table would be too big to gather. ``release=False`` keeps the FMU instances loaded
+    in the workers for the next sweep (free them with ``client.run(release_fmus)``).
+    """
+    if isinstance(spec, dict):
+        spec = SweepSpec.from_dict(spec)
+    backend = get_backend(backend, fmu)
+    n = spec.n_cases
+    keep = _keep(columns)
+
+    if scheduler == "serial":
+        chunks = _chunks(n, chunk_size or backend.default_chunk)
+        payload = backend.local_payload() if isinstance(backend, FmuBackend) else backend.payload()
+        t0 = time.perf_counter()
+        try:
+            results = []
+            for k, (a, b) in enumerate(chunks):
+                results.append(_run_chunk(a, b, spec, backend, payload, keep))
+                if progress:
+                    print(f"\r[serial] {k + 1}/{len(chunks)} chunks", end="", flush=True)
+            if progress:
+                print()
+        finally:
+            if isinstance(backend, FmuBackend) and release:
+                release_fmus()
+        elapsed = time.perf_counter() - t0
+        return _result(spec, backend, results, "this process (serial)", 1, elapsed, len(chunks), keep)
+
+    with open_client(scheduler, n_workers) as client:
+        workers = _count_workers(client)
+        where = _describe_client(client, scheduler)
+        if chunk_size is None:
+            chunk_size = max(1, min(backend.default_chunk, math.ceil(n / (4 * workers))))
+        chunks = _chunks(n, chunk_size)
+        t0 = time.perf_counter()
+        payload = backend.payload()
+        if payload is not None:
+            payload = client.scatter([payload], broadcast=True, hash=False)[0]
+        futures = client.map(_run_chunk, [a for a, _ in chunks], [b for _, b in chunks],
+                             spec=spec, backend=backend, payload=payload, keep=keep, pure=False)
+        try:
+            if progress:
+                from distributed import progress as dask_progress
+
+                dask_progress(futures)
+                print()
+            results = client.gather(futures)
+        finally:
+            client.cancel(futures)
+            if isinstance(backend, FmuBackend) and release:
+                with contextlib.suppress(Exception):
+                    client.run(release_fmus)
+        elapsed = time.perf_counter() - t0
+        return _result(spec, backend, results, where, workers, elapsed, len(chunks), keep)
+
+
+def _count_workers(client) -> int:
+    try:
+        info = client.scheduler_info(n_workers=-1)
+    except TypeError:  # distributed before 2025.4 lists every worker anyway
+        info = client.scheduler_info()
+    return max(1, len(info["workers"]))
+
+
+def _describe_client(client, scheduler) -> str:
+    from distributed import LocalCluster
+
+    if isinstance(getattr(client, "cluster", None), LocalCluster) and not isinstance(scheduler, str):
+        return f"a LocalCluster ({client.scheduler.address})"
+    return f"the Dask scheduler at {client.scheduler.address}"
+
+
+def _result(spec, backend, results, where, workers, elapsed, n_chunks, keep) -> SweepResult:
+    parts = [r[0] for r in results]
+    infos = [r[1] for r in results]
+    codes = sorted({i["code"] for i in infos})
+    info = {"code": codes, "processes": len({i["pid"] for i in infos}),
+            "cpu_seconds": float(sum(i["cpu"] for i in infos)), "client_code": code_fingerprint()}
+    if "fmu_code_file" in (infos[0] if infos else {}):
+        info["fmu_code_files"] = sorted({i["fmu_code_file"] for i in infos})
+    if backend.name == "package" and codes and codes != [info["client_code"]]:
+        warnings.warn(f"the workers ran restitution code {codes}, this process has {info['client_code']}: "
+                      f"install the same restitution on the workers", RuntimeWarning, stacklevel=3)
+    return SweepResult(columns=_assemble(spec, parts, keep), spec=spec, backend=backend.describe(), scheduler=where,
+                       n_workers=workers, elapsed=elapsed, n_chunks=n_chunks, info=info)

@@ -1,0 +1,439 @@
+"""What a sweep covers: material pairs, grid axes, random draws and fixed values, by FMU name.
+
+A sweep is the full-factorial product of its *grid* axes (material pairs first, then the
+axes in the order given), and at every grid point ``samples`` cases whose *random*
+parameters are drawn independently. Every case carries all 17 FMU inputs and parameters
+(unset ones at the FMU's start values), so each back end gets the same explicit table.
+
+Case ``i`` is built from the spec and ``i`` alone: any block of cases can be generated where
+it is evaluated (on a Dask worker), and the random draws do not depend on how the sweep is
+cut into chunks (they come in fixed blocks of :data:`RANDOM_BLOCK` cases, each seeded with
+``(seed, block index)``).
+
+Names are the FMU's (``sphere.E``, ``plate.t``, ``v_approach``, ...); the package's
+keyword names (``sphere_E``, ``plate_t``, ``v``) are accepted too. ``t_over_d`` is a derived
+axis: ``plate.t = t_over_d * sphere.d``.
+"""
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..materials import MATERIALS, TABLE4_CASES, table4_case
+
+__all__ = ["SweepSpec", "INPUTS", "OUTPUTS", "CODES", "RANDOM_BLOCK", "canonical_name", "load_spec",
+           "parse_values", "parse_distribution", "resolve_pair"]
+
+# (FMU name, impact() keyword, FMI type, start value): the FMU's inputs and parameters.
+INPUTS = (
+    ("v_approach", "v", "Real", 1.0),
+    ("sphere.E", "sphere_E", "Real", 207e9),
+    ("sphere.nu", "sphere_nu", "Real", 0.30),
+    ("sphere.Sy", "sphere_Sy", "Real", 2.0e9),
+    ("sphere.rho", "sphere_rho", "Real", 7861.0),
+    ("sphere.d", "sphere_d", "Real", 6.35e-3),
+    ("plate.E", "plate_E", "Real", 69e9),
+    ("plate.nu", "plate_nu", "Real", 0.33),
+    ("plate.Sy", "plate_Sy", "Real", 0.290e9),
+    ("plate.rho", "plate_rho", "Real", 2700.0),
+    ("plate.t", "plate_t", "Real", 6.35e-3),
+    ("restitution_model", "restitution_model", "Integer", 1),
+    ("zener_method", "zener_method", "Integer", 1),
+    ("plasticity", "plasticity", "Integer", 2),
+    ("plate_waves", "plate_waves", "Integer", 2),
+    ("effect_tolerance", "effect_tolerance", "Real", 1e-6),
+    ("zener.ode_tolerance", "ode_rtol", "Real", 1e-10),
+)
+INPUT_NAMES = tuple(row[0] for row in INPUTS)
+START = {row[0]: row[3] for row in INPUTS}
+INTEGER_INPUTS = tuple(row[0] for row in INPUTS if row[2] == "Integer")
+
+#: Integer-coded parameters: the words accepted for each code (as in the FMU's descriptions).
+CODES = {
+    "restitution_model": {"e45": 1, "e44": 2},
+    "zener_method": {"exact": 1, "paper_fit": 2, "linear": 3, "ode": 4},
+    "plasticity": {"off": 0, "on": 1, "auto": 2},
+    "plate_waves": {"off": 0, "on": 1, "auto": 2},
+}
+
+# (FMU name, ImpactResult field, FMI type): the FMU's outputs.
+OUTPUTS = (
+    ("e", "e", "Real"), ("v_rebound", "v_rebound", "Real"), ("jgm.e", "e_ep", "Real"),
+    ("jgm.V_c", "V_c", "Real"), ("jgm.V_star", "V_star", "Real"), ("zener.e", "e_ze", "Real"),
+    ("zener.lambda", "lam", "Real"), ("zener.tau0", "tau0", "Real"),
+    ("zener.t_contact", "t_contact", "Real"), ("plate.m_eff", "m_eff", "Real"),
+    ("plate.v_after", "v_plate", "Real"), ("valid", "valid", "Boolean"),
+    ("zener.in_range", "lambda_in_range", "Boolean"), ("jgm.in_range", "vstar_in_range", "Boolean"),
+    ("e_negative", "e_negative", "Boolean"), ("effects.plasticity", "plasticity_used", "Boolean"),
+    ("effects.plate_waves", "plate_waves_used", "Boolean"),
+)
+OUTPUT_NAMES = tuple(row[0] for row in OUTPUTS)
+
+#: Derived axis: plate.t = t_over_d * sphere.d.
+T_OVER_D = "t_over_d"
+#: Material-property inputs a material pair sets.
+PAIR_INPUTS = ("sphere.E", "sphere.nu", "sphere.Sy", "sphere.rho", "plate.E", "plate.nu", "plate.Sy", "plate.rho")
+#: Random draws come in blocks of this many cases, each from its own seeded generator.
+RANDOM_BLOCK = 4096
+
+_ALIASES = {row[1]: row[0] for row in INPUTS}
+_ALIASES.update({"v": "v_approach", "speed": "v_approach", "ode_rtol": "zener.ode_tolerance",
+                 "t/d": T_OVER_D, "t_d": T_OVER_D})
+
+
+def canonical_name(name: str) -> str:
+    """The FMU name of an input/parameter given by FMU name, impact() keyword or alias."""
+    name = name.strip()
+    if name in START or name == T_OVER_D:
+        return name
+    if name in _ALIASES:
+        return _ALIASES[name]
+    raise ValueError(f"unknown sweep parameter {name!r}: use an FMU input/parameter name "
+                     f"({', '.join(INPUT_NAMES)}) or {T_OVER_D!r}")
+
+
+def _code(name: str, value):
+    """An integer-coded parameter's code from a number or a word ('exact', 'e45', 'auto', ...)."""
+    if isinstance(value, str):
+        words = CODES[name]
+        if value.strip() in words:
+            return words[value.strip()]
+        try:
+            value = float(value)
+        except ValueError:
+            raise ValueError(f"{name} = {value!r}: use one of {sorted(words)} or a code "
+                             f"{sorted(words.values())}") from None
+    if float(value) != int(value):
+        raise ValueError(f"{name} = {value!r} is not an integer code")
+    return int(value)
+
+
+def _number(name: str, value) -> float:
+    if name in CODES:
+        return float(_code(name, value))
+    return float(value)
+
+
+# --- value lists and distributions -------------------------------------------------------
+def parse_values(name: str, spec) -> np.ndarray:
+    """Grid values: a number, a list, ``{"linspace": [a, b, n]}``, ``{"geomspace": [a, b, n]}``,
+    ``{"arange": [a, b, step]}``, or the CLI forms ``"a,b,c"``, ``"linspace:a:b:n"``, ``"geomspace:a:b:n"``."""
+    if isinstance(spec, str):
+        text = spec.strip()
+        kind, _, rest = text.partition(":")
+        if rest and kind in ("linspace", "geomspace", "logspace", "arange"):
+            spec = {kind: [float(x) for x in rest.split(":")]}
+        else:
+            spec = [x for x in text.split(",") if x.strip()]
+    if isinstance(spec, dict):
+        if len(spec) != 1:
+            raise ValueError(f"{name}: a value range has exactly one key, got {sorted(spec)}")
+        (kind, args), = spec.items()
+        args = list(args)
+        if kind in ("linspace", "geomspace", "logspace"):
+            if len(args) != 3 or int(args[2]) != args[2] or args[2] < 1:
+                raise ValueError(f"{name}: {kind} needs [first, last, count]")
+            fn = {"linspace": np.linspace, "geomspace": np.geomspace, "logspace": np.logspace}[kind]
+            values = fn(float(args[0]), float(args[1]), int(args[2]))
+        elif kind == "arange":
+            values = np.arange(*map(float, args))
+        else:
+            raise ValueError(f"{name}: unknown value range {kind!r} (linspace, geomspace, logspace, arange)")
+    elif isinstance(spec, (list, tuple, np.ndarray)):
+        values = np.array([_number(name, v) for v in spec], dtype=float)
+    else:
+        values = np.array([_number(name, spec)], dtype=float)
+    if values.size == 0:
+        raise ValueError(f"{name}: no values")
+    return values
+
+
+#: distribution -> number of parameters.
+DISTRIBUTIONS = {"uniform": 2, "loguniform": 2, "normal": 2, "normal_rel": 1, "uniform_rel": 1, "choice": None}
+
+
+def parse_distribution(name: str, spec) -> tuple[str, tuple]:
+    """A random parameter's distribution: ``{"uniform": [lo, hi]}``, ``{"loguniform": [lo, hi]}``,
+    ``{"normal": [mean, sd]}``, ``{"normal_rel": sd}`` (base value x (1 + sd N(0,1))),
+    ``{"uniform_rel": h}`` (base value x U(1-h, 1+h)), ``{"choice": [values]}``, or the CLI
+    form ``"uniform:lo:hi"``, ``"normal_rel:0.02"``, ``"choice:a,b,c"``. The base value of the
+    relative forms is what the case has without the draw (material pair, grid, fixed or start value)."""
+    if isinstance(spec, str):
+        kind, _, rest = spec.strip().partition(":")
+        if kind == "choice":
+            args = [x for x in rest.split(",") if x.strip()]
+        else:
+            args = [float(x) for x in rest.split(":") if x.strip()]
+        spec = {kind: args}
+    if not isinstance(spec, dict) or len(spec) != 1:
+        raise ValueError(f"{name}: a distribution is one of {sorted(DISTRIBUTIONS)} with its parameters, got {spec!r}")
+    (kind, args), = spec.items()
+    if kind not in DISTRIBUTIONS:
+        raise ValueError(f"{name}: unknown distribution {kind!r} (one of {sorted(DISTRIBUTIONS)})")
+    args = list(args) if isinstance(args, (list, tuple)) else [args]
+    if kind == "choice":
+        if not args:
+            raise ValueError(f"{name}: choice needs at least one value")
+        return kind, tuple(_number(name, a) for a in args)
+    if len(args) != DISTRIBUTIONS[kind]:
+        raise ValueError(f"{name}: {kind} takes {DISTRIBUTIONS[kind]} parameter(s), got {args!r}")
+    args = tuple(float(a) for a in args)
+    if kind in ("uniform", "loguniform") and not args[0] < args[1]:
+        raise ValueError(f"{name}: {kind} needs low < high, got {args!r}")
+    if kind == "loguniform" and args[0] <= 0:
+        raise ValueError(f"{name}: loguniform needs low > 0, got {args!r}")
+    if kind != "uniform" and kind != "loguniform" and min(args[1:] if kind == "normal" else args) < 0:
+        raise ValueError(f"{name}: {kind} needs a spread >= 0, got {args!r}")
+    if name in CODES and kind != "choice":
+        raise ValueError(f"{name} is integer-coded: only 'choice' can draw it")
+    return kind, args
+
+
+def _draw(rng: np.random.Generator, kind: str, args: tuple, n: int) -> np.ndarray:
+    if kind == "uniform":
+        return rng.uniform(args[0], args[1], n)
+    if kind == "loguniform":
+        return np.exp(rng.uniform(math.log(args[0]), math.log(args[1]), n))
+    if kind == "normal":
+        return args[0] + args[1] * rng.standard_normal(n)
+    if kind == "normal_rel":
+        return 1.0 + args[0] * rng.standard_normal(n)
+    if kind == "uniform_rel":
+        return rng.uniform(1.0 - args[0], 1.0 + args[0], n)
+    return np.asarray(args, dtype=float)[rng.integers(0, len(args), n)]
+
+
+# --- material pairs -------------------------------------------------------------------
+def resolve_pair(pair: str):
+    """(sphere Material, plate Material) of ``"sphere_key/plate_key"`` (keys of
+    :data:`restitution.MATERIALS`) or ``"table4:A1"`` (Green 2022 Table 4 cases)."""
+    text = pair.strip()
+    if text.lower().startswith("table4:"):
+        case = text.split(":", 1)[1].strip().upper()
+        if case not in TABLE4_CASES:
+            raise ValueError(f"pair {pair!r}: Table 4 cases are {', '.join(TABLE4_CASES)}")
+        return table4_case(case)
+    sphere, sep, plate = text.partition("/")
+    if not sep:
+        raise ValueError(f"pair {pair!r}: write it as sphere_material/plate_material, e.g. s2_tool_steel/al_6061")
+    missing = [k for k in (sphere.strip(), plate.strip()) if k not in MATERIALS]
+    if missing:
+        raise ValueError(f"pair {pair!r}: unknown material(s) {missing}; known: {', '.join(sorted(MATERIALS))}")
+    return MATERIALS[sphere.strip()], MATERIALS[plate.strip()]
+
+
+def _pair_values(pair: str) -> dict:
+    sphere, plate = resolve_pair(pair)
+    return {"sphere.E": sphere.E, "sphere.nu": sphere.nu, "sphere.Sy": sphere.Sy, "sphere.rho": sphere.rho,
+            "plate.E": plate.E, "plate.nu": plate.nu, "plate.Sy": plate.Sy, "plate.rho": plate.rho}
+
+
+def pair_label(pair: str) -> str:
+    """Readable name of a pair: 'S2 tool steel on Aluminum 6061'."""
+    if not pair:
+        return "sphere and plate as set"
+    if pair.lower().startswith("table4:"):
+        return f"Table 4 case {pair.split(':', 1)[1].strip().upper()}"
+    sphere, plate = resolve_pair(pair)
+    return f"{sphere.name} on {plate.name}"
+
+
+# --- the spec --------------------------------------------------------------------------
+@dataclass
+class SweepSpec:
+    """A grid and/or random sample over FMU inputs/parameters (see the module docstring).
+
+    >>> spec = SweepSpec(pairs=["s2_tool_steel/al_6061"],
+    ...                  grid={"v_approach": {"geomspace": [0.1, 10, 40]}, "t_over_d": {"geomspace": [0.1, 10, 30]}})
+    >>> spec.n_cases
+    1200
+    """
+
+    pairs: list = field(default_factory=list)
+    grid: dict = field(default_factory=dict)
+    random: dict = field(default_factory=dict)
+    fixed: dict = field(default_factory=dict)
+    samples: int = 1
+    seed: int = 0
+
+    def __post_init__(self):
+        self.pairs = [str(p).strip() for p in self.pairs]
+        for p in self.pairs:
+            resolve_pair(p)
+        if len(set(self.pairs)) != len(self.pairs):
+            raise ValueError(f"pairs: duplicate entries in {self.pairs}")
+        self.grid = {canonical_name(k): v for k, v in self.grid.items()}
+        self.random = {canonical_name(k): v for k, v in self.random.items()}
+        self.fixed = {canonical_name(k): v for k, v in self.fixed.items()}
+        self._axes = {k: parse_values(k, v) for k, v in self.grid.items()}
+        self._dists = {k: parse_distribution(k, v) for k, v in self.random.items()}
+        self._fixed = {k: parse_values(k, v) for k, v in self.fixed.items()}
+        for k, v in self._fixed.items():
+            if v.size != 1:
+                raise ValueError(f"fixed {k}: one value, got {v.size} (use the grid for several)")
+        self.samples = int(self.samples)
+        self.seed = int(self.seed)
+        if self.samples < 1:
+            raise ValueError(f"samples = {self.samples}: must be >= 1")
+        if self.samples > 1 and not self._dists:
+            raise ValueError("samples > 1 needs at least one random parameter")
+        # Each input gets its value from one place; relative draws scale whatever that is.
+        sources = {}
+        for where, names in (("fixed", self._fixed), ("grid", self._axes),
+                             ("random", {k for k, (kind, _) in self._dists.items() if not kind.endswith("_rel")})):
+            for k in names:
+                if k in sources:
+                    raise ValueError(f"{k} is set twice ({sources[k]} and {where})")
+                sources[k] = where
+        if self.pairs:
+            for k in PAIR_INPUTS:
+                if k in sources:
+                    raise ValueError(f"{k} is set by the material pairs and by {sources[k]}: "
+                                     f"scatter it with a relative draw (normal_rel, uniform_rel) instead")
+        if T_OVER_D in sources and "plate.t" in sources:
+            raise ValueError(f"plate.t and {T_OVER_D} both set: give one of them")
+        for k, (kind, _) in self._dists.items():
+            if kind.endswith("_rel") and k == T_OVER_D and T_OVER_D not in sources:
+                raise ValueError(f"{k}: a relative draw needs a base value from the grid or fixed")
+
+    # --- structure ---
+    @property
+    def axes(self) -> dict:
+        """Grid axes in iteration order (material pairs first, as indices into :attr:`pairs`)."""
+        axes = {}
+        if self.pairs:
+            axes["pair"] = np.arange(len(self.pairs), dtype=float)
+        axes.update(self._axes)
+        return axes
+
+    @property
+    def shape(self) -> tuple:
+        return tuple(a.size for a in self.axes.values())
+
+    @property
+    def n_grid(self) -> int:
+        return int(np.prod(self.shape, dtype=np.int64)) if self.axes else 1
+
+    @property
+    def n_cases(self) -> int:
+        return self.n_grid * self.samples
+
+    def as_dict(self) -> dict:
+        """JSON-able form that :meth:`from_dict` reads back."""
+        def plain(v):
+            if isinstance(v, np.ndarray):
+                return v.tolist()
+            if isinstance(v, dict):
+                return {k: plain(x) for k, x in v.items()}
+            if isinstance(v, (list, tuple)):
+                return [plain(x) for x in v]
+            return v
+        return {"pairs": list(self.pairs), "grid": plain(self.grid), "random": plain(self.random),
+                "fixed": plain(self.fixed), "samples": self.samples, "seed": self.seed}
+
+    @classmethod
+    def from_dict(cls, data: dict) -> "SweepSpec":
+        data = dict(data)
+        data.pop("run", None)  # run options (back end, scheduler, output) live beside the spec
+        unknown = set(data) - {"pairs", "grid", "random", "fixed", "samples", "seed"}
+        if unknown:
+            raise ValueError(f"unknown sweep spec key(s) {sorted(unknown)}: "
+                             f"use pairs, grid, random, fixed, samples, seed (and a [run] table)")
+        return cls(**data)
+
+    # --- cases ---
+    def cases(self, start: int = 0, stop: int | None = None) -> dict:
+        """Columns of cases ``start <= i < stop``: ``case``, ``pair`` (index into :attr:`pairs`,
+        -1 without pairs), every FMU input/parameter by name, and ``t_over_d``."""
+        n = self.n_cases
+        stop = n if stop is None else min(int(stop), n)
+        start = int(start)
+        if not 0 <= start <= stop:
+            raise ValueError(f"case range [{start}, {stop}) outside [0, {n})")
+        index = np.arange(start, stop, dtype=np.int64)
+        grid_index = index // self.samples
+        cols = {name: np.full(index.size, float(START[name])) for name in INPUT_NAMES}
+        for k, v in self._fixed.items():
+            if k != T_OVER_D:
+                cols[k] = np.full(index.size, v[0])
+        # Grid coordinates, C order (last axis fastest).
+        axes = self.axes
+        coords = {}
+        rem = grid_index.copy()
+        for name, values in reversed(list(axes.items())):
+            coords[name] = values[rem % values.size]
+            rem //= values.size
+        pair = np.full(index.size, -1, dtype=np.int64)
+        if self.pairs:
+            pair = coords.pop("pair").astype(np.int64)
+            for j, p in enumerate(self.pairs):
+                sel = pair == j
+                if sel.any():
+                    for k, val in _pair_values(p).items():
+                        cols[k][sel] = val
+        t_over_d = None
+        for k, v in coords.items():
+            if k == T_OVER_D:
+                t_over_d = v
+            else:
+                cols[k] = v
+        if T_OVER_D in self._fixed:
+            t_over_d = np.full(index.size, self._fixed[T_OVER_D][0])
+        # Random draws, in blocks independent of the chunking.
+        if self._dists:
+            draws = self._random_draws(start, stop)
+            for k, (kind, _args) in self._dists.items():
+                if k == T_OVER_D:
+                    t_over_d = draws[k] * t_over_d if kind.endswith("_rel") else draws[k]
+                elif kind.endswith("_rel"):
+                    cols[k] = cols[k] * draws[k]
+                else:
+                    cols[k] = draws[k]
+        if t_over_d is not None:
+            cols["plate.t"] = t_over_d * cols["sphere.d"]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            cols[T_OVER_D] = cols["plate.t"] / cols["sphere.d"]
+        out = {"case": index, "pair": pair}
+        out.update(cols)
+        return out
+
+    def _random_draws(self, start: int, stop: int) -> dict:
+        first, last = start // RANDOM_BLOCK, (max(stop, start + 1) - 1) // RANDOM_BLOCK
+        parts = {k: [] for k in self._dists}
+        for b in range(first, last + 1):
+            rng = np.random.default_rng([self.seed, b])
+            lo = max(start - b * RANDOM_BLOCK, 0)
+            hi = min(stop - b * RANDOM_BLOCK, RANDOM_BLOCK)
+            for k, (kind, args) in self._dists.items():
+                parts[k].append(_draw(rng, kind, args, RANDOM_BLOCK)[lo:hi])
+        return {k: np.concatenate(v) if v else np.empty(0) for k, v in parts.items()}
+
+    def describe(self) -> str:
+        bits = []
+        if self.pairs:
+            bits.append(f"{len(self.pairs)} material pair(s)")
+        bits += [f"{k} x{a.size}" for k, a in self._axes.items()]
+        if self._dists:
+            bits.append(f"{self.samples} random sample(s) of {', '.join(self._dists)} per grid point")
+        return f"{self.n_cases} cases: " + (", ".join(bits) if bits else "one case at the start values")
+
+
+def load_spec(path) -> dict:
+    """The dict in a TOML or JSON spec file (``.toml`` / ``.json``)."""
+    path = Path(path)
+    text = path.read_text(encoding="utf-8")
+    if path.suffix.lower() == ".json":
+        return json.loads(text)
+    try:
+        import tomllib
+    except ModuleNotFoundError:  # Python 3.10
+        try:
+            import tomli as tomllib
+        except ModuleNotFoundError:
+            raise SystemExit(f"{path}: reading TOML needs Python >= 3.11 or `pip install tomli`; "
+                             f"or write the spec as JSON") from None
+    return tomllib.loads(text)

@@ -1,0 +1,221 @@
+"""Design-space sweeps (restitution.sweep): specs, both back ends, a 2-worker Dask cluster
+against a serial run, the CLI on an existing scheduler, the table and the COR map."""
+import math
+import os
+import zipfile
+from xml.etree import ElementTree as ET
+
+import numpy as np
+import pytest
+
+import restitution as r
+from restitution.model import PARAMETERS
+from restitution.sweep import (INPUTS, OUTPUTS, SweepSpec, code_fingerprint, compare_results, open_client,
+                               read_table, release_fmus, run_sweep)
+from restitution.sweep.__main__ import main as sweep_cli
+from restitution.sweep.spec import RANDOM_BLOCK
+
+TOL = 1e-12
+
+#: Three pairs (one from Table 4), speeds from well below to far above yield, thin to thick
+#: plates, two Zener methods, two restitution models, and a wide scatter of the sphere modulus
+#: that drives some cases out of range (E <= 0): 2 * 3 * 7 * 4 * 2 * 2 = 1344 cases.
+SPEC = dict(
+    pairs=["s2_tool_steel/al_6061", "borosilicate_glass/stainless_440c", "table4:A2"],
+    grid={"v_approach": {"geomspace": [0.02, 30.0, 7]}, "t_over_d": [0.05, 0.3, 1.0, 4.0],
+          "zener_method": ["exact", "linear"], "restitution_model": ["e45", "e44"]},
+    random={"sphere.E": {"normal_rel": 0.5}}, samples=2, seed=11,
+)
+
+
+@pytest.fixture(scope="module")
+def cluster():
+    """A 2-worker LocalCluster (processes), closed when the module's tests are done."""
+    with open_client("local", n_workers=2) as client:
+        yield client
+    assert client.status == "closed"
+
+
+@pytest.fixture(scope="module")
+def serial(impact_fmu):
+    spec = SweepSpec(**SPEC)
+    return {"package": run_sweep(spec, "package", scheduler="serial"),
+            "fmu": run_sweep(spec, "fmu", fmu=impact_fmu, scheduler="serial", chunk_size=500)}
+
+
+# --- the spec ----------------------------------------------------------------------------
+def test_cases_do_not_depend_on_chunking_and_are_reproducible():
+    spec = SweepSpec(pairs=["brass_260/al_6061"], grid={"v_approach": [0.5, 1, 2]},
+                     random={"plate.t": {"loguniform": [1e-3, 1e-2]}, "sphere.E": {"normal_rel": 0.05}},
+                     samples=3000, seed=3)
+    assert spec.n_cases == 9000 > RANDOM_BLOCK
+    whole = spec.cases()
+    for step in (1000, 4096, 777):
+        parts = [spec.cases(a, a + step) for a in range(0, spec.n_cases, step)]
+        for name, col in whole.items():
+            assert np.array_equal(np.concatenate([p[name] for p in parts]), col), (step, name)
+    assert np.array_equal(SweepSpec(**{**spec.as_dict()}).cases()["plate.t"], whole["plate.t"])
+    other = SweepSpec(**{**spec.as_dict(), "seed": 4}).cases()
+    assert not np.any(other["plate.t"] == whole["plate.t"])
+    # case i: grid point i // samples (last axis fastest), draws within range, pair values set
+    assert np.array_equal(whole["v_approach"], np.repeat([0.5, 1.0, 2.0], 3000))
+    assert 1e-3 <= whole["plate.t"].min() and whole["plate.t"].max() <= 1e-2
+    brass = r.MATERIALS["brass_260"]
+    assert abs(np.mean(whole["sphere.E"]) / brass.E - 1) < 0.003
+    assert abs(np.std(whole["sphere.E"]) / brass.E - 0.05) < 0.003
+    assert np.all(whole["plate.E"] == r.MATERIALS["al_6061"].E)
+    assert np.allclose(whole["t_over_d"], whole["plate.t"] / 6.35e-3)
+
+
+def test_grid_axes_names_and_derived_thickness():
+    spec = SweepSpec(grid={"v": "0.5,1", "t/d": "geomspace:0.1:10:3", "sphere_d": [2e-3, 4e-3]},
+                     fixed={"zener_method": "paper_fit", "plasticity": "off"})
+    assert spec.shape == (2, 3, 2) and spec.n_cases == 12
+    c = spec.cases()
+    assert np.array_equal(c["v_approach"], np.repeat([0.5, 1.0], 6))
+    assert np.allclose(c["plate.t"], np.tile(np.repeat([0.1, 1.0, 10.0], 2) * np.array([2e-3, 4e-3] * 3), 2))
+    assert np.all(c["zener_method"] == 2) and np.all(c["plasticity"] == 0)
+    assert np.all(c["sphere.E"] == 207e9) and np.all(c["pair"] == -1)  # FMU start values elsewhere
+
+
+@pytest.mark.parametrize("bad, message", [
+    (dict(pairs=["s2_tool_steel/al_6061"], grid={"sphere.E": [1e11, 2e11]}), "set by the material pairs"),
+    (dict(grid={"plate.t": [1e-3], "t_over_d": [1.0]}), "plate.t and t_over_d"),
+    (dict(grid={"sphere.G": [1.0]}), "unknown sweep parameter"),
+    (dict(pairs=["steel/al_6061"]), "unknown material"),
+    (dict(grid={"zener_method": ["exactly"]}), "zener_method"),
+    (dict(random={"v_approach": {"uniform": [2, 1]}}), "low < high"),
+    (dict(grid={"v_approach": [1.0]}, fixed={"v_approach": 2.0}), "set twice"),
+])
+def test_bad_specs_name_the_problem(bad, message):
+    with pytest.raises(ValueError, match=message):
+        SweepSpec(**bad)
+
+
+def test_parameter_table_matches_the_fmu(impact_fmu):
+    with zipfile.ZipFile(impact_fmu) as z:
+        root = ET.fromstring(z.read("modelDescription.xml"))
+    found = {sv.get("name"): (sv.get("causality"), sv[0].tag, sv[0].get("start"))
+             for sv in root.find("ModelVariables")}
+    expected = {name: ("input" if name == "v_approach" else "parameter", vtype, start)
+                for name, _kw, vtype, start in INPUTS}
+    expected.update({name: ("output", vtype, None) for name, _f, vtype in OUTPUTS})
+    assert set(found) == set(expected)
+    for name, (causality, vtype, start) in expected.items():
+        assert found[name][:2] == (causality, vtype), name
+        if start is not None:
+            assert float(found[name][2]) == start, name
+
+
+# --- back ends, serial -------------------------------------------------------------------
+def test_serial_backends_agree_and_match_impact(serial):
+    package, fmu = serial["package"], serial["fmu"]
+    diffs = compare_results(fmu, package)
+    assert max(diffs.values()) <= TOL, diffs
+    cols = package.columns
+    # the scatter drove some sphere moduli below zero: those cases are flagged and NaN in both
+    bad = ~cols["ok"]
+    assert 0 < bad.sum() < 0.2 * len(package)
+    assert np.all(cols["sphere.E"][bad] <= 0) and np.all(cols["sphere.E"][~bad] > 0)
+    assert np.all(np.isnan(cols["e"][bad])) and np.all(np.isnan(fmu["e"][bad]))
+    assert not np.any(cols["valid"][bad])
+    # every valid case is what impact() gives for the same inputs, one at a time
+    models, methods = r.RESTITUTION_MODELS, r.ZENER_METHODS
+    for i in np.flatnonzero(~bad)[::37]:
+        kw = {k: float(cols[k.replace("_", ".", 1)][i]) for k, _unit, _check in PARAMETERS}
+        res = r.impact(float(cols["v_approach"][i]), **kw,
+                       restitution_model=models[int(cols["restitution_model"][i]) - 1],
+                       zener_method=methods[int(cols["zener_method"][i]) - 1])
+        assert fmu["e"][i] == pytest.approx(res.e, rel=1e-13, abs=1e-15)
+        assert fmu["zener.t_contact"][i] == pytest.approx(res.t_contact, rel=1e-12)
+        assert bool(fmu["valid"][i]) == bool(res.valid)
+    # the FMU ran the restitution bundled inside it (built from these sources), not this process's copy
+    assert fmu.info["fmu_code_files"][0].endswith(os.path.join("resources", "restitution", "model.py"))
+    assert os.path.dirname(r.__file__) not in fmu.info["fmu_code_files"][0]
+    assert fmu.info["code"] == [package.info["code"][0]] == [code_fingerprint()]
+
+
+def test_known_value_and_physical_trends():
+    spec = SweepSpec(pairs=["s2_tool_steel/al_6061"],
+                     grid={"v_approach": [0.5, 1.0, 3.0], "t_over_d": [0.2, 1.0, 5.0]})
+    res = run_sweep(spec, scheduler="serial")
+    e = res["e"].reshape(3, 3)  # [speed, t/d]
+    # the FMU's default case (S2 steel ball, d = t = 6.35 mm, on Al 6061 at 1 m/s)
+    assert e[1, 1] == pytest.approx(0.596897072574, rel=1e-9)
+    assert np.all(np.diff(e, axis=0) < 0)  # faster: more plasticity and plate waves, lower e
+    assert np.all(np.diff(e, axis=1) > 0)  # thicker plate: fewer plate waves, higher e
+    assert res.columns["pair"][0] == "s2_tool_steel/al_6061"
+
+
+# --- on a 2-worker cluster ---------------------------------------------------------------
+def test_cluster_matches_serial_for_both_backends(cluster, serial, impact_fmu):
+    spec = SweepSpec(**SPEC)
+    dask_package = run_sweep(spec, "package", scheduler=cluster)
+    dask_fmu = run_sweep(spec, "fmu", fmu=impact_fmu, scheduler=cluster, chunk_size=100)
+    assert dask_package.n_workers == dask_fmu.n_workers == 2
+    assert dask_fmu.n_chunks == math.ceil(spec.n_cases / 100)
+    assert dask_fmu.info["processes"] == 2  # one FMU instance in each worker process
+    for ours, theirs in ((dask_package, serial["package"]), (dask_fmu, serial["fmu"]),
+                         (dask_fmu, serial["package"])):
+        for name in ("case", "pair", "sphere.E", "plate.t", "v_approach"):
+            assert np.array_equal(ours[name], theirs[name]), name
+        diffs = compare_results(ours, theirs)
+        assert max(diffs.values()) <= TOL, diffs
+    # worker-side FMU instances were freed at the end of the sweep
+    assert set(cluster.run(release_fmus).values()) == {0}
+
+
+def test_cli_on_an_existing_scheduler_writes_table_and_map(cluster, impact_fmu, tmp_path, capsys):
+    spec_file = tmp_path / "map.toml"
+    spec_file.write_text(
+        'pairs = ["s2_tool_steel/al_6061", "chrome_steel/s7_tool_steel"]\n'
+        '[grid]\n'
+        'v_approach = {geomspace = [0.1, 10.0, 9]}\n'
+        't_over_d = {geomspace = [0.1, 10.0, 7]}\n'
+        '[run]\n'
+        'backend = "both"\n')
+    out = tmp_path / "map.csv"
+    status = sweep_cli([str(spec_file), "--scheduler", cluster.scheduler.address, "--fmu", str(impact_fmu),
+                        "--out", str(out), "--no-progress"])
+    text = capsys.readouterr().out
+    assert status == 0, text
+    assert "126 cases" in text and "agree within 1e-12" in text and "2 worker(s)" in text
+    table = read_table(out)
+    expected = run_sweep(SweepSpec(pairs=["s2_tool_steel/al_6061", "chrome_steel/s7_tool_steel"],
+                                   grid={"v_approach": {"geomspace": [0.1, 10.0, 9]},
+                                         "t_over_d": {"geomspace": [0.1, 10.0, 7]}}), scheduler="serial")
+    for name, col in expected.columns.items():
+        assert np.array_equal(table[name], col) if col.dtype != float else \
+            np.array_equal(table[name], col, equal_nan=True), name
+    png = out.with_name("map_cor_map.png")
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and png.stat().st_size > 20_000
+
+
+def test_parquet_table_round_trip(tmp_path):
+    pytest.importorskip("pyarrow")
+    res = run_sweep(SweepSpec(grid={"v_approach": [0.3, 3.0]}, random={"plate.t": {"uniform": [1e-3, 5e-3]}},
+                              samples=5), scheduler="serial")
+    table = read_table(res.write(tmp_path / "t.parquet"))
+    for name, col in res.columns.items():
+        assert np.array_equal(table[name], col), name
+
+
+def test_dask_scheduler_address_setting_is_used(cluster):
+    import dask
+
+    spec = SweepSpec(pairs=["chrome_steel/s7_tool_steel"], grid={"v_approach": [0.5, 2.0, 8.0]})
+    with dask.config.set({"scheduler-address": cluster.scheduler.address}):
+        res = run_sweep(spec)  # no scheduler given: Dask's configured one, not a new LocalCluster
+    assert res.scheduler == f"the Dask scheduler at {cluster.scheduler.address}" and res.n_workers == 2
+    assert np.array_equal(res["e"], run_sweep(spec, scheduler="serial")["e"])
+
+
+def test_fewer_columns_same_numbers(serial, impact_fmu):
+    spec = SweepSpec(**SPEC)
+    for backend in ("package", "fmu"):
+        res = run_sweep(spec, backend, fmu=impact_fmu, scheduler="serial", columns=["v_approach", "e", "valid"])
+        assert list(res.columns) == ["case", "pair", "v_approach", "e", "valid"]
+        for name in res.columns:
+            assert np.array_equal(res[name], serial[backend][name], equal_nan=name == "e"), (backend, name)
+    with pytest.raises(ValueError, match="unknown column"):
+        run_sweep(spec, scheduler="serial", columns=["E"])
