@@ -68,7 +68,8 @@ VARIABLES = (
     ("jgm.V_star", "Real", OUT, "1", None, "Normalised impact speed V* = v_approach / V_c", "V_star"),
     ("zener.e", "Real", OUT, "1", None, "Zener's COR e_ze (1 where plate waves are off or skipped)", "e_ze"),
     ("zener.lambda", "Real", OUT, "1", None, "Zener's inelasticity parameter lambda, Eq. (12)", "lam"),
-    ("zener.tau0", "Real", OUT, "1", None, "Dimensionless contact time tau0 (3.2180655, Hertz, where skipped)", "tau0"),
+    ("zener.tau0", "Real", OUT, "1", None, "Dimensionless contact time tau0 (plate_waves off: 3.2180655, Hertz; "
+     "skipped by auto: the method's value at lambda = 0)", "tau0"),
     ("zener.t_contact", "Real", OUT, "s", None, "Contact duration T * tau0 (0 when v_approach = 0)", "t_contact"),
     ("plate.m_eff", "Real", OUT, "kg", None, "Equivalent plate mass, Eq. (19) (+inf for a half-space, e_ze = 1)", "m_eff"),
     ("plate.v_after", "Real", OUT, "m/s", None, "Plate velocity after impact, Eq. (17), positive along the approach", "v_plate"),
@@ -121,15 +122,19 @@ class SpherePlateImpact(Fmi2Slave):
         self._values = {}  # name -> current value of every input and parameter
         self._invalid = {}  # name -> message, for values currently rejected
         self._outputs = {}
-        self._evaluated_key = None
+        self._stale = True  # an input or parameter changed since the last evaluation
+        self._call = None  # impact()'s arguments but v, built when a parameter changed
         self._failure = None  # message of the last evaluation that raised
+        self._output_keys = {}  # (Real|Boolean, value reference) -> ImpactResult key, for get_real/get_boolean
         for name, vtype, causality, _unit, start, description, key in VARIABLES:
             if causality == OUT:
                 var_cls = Real if vtype == "Real" else Boolean
-                self.register_variable(var_cls(
+                var = var_cls(
                     name, causality=Fmi2Causality.output, variability=Fmi2Variability.continuous
                     if vtype == "Real" else Fmi2Variability.discrete, initial=Fmi2Initial.calculated,
-                    description=description, getter=self._output_getter(key, vtype)), nested=False)
+                    description=description, getter=self._output_getter(key, vtype))
+                self.register_variable(var, nested=False)
+                self._output_keys.setdefault(vtype, {})[var.value_reference] = key
                 continue
             self._values[name] = start
             var_cls = Real if vtype == "Real" else Integer
@@ -148,11 +153,15 @@ class SpherePlateImpact(Fmi2Slave):
 
     def _setter(self, name):
         ok, allowed, _low, _high = allowed_range(name)
+        is_parameter = name != "v_approach"
 
         def set_value(value):
             if value == self._values.get(name) and name not in self._invalid:
                 return
             self._values[name] = value
+            self._stale = True
+            if is_parameter:
+                self._call = None
             try:
                 good = ok(value)
             except (TypeError, ValueError, OverflowError):
@@ -169,30 +178,57 @@ class SpherePlateImpact(Fmi2Slave):
         nan = math.nan if vtype == "Real" else False
 
         def get_value():
-            outputs = self._evaluate()
-            return outputs.get(key, nan) if outputs is not None else nan
+            if self._stale or self._invalid or self._failure is not None:
+                outputs = self._evaluate()
+                return outputs.get(key, nan) if outputs is not None else nan
+            return self._outputs[key]  # the common case: cached, valid
         return get_value
+
+    # fmi2GetReal/fmi2GetBoolean: pythonfmu's versions call one getter per variable (and each
+    # getter checks the cache); for outputs only, evaluate once and read them in one pass. The
+    # values are those of the getters: NaN (Real) or False (Boolean) while the outputs are invalid.
+    # Requests that include inputs or parameters take pythonfmu's path, with its checks.
+    def get_real(self, vrs):
+        keys = self._output_keys["Real"]
+        try:
+            names = [keys[vr] for vr in vrs]
+        except KeyError:
+            return super().get_real(vrs)
+        outputs = self._evaluate()
+        return [outputs[k] for k in names] if outputs is not None else [math.nan] * len(names)
+
+    def get_boolean(self, vrs):
+        keys = self._output_keys["Boolean"]
+        try:
+            names = [keys[vr] for vr in vrs]
+        except KeyError:
+            return super().get_boolean(vrs)
+        outputs = self._evaluate()
+        return [outputs[k] for k in names] if outputs is not None else [False] * len(names)
 
     # --- evaluation --------------------------------------------------------------------
     def _evaluate(self):
         """Outputs for the current inputs, recomputed only when an input or parameter changed."""
         if self._invalid:
             return None
-        key = tuple(self._values.values())
-        if key == self._evaluated_key:
+        if not self._stale:
             return self._outputs if self._failure is None else None
-        self._evaluated_key = key
+        self._stale = False
         v = self._values
         try:
-            result = impact(
-                float(v["v_approach"]), float(v["sphere.E"]), float(v["sphere.nu"]), float(v["sphere.Sy"]),
-                float(v["sphere.rho"]), float(v["sphere.d"]), float(v["plate.E"]), float(v["plate.nu"]),
-                float(v["plate.Sy"]), float(v["plate.rho"]), float(v["plate.t"]),
-                restitution_model=RESTITUTION_MODELS[int(v["restitution_model"]) - 1],
-                zener_method=ZENER_METHODS[int(v["zener_method"]) - 1],
-                plasticity=EFFECT_MODES[int(v["plasticity"])], plate_waves=EFFECT_MODES[int(v["plate_waves"])],
-                effect_tolerance=float(v["effect_tolerance"]), ode_rtol=float(v["zener.ode_tolerance"]),
-                validate=False)
+            if self._call is None:
+                self._call = (
+                    (float(v["sphere.E"]), float(v["sphere.nu"]), float(v["sphere.Sy"]), float(v["sphere.rho"]),
+                     float(v["sphere.d"]), float(v["plate.E"]), float(v["plate.nu"]), float(v["plate.Sy"]),
+                     float(v["plate.rho"]), float(v["plate.t"])),
+                    dict(restitution_model=RESTITUTION_MODELS[int(v["restitution_model"]) - 1],
+                         zener_method=ZENER_METHODS[int(v["zener_method"]) - 1],
+                         plasticity=EFFECT_MODES[int(v["plasticity"])],
+                         plate_waves=EFFECT_MODES[int(v["plate_waves"])],
+                         effect_tolerance=float(v["effect_tolerance"]), ode_rtol=float(v["zener.ode_tolerance"]),
+                         validate=False))
+            args, kwargs = self._call
+            result = impact(float(v["v_approach"]), *args, **kwargs)
         except Exception as exc:  # a numerical failure must not become fmi2Fatal
             self._failure = f"evaluation failed for {self._describe_inputs()}: {type(exc).__name__}: {exc}"
             self.log(self._failure, Fmi2Status.error)
@@ -219,6 +255,7 @@ class SpherePlateImpact(Fmi2Slave):
             if causality != OUT:
                 self._values[name] = start
         self._invalid.clear()
-        self._evaluated_key = None
+        self._stale = True
+        self._call = None
         self._failure = None
         self._outputs = {}

@@ -16,6 +16,8 @@ __all__ = ["is_scalar", "exp", "log", "sqrt", "where", "minimum", "maximum", "as
 
 def is_scalar(x) -> bool:
     """True for Python/numpy real scalars, False for arrays (even 0-d ones)."""
+    if x.__class__ is float:  # the common case first: ~40 ns instead of ~130 ns
+        return True
     return isinstance(x, (float, int)) and not isinstance(x, bool) or isinstance(x, np.floating)
 
 
@@ -26,35 +28,35 @@ _EXP_MIN_ARG = -708.0
 
 def exp(x):
     """exp(x); 0 (not a subnormal, no underflow flag) for x < -708."""
-    if is_scalar(x):
+    if x.__class__ is float or is_scalar(x):
         return math.exp(x) if x >= _EXP_MIN_ARG else 0.0
     x = np.asarray(x, dtype=float)
     return np.where(x < _EXP_MIN_ARG, 0.0, np.exp(np.maximum(x, _EXP_MIN_ARG)))
 
 
 def log(x):
-    return math.log(x) if is_scalar(x) else np.log(x)
+    return math.log(x) if x.__class__ is float or is_scalar(x) else np.log(x)
 
 
 def sqrt(x):
-    return math.sqrt(x) if is_scalar(x) else np.sqrt(x)
+    return math.sqrt(x) if x.__class__ is float or is_scalar(x) else np.sqrt(x)
 
 
 def where(cond, a, b):
     """``a`` where ``cond`` else ``b``; both branches must already be safe to evaluate."""
-    if isinstance(cond, (bool, np.bool_)):
+    if cond.__class__ is bool or isinstance(cond, np.bool_):
         return a if cond else b
     return np.where(cond, a, b)
 
 
 def minimum(a, b):
-    if is_scalar(a) and is_scalar(b):
+    if (a.__class__ is float or is_scalar(a)) and (b.__class__ is float or is_scalar(b)):
         return a if a <= b else b
     return np.minimum(a, b)
 
 
 def maximum(a, b):
-    if is_scalar(a) and is_scalar(b):
+    if (a.__class__ is float or is_scalar(a)) and (b.__class__ is float or is_scalar(b)):
         return a if a >= b else b
     return np.maximum(a, b)
 

@@ -27,6 +27,8 @@ def _check(name, value, unit, ok_scalar, ok_array, allowed):
 
 def check_positive(name: str, value, unit: str = ""):
     """Require finite values > 0."""
+    if value.__class__ is float and 0.0 < value < math.inf:  # fast path, same result
+        return value
     u = f" {unit}" if unit else ""
     return _check(name, value, u, lambda v: math.isfinite(v) and v > 0.0,
                   lambda a: np.isfinite(a) & (a > 0.0), "finite and > 0")
@@ -34,6 +36,8 @@ def check_positive(name: str, value, unit: str = ""):
 
 def check_nonnegative(name: str, value, unit: str = ""):
     """Require finite values >= 0."""
+    if value.__class__ is float and 0.0 <= value < math.inf:  # fast path, same result
+        return value
     u = f" {unit}" if unit else ""
     return _check(name, value, u, lambda v: math.isfinite(v) and v >= 0.0,
                   lambda a: np.isfinite(a) & (a >= 0.0), "finite and >= 0")
@@ -41,6 +45,8 @@ def check_nonnegative(name: str, value, unit: str = ""):
 
 def check_poisson(name: str, value):
     """Require a Poisson's ratio in [0, 0.5) (0.5, incompressible, makes E' infinite)."""
+    if value.__class__ is float and 0.0 <= value < 0.5:  # fast path, same result
+        return value
     return _check(name, value, "", lambda v: 0.0 <= v < 0.5,
                   lambda a: (a >= 0.0) & (a < 0.5), "0 <= nu < 0.5")
 

@@ -9,7 +9,13 @@ Stop rule: the ball is at rest when the rebound speed falls below ``v_min`` (def
 0.1 m/s, as the ``v_min`` of the Modelica Reference FMU BouncingBall) or when e <= 0 (the
 sphere stays with the plate). With this model e -> 1 as the speed -> 0 (no plasticity
 below V_c, lambda ~ v^(1/5)), so the ideal bounce sequence is Zeno-like: the stop rule,
-not the physics, ends it. ``max_bounces`` is a last guard.
+not the physics, ends it. ``max_bounces`` is a last guard (e = 1 exactly, e.g. both effects
+off or skipped by ``auto``, bounces forever). ``rest_time`` is the instant of the last impact.
+
+Impact instants are accumulated with compensated (Neumaier) summation, so after thousands
+of bounces they are still the correctly rounded sums of the flight times. A rebound
+function that returns a non-finite e or v_rebound (e.g. an FMU whose inputs are invalid
+reads NaN) stops the drop with ValueError instead of bouncing on NaN.
 
 fmpy's ``simulate_fmu`` has no events in co-simulation (FMI-NOTES.md), hence this master
 on ``fmpy.fmi2.FMU2Slave`` (through :class:`~restitution.cosim.fmu.FmuInstance`).
@@ -55,6 +61,24 @@ class Bounces:
     @property
     def n_impacts(self) -> int:
         return int(self.time.size)
+
+    def _segments(self, t):
+        t = np.asarray(t, dtype=float)
+        starts = np.concatenate([[0.0], self.time])
+        v0 = np.concatenate([[0.0], self.v_rebound])
+        h0 = np.concatenate([[self.drop_height], np.zeros(self.time.size)])
+        k = np.clip(np.searchsorted(starts, t, side="right") - 1, 0, starts.size - 1)
+        return t, t - starts[k], v0[k], h0[k]
+
+    def velocity(self, t):
+        """Upward velocity of the ball [m/s] at times ``t`` [s] (0 once at rest)."""
+        t, dt, v0, _h0 = self._segments(t)
+        return np.where(t >= self.rest_time, 0.0, v0 - self.gravity * dt)
+
+    def energy(self, t):
+        """Mechanical energy per unit mass g h + v^2/2 [J/kg] at times ``t`` [s]."""
+        v = self.velocity(t)
+        return self.gravity * self.height(t) + 0.5 * v * v
 
     def height(self, t):
         """Height of the ball [m] at times ``t`` [s] (piecewise parabolas between impacts)."""
@@ -121,6 +145,7 @@ def bounce(rebound, drop_height: float, gravity: float = STANDARD_GRAVITY, v_min
     advance = getattr(rebound, "advance", None)
     rows = []
     t = 0.0
+    t_err = 0.0  # Neumaier compensation term of the running sum t
     v_up = 0.0  # upward speed at the last impact (0: released from rest)
     h = drop_height
     stop = "max_bounces"
@@ -129,12 +154,18 @@ def bounce(rebound, drop_height: float, gravity: float = STANDARD_GRAVITY, v_min
         v_impact = math.sqrt(v_up * v_up + 2.0 * gravity * h)
         flight = (v_up + v_impact) / gravity
         if advance is not None:
-            advance(t, flight)
-        t += flight
+            advance(t + t_err, flight)
+        total = t + flight
+        t_err += (t - total) + flight if abs(t) >= abs(flight) else (flight - total) + t
+        t = total
         out = rebound(v_impact)
         v_reb = out["v_rebound"]
+        if not (math.isfinite(out["e"]) and math.isfinite(v_reb)):
+            raise ValueError(f"rebound at v_approach = {v_impact!r} m/s gave e = {out['e']!r}, "
+                             f"v_rebound = {v_reb!r} (impact {len(rows) + 1}, t = {t + t_err!r} s): "
+                             "the impact model rejected its inputs (see its log)")
         apex = v_reb * v_reb / (2.0 * gravity) if v_reb > 0.0 else 0.0
-        rows.append((t, v_impact, out["e"], out["e_ep"], out["e_ze"], out["lam"], out["tau0"],
+        rows.append((t + t_err, v_impact, out["e"], out["e_ep"], out["e_ze"], out["lam"], out["tau0"],
                      out["t_contact"], v_reb, apex))
         if out["e"] <= 0.0:
             stop = "e<=0"
