@@ -29,7 +29,8 @@ FMU_SRC = ROOT / "fmu_src"
 PACKAGE = FMU_SRC / "restitution"
 
 #: FMU model identifier -> slave script in fmu_src/.
-FMUS = {"SpherePlateImpact": FMU_SRC / "sphere_plate_impact_slave.py"}
+FMUS = {"SpherePlateImpact": FMU_SRC / "sphere_plate_impact_slave.py",
+        "BouncingBall": FMU_SRC / "bouncing_ball_slave.py"}
 
 #: SI base-unit exponents of every unit the FMUs use.
 UNITS = {
@@ -46,11 +47,13 @@ UNITS = {
 PARAMETER_CAUSALITIES = ("parameter", "input")
 
 
-def complete_model_description(xml_text: str, variables, allowed_range) -> str:
+def complete_model_description(xml_text: str, variables, allowed_range, feedthrough=None) -> str:
     """modelDescription.xml with units, descriptions, limits and a full ModelStructure.
 
     ``variables`` is the slave's table: (name, type, causality, unit, start, description, key);
-    ``allowed_range(name)`` gives (check, text, min, max) for inputs and parameters.
+    ``allowed_range(name)`` gives (check, text, min, max) for inputs and parameters;
+    ``feedthrough``: names of the outputs that depend directly on the inputs (default: all
+    but V_c, as in SpherePlateImpact).
     """
     spec = {row[0]: row for row in variables}
     root = ET.fromstring(xml_text)
@@ -91,7 +94,10 @@ def complete_model_description(xml_text: str, variables, allowed_range) -> str:
     for row in variables:
         if row[2] != "output":
             continue
-        depends_on_input = row[6] not in ("V_c",)  # V_c depends on parameters only
+        if feedthrough is None:
+            depends_on_input = row[6] not in ("V_c",)  # V_c depends on parameters only
+        else:
+            depends_on_input = row[0] in feedthrough
         deps = " ".join(map(str, inputs)) if depends_on_input else ""
         attrs = {"index": str(index[row[0]]), "dependencies": deps}
         if deps:
@@ -117,6 +123,20 @@ def _rewrite_zip_member(fmu: Path, member: str, transform) -> None:
     tmp.replace(fmu)
 
 
+#: Subfolders of the package the FMUs bundle; the others (cosim/, scene/, sweep/, ...) are
+#: host-side helpers whose imports (fmpy, dask, matplotlib, ...) the slaves never need. Bundling
+#: them made the plain-C-host loader require those packages at start-up (python_env.txt require=).
+BUNDLED_SUBDIRS = {"data"}
+
+
+def _physics_only(directory, names):
+    """copytree filter: no caches, and only BUNDLED_SUBDIRS below the package root."""
+    ignored = set(shutil.ignore_patterns("__pycache__", "*.pyc")(directory, names))
+    if Path(directory).resolve() == PACKAGE.resolve():
+        ignored |= {n for n in names if (PACKAGE / n).is_dir() and n not in BUNDLED_SUBDIRS}
+    return ignored
+
+
 def build_one(model: str, out_dir: Path, standalone: bool = True) -> Path:
     """Build, complete and validate ``out_dir/<model>.fmu``; return its path."""
     from pythonfmu.builder import FmuBuilder
@@ -126,14 +146,15 @@ def build_one(model: str, out_dir: Path, standalone: bool = True) -> Path:
     out_dir.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(prefix="fmu_build_") as tmp:
         staged = Path(tmp) / "restitution"
-        shutil.copytree(PACKAGE, staged, ignore=shutil.ignore_patterns("__pycache__", "*.pyc"))
+        shutil.copytree(PACKAGE, staged, ignore=_physics_only)
         fmu = FmuBuilder.build_FMU(script, dest=out_dir, project_files=[staged],
                                    canGetAndSetFMUstate=True, canSerializeFMUstate=True)
     sys.path.insert(0, str(script.parent))
     slave_module = importlib.import_module(script.stem)
     _rewrite_zip_member(Path(fmu), "modelDescription.xml",
                         lambda xml: complete_model_description(xml, slave_module.VARIABLES,
-                                                                     slave_module.allowed_range))
+                                                                     slave_module.allowed_range,
+                                                                     getattr(slave_module, "FEEDTHROUGH", None)))
     if standalone and shutil.which("gcc") is None:
         print("warning: gcc not found; the FMU will need a Python host (fmpy, libcosimpy)", file=sys.stderr)
     elif standalone:

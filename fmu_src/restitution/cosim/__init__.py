@@ -4,6 +4,8 @@ Nothing in the physics modules imports this subpackage.
 """
 from .bouncing import Bounces, bounce, fmu_rebound, package_rebound
 from .fmu import FmiStatusError, FmuInstance, build_default_fmu, impact_fmu_parameters
+from .fixed_step import CosimResult, FixedStepMaster, ball_bounces
 
 __all__ = ["FmuInstance", "FmiStatusError", "build_default_fmu", "impact_fmu_parameters",
-           "Bounces", "bounce", "fmu_rebound", "package_rebound"]
+           "Bounces", "bounce", "fmu_rebound", "package_rebound",
+           "CosimResult", "FixedStepMaster", "ball_bounces"]

@@ -26,8 +26,8 @@ def _repo_root() -> Path | None:
     return None
 
 
-def build_default_fmu(out_dir: str | Path | None = None) -> Path:
-    """Path of ``SpherePlateImpact.fmu``, building it with build_scripts/build_fmu.py if missing.
+def build_default_fmu(out_dir: str | Path | None = None, model: str = "SpherePlateImpact") -> Path:
+    """Path of ``<model>.fmu`` (default SpherePlateImpact), building the FMUs with build_scripts/build_fmu.py if missing.
 
     Only works from a source checkout (the build script is not installed with the package).
     """
@@ -35,7 +35,7 @@ def build_default_fmu(out_dir: str | Path | None = None) -> Path:
     if root is None:
         raise FileNotFoundError("build_scripts/build_fmu.py not found: build the FMU from a source checkout")
     out = Path(out_dir) if out_dir is not None else root / "dist"
-    fmu = out / "SpherePlateImpact.fmu"
+    fmu = out / f"{model}.fmu"
     if not fmu.exists():
         subprocess.run([sys.executable, str(root / "build_scripts" / "build_fmu.py"), "--out", str(out)],
                        check=True)

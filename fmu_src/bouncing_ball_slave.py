@@ -1,0 +1,242 @@
+"""BouncingBall: a ball in free flight above a plate, as an FMI 2.0 co-simulation slave.
+
+The ball's side of a two-FMU co-simulation with ``SpherePlateImpact.fmu``: this FMU holds
+the free flight under gravity and finds each contact with the plate *inside* ``do_step``
+(the root of the flight parabola h(t) = 0, in closed form); the impact FMU supplies the
+coefficient of restitution. Connections:
+
+    BouncingBall.v_approach  ->  SpherePlateImpact.v_approach
+    SpherePlateImpact.e      ->  BouncingBall.e
+
+A co-simulation master exchanges values only at communication points, so the ball cannot
+ask for the COR of an impact that happens inside a step. ``contact_mode`` says what it does:
+
+* 1 = ``wait`` (default): at contact the ball stops at the plate (h = 0), keeps its
+  approach velocity and reports it as ``v_approach``; at the start of the next step it
+  rebounds with the COR then on its input ``e``, which a master that resolves the direct
+  feedthrough of the impact FMU has computed for exactly that approach speed. The COR is
+  right; the rebound is late by the rest of the step (< one communication step).
+* 2 = ``immediate``: the ball rebounds at the contact instant with the COR held on its
+  input since the last communication point, i.e. the COR for the speed the ball had then,
+  not its impact speed. The timing is right; the COR is off by O(step).
+
+The flight is kept as a parabola from its start (``flight.*``), so the position at any
+time is closed-form and independent of the step size: every error in a co-simulation of
+this FMU comes from the coupling, none from integrating the flight.
+
+The ball rests when the rebound speed would fall below ``v_min`` or e <= 0 (as the
+event-exact master ``restitution.cosim.bounce``). Impacts are instantaneous (the contact
+duration, tens of microseconds, is not spent), as in that master.
+
+State: every quantity the ball evolves is a registered variable (outputs and the local
+``flight.*``), because pythonfmu's fmi2GetFMUstate saves registered variables only.
+Bad input never raises: it is logged with fmi2Error and ``fmi2DoStep`` returns fmi2Discard
+until a valid value is set. The module has a unique name (two pythonfmu FMUs whose scripts
+share a module name clash in one process).
+"""
+from __future__ import annotations
+
+import math
+
+from pythonfmu import Boolean, Fmi2Causality, Fmi2Slave, Fmi2Variability, Integer, Real
+from pythonfmu.enums import Fmi2Initial, Fmi2Status
+
+P, IN, OUT, LOCAL = "parameter", "input", "output", "local"
+
+#: A contact found within this time [s] after the end of a step still belongs to the step:
+#: a master that steps exactly to a reported contact time (t_impact) must see the contact
+#: although (t + (t_impact - t)) may differ from t_impact by an ulp.
+TIME_TOLERANCE = 1e-12
+
+CONTACT_MODES = ("wait", "immediate")
+
+# (name, type, causality, unit, start, description, key); build_fmu.py reads this table to
+# write units, ranges and descriptions into modelDescription.xml.
+VARIABLES = (
+    ("h0", "Real", P, "m", 0.3, "Drop height: the ball is released from rest at the start time, > 0", "h0"),
+    ("g", "Real", P, "m/s2", 9.80665, "Gravitational acceleration, > 0", "g"),
+    ("v_min", "Real", P, "m/s", 0.1, "The ball comes to rest when its rebound speed would be below v_min, > 0",
+     "v_min"),
+    ("contact_mode", "Integer", P, None, 1,
+     "1 = wait (at contact stay at the plate until the next communication point, then rebound with the COR "
+     "input), 2 = immediate (rebound at contact with the COR input held since the last communication point)",
+     "contact_mode"),
+    ("e", "Real", IN, "1", 1.0, "Coefficient of restitution for the current approach speed "
+     "(from SpherePlateImpact.e), -1 <= e <= 1; e <= 0: the ball stays at the plate", "e"),
+    ("h", "Real", OUT, "m", None, "Height of the ball above the plate", "h"),
+    ("v", "Real", OUT, "m/s", None, "Vertical velocity of the ball, upward positive", "v"),
+    ("v_approach", "Real", OUT, "m/s", None, "Speed of the ball toward the plate, max(-v, 0) "
+     "(while waiting at the plate: the impact speed); connect to SpherePlateImpact.v_approach", "v_approach"),
+    ("impacts", "Integer", OUT, None, None, "Number of contacts with the plate so far", "impacts"),
+    ("t_impact", "Real", OUT, "s", None, "Time of the last contact, located inside the step (-1: none yet)",
+     "t_impact"),
+    ("v_impact", "Real", OUT, "m/s", None, "Approach speed at the last contact", "v_impact"),
+    ("t_rebound", "Real", OUT, "s", None, "Time the ball left the plate after the last contact (-1: not yet)",
+     "t_rebound"),
+    ("v_rebound", "Real", OUT, "m/s", None, "Rebound speed after the last contact (0: at rest)", "v_rebound"),
+    ("e_applied", "Real", OUT, "1", None, "COR applied at the last rebound", "e_applied"),
+    ("in_contact", "Boolean", OUT, None, None, "Waiting at the plate for the COR (contact_mode = 1)", "in_contact"),
+    ("at_rest", "Boolean", OUT, None, None, "The ball has come to rest on the plate", "at_rest"),
+    ("flight.t_start", "Real", LOCAL, "s", None, "Start time of the current free flight", "t_start"),
+    ("flight.h_start", "Real", LOCAL, "m", None, "Height at the start of the current free flight", "h_start"),
+    ("flight.v_start", "Real", LOCAL, "m/s", None, "Upward velocity at the start of the current free flight",
+     "v_start"),
+)
+
+#: Outputs that depend directly on an input at the same communication point: none (the
+#: COR input acts only inside fmi2DoStep). build_fmu.py writes the ModelStructure from it.
+FEEDTHROUGH = ()
+
+
+def allowed_range(name):
+    """(predicate, allowed-range text, xml min, xml max) of an input or parameter."""
+    if name == "contact_mode":
+        return (lambda v: 1 <= int(v) <= len(CONTACT_MODES)), "1 = wait or 2 = immediate", "1", "2"
+    if name == "e":
+        return (lambda v: -1.0 <= v <= 1.0), "-1 <= e <= 1", "-1", "1"
+    return (lambda v: 0.0 < v < math.inf), "finite and > 0", "0", None
+
+
+_INITIAL_STATE = {
+    "h": 0.0, "v": 0.0, "v_approach": 0.0, "impacts": 0, "t_impact": -1.0, "v_impact": 0.0,
+    "t_rebound": -1.0, "v_rebound": 0.0, "e_applied": math.nan, "in_contact": False, "at_rest": False,
+    "t_start": 0.0, "h_start": 0.0, "v_start": 0.0,
+}
+
+
+class BouncingBall(Fmi2Slave):
+    """A ball dropped onto a plate; the coefficient of restitution is an input (from SpherePlateImpact)."""
+
+    author = "restitution developers"
+    description = ("Ball in free flight above a plate; locates each contact inside the step and rebounds "
+                   "with the coefficient of restitution on its input (connect to SpherePlateImpact.fmu)")
+
+    def __init__(self, **kwargs):
+        super().__init__(**kwargs)
+        self._values = {}  # parameters and the input, by FMI name
+        self._invalid = {}  # name -> message, for values currently rejected
+        self._s = dict(_INITIAL_STATE)  # evolving state, by table key
+        self._start_time = 0.0
+        for name, vtype, causality, _unit, start, description, key in VARIABLES:
+            var_cls = {"Real": Real, "Integer": Integer, "Boolean": Boolean}[vtype]
+            if causality in (P, IN):
+                self._values[name] = start
+                self.register_variable(var_cls(
+                    name, causality=Fmi2Causality.parameter if causality == P else Fmi2Causality.input,
+                    variability=Fmi2Variability.fixed if causality == P else Fmi2Variability.continuous,
+                    start=start, description=description, getter=self._value_getter(name),
+                    setter=self._value_setter(name)), nested=False)
+                continue
+            variability = Fmi2Variability.continuous if vtype == "Real" else Fmi2Variability.discrete
+            self.register_variable(var_cls(
+                name, causality=Fmi2Causality.output if causality == OUT else Fmi2Causality.local,
+                variability=variability, initial=Fmi2Initial.calculated, description=description,
+                getter=self._state_getter(key), setter=self._state_setter(key)), nested=False)
+
+    # --- variable access ---------------------------------------------------------------
+    def _value_getter(self, name):
+        return lambda: self._values[name]
+
+    def _value_setter(self, name):
+        ok, allowed, _low, _high = allowed_range(name)
+
+        def set_value(value):
+            self._values[name] = value
+            try:
+                good = bool(ok(value))
+            except (TypeError, ValueError, OverflowError):
+                good = False
+            if good:
+                self._invalid.pop(name, None)
+            else:
+                message = f"{name} = {value!r} is outside the allowed range: {allowed}"
+                self._invalid[name] = message
+                self.log(message, Fmi2Status.error)
+        return set_value
+
+    def _state_getter(self, key):
+        return lambda: self._s[key]
+
+    def _state_setter(self, key):  # used by fmi2SetFMUstate
+        def set_value(value):
+            self._s[key] = value
+        return set_value
+
+    # --- the ball ------------------------------------------------------------------------
+    def _start_flight(self, t, h, v):
+        s = self._s
+        s["t_start"], s["h_start"], s["v_start"] = float(t), float(h), float(v)
+
+    def _rebound(self, t):
+        """Leave the plate at time t with the COR on the input (or come to rest)."""
+        s = self._s
+        e = float(self._values["e"])
+        v_out = e * s["v_impact"]
+        s["in_contact"] = False
+        s["t_rebound"] = float(t)
+        s["e_applied"] = e
+        if e <= 0.0 or v_out < float(self._values["v_min"]):
+            s["at_rest"] = True
+            s["v_rebound"] = 0.0
+            self._start_flight(t, 0.0, 0.0)
+        else:
+            s["v_rebound"] = v_out
+            self._start_flight(t, 0.0, v_out)
+
+    def _update_outputs(self, t):
+        s = self._s
+        if s["at_rest"]:
+            s["h"], s["v"], s["v_approach"] = 0.0, 0.0, 0.0
+            return
+        if s["in_contact"]:
+            s["h"], s["v"], s["v_approach"] = 0.0, -s["v_impact"], s["v_impact"]
+            return
+        g = float(self._values["g"])
+        dt = max(t - s["t_start"], 0.0)
+        s["h"] = max(s["h_start"] + s["v_start"] * dt - 0.5 * g * dt * dt, 0.0)
+        s["v"] = s["v_start"] - g * dt
+        s["v_approach"] = max(-s["v"], 0.0)
+
+    # --- FMI calls -------------------------------------------------------------------------
+    def setup_experiment(self, start_time, stop_time=None, tolerance=None):
+        self._start_time = float(start_time)
+
+    def exit_initialization_mode(self):
+        self._s = dict(_INITIAL_STATE)
+        h0 = self._values["h0"]
+        self._start_flight(self._start_time, h0 if "h0" not in self._invalid else 0.0, 0.0)
+        self._update_outputs(self._start_time)
+
+    def do_step(self, current_time: float, step_size: float) -> bool:
+        if self._invalid:
+            self.log("doStep discarded: " + "; ".join(self._invalid.values()), Fmi2Status.discard)
+            return False
+        s = self._s
+        g = float(self._values["g"])
+        wait = int(self._values["contact_mode"]) == 1
+        now = float(current_time)
+        end = now + float(step_size)
+        if s["in_contact"]:  # the COR for the pending contact arrived at this communication point
+            self._rebound(now)
+        while not s["at_rest"]:
+            # root of h_start + v_start s - g s^2 / 2 = 0; this form avoids cancellation
+            v_hit = math.sqrt(s["v_start"] ** 2 + 2.0 * g * s["h_start"])
+            t_hit = s["t_start"] + (s["v_start"] + v_hit) / g
+            if t_hit > end + TIME_TOLERANCE:
+                break
+            s["impacts"] += 1
+            s["t_impact"], s["v_impact"] = t_hit, v_hit
+            s["in_contact"] = True
+            if wait:
+                break
+            self._rebound(t_hit)
+        self._update_outputs(end)
+        return True
+
+    def reset(self):
+        for name, _vtype, causality, _unit, start, _description, _key in VARIABLES:
+            if causality in (P, IN):
+                self._values[name] = start
+        self._invalid.clear()
+        self._s = dict(_INITIAL_STATE)
+        self._start_time = 0.0

@@ -1,0 +1,232 @@
+"""The examples (examples/*.py), run with show_plot=False, and the statements they illustrate.
+
+Each example is imported and its ``run`` called with the FMUs built from the working tree;
+the numbers it returns are checked against the event-exact master, the package, and the
+paper's statements (Green, Nonlinear Dyn 2022, Sec. 6-7).
+"""
+import importlib.util
+import math
+import shutil
+import sys
+from pathlib import Path
+from xml.etree import ElementTree as ET
+
+import numpy as np
+import pytest
+
+import restitution as r
+
+ROOT = Path(__file__).resolve().parent.parent
+EXAMPLES = ROOT / "examples"
+G = 9.80665
+
+
+def _load(name):
+    spec = importlib.util.spec_from_file_location(f"example_{name}", EXAMPLES / f"{name}.py")
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module
+    spec.loader.exec_module(module)
+    return module
+
+
+@pytest.fixture(scope="module")
+def fmu_dir(impact_fmu, tmp_path_factory) -> Path:
+    """BouncingBall.fmu built from the working tree, next to the session's SpherePlateImpact.fmu."""
+    from build_fmu import build_one
+
+    out = tmp_path_factory.mktemp("fmus")
+    shutil.copy(impact_fmu, out / "SpherePlateImpact.fmu")
+    build_one("BouncingBall", out)
+    return out
+
+
+# --- 1. bouncing ball on plates of several thicknesses ------------------------------------
+@pytest.fixture(scope="module")
+def bouncing(fmu_dir, tmp_path_factory):
+    return _load("bouncing_ball").run(show_plot=False, fmu_path=fmu_dir / "SpherePlateImpact.fmu",
+                                      out_dir=tmp_path_factory.mktemp("out"), verbose=False)
+
+
+def test_bouncing_ball_thickness_effect(bouncing):
+    cases = bouncing["cases"]
+    assert list(cases) == ["t/d = 0.25", "t/d = 0.5", "t/d = 1", "t/d = 2", "half-space"]
+    v1 = math.sqrt(2 * G * 0.3)
+    first_e = [b.e[0] for b in cases.values()]
+    for b in cases.values():
+        assert b.v_approach[0] == pytest.approx(v1, rel=1e-12)
+        assert b.time[0] == pytest.approx(math.sqrt(2 * 0.3 / G), rel=1e-12)
+    # thicker plate, livelier bounce; the half-space gives the JGM value e = e_ep
+    assert np.all(np.diff(first_e) > 0.03), first_e
+    half = cases["half-space"]
+    assert np.all(half.e_ze == 1.0) and np.allclose(half.e, half.e_ep, rtol=0, atol=1e-15)
+    # t/d = 0.25: e < 0, the ball stays with the plate (Sec. 5: negative apparent COR)
+    thin = cases["t/d = 0.25"]
+    assert thin.n_impacts == 1 and thin.stop_reason == "e<=0" and -0.2 < thin.e[0] < -0.1
+    # more bounces and a later rest on thicker plates
+    assert [b.n_impacts for b in cases.values()] == sorted(b.n_impacts for b in cases.values())
+    assert np.all(np.diff([b.rest_time for b in cases.values()]) > 0)
+    assert [round(b.e[0], 3) for b in cases.values()] == [-0.147, 0.224, 0.498, 0.595, 0.630]
+
+
+def test_bouncing_ball_table_matches_the_package(bouncing):
+    rows = bouncing["rows"]
+    assert {w["plate"] for w in rows} == set(bouncing["cases"])
+    assert sum(w["plate"] == "t/d = 1" for w in rows) == 5
+    sphere = r.Sphere(r.MATERIALS["s2_tool_steel"], 6.35e-3)
+    for w in rows:
+        if w["plate"] == "half-space":
+            continue
+        td = float(w["plate"].split("=")[1])
+        ref = r.impact_between(sphere, r.Plate(r.MATERIALS["al_6061"], td * 6.35e-3), v=w["v_approach"])
+        assert w["e"] == pytest.approx(ref.e, abs=1e-12)
+        assert w["e_ze"] == pytest.approx(ref.e_ze, abs=1e-12)
+        assert w["t_contact_us"] == pytest.approx(ref.t_contact * 1e6, rel=1e-9)
+    assert bouncing["markdown"].count("\n") == len(rows) + 1
+    assert bouncing["png"].stat().st_size > 10_000
+
+
+# --- 2. two FMUs under three masters ---------------------------------------------------------
+STEPS = (1e-2, 1e-3)
+
+
+@pytest.fixture(scope="module")
+def cosim(fmu_dir, tmp_path_factory):
+    return _load("two_fmu_cosim").run(show_plot=False, steps=STEPS, fmu_dir=fmu_dir,
+                                      out_dir=tmp_path_factory.mktemp("cosim"), verbose=False)
+
+
+def _row(cosim, master, step):
+    (row,) = [w for w in cosim["rows"] if w["master"] == master and w["step"] == step]
+    return row
+
+
+def test_fixed_step_master_delays_the_rebound_by_less_than_a_step_per_bounce(cosim):
+    for h in STEPS:
+        w = _row(cosim, "fmpy fixed step", h)
+        assert w["bounces"] == 5
+        assert w["apex_rel_max"] < 1e-12 and w["de_max"] < 1e-12  # the COR is the exact one
+        assert 0.5 * h < w["dt_max"] < 4 * h  # four waits, each shorter than one step
+    assert _row(cosim, "fmpy fixed step", 1e-3)["dt_max"] < _row(cosim, "fmpy fixed step", 1e-2)["dt_max"] / 5
+
+
+def test_immediate_rebound_has_the_right_time_base_but_a_stale_cor(cosim):
+    coarse, fine = _row(cosim, "fmpy fixed step, immediate", 1e-2), _row(cosim, "fmpy fixed step, immediate", 1e-3)
+    assert 1e-3 < coarse["apex_rel_max"] < 0.3 and fine["apex_rel_max"] < coarse["apex_rel_max"] / 5
+    assert 0 < fine["de_max"] < coarse["de_max"] < 0.05
+
+
+def test_libcosim_lags_one_communication_step(cosim):
+    exact = cosim["exact"]
+    for h in STEPS:
+        w = _row(cosim, "libcosim fixedStep", h)
+        assert w["bounces"] == 5
+        assert w["apex_rel_max"] > 1e-5 and w["dt_max"] < 5 * h
+        # the first rebound uses the COR for the speed at the last communication point before the contact
+        res = cosim["results"][("libcosim fixedStep", h)]
+        e_applied = res["ball.e_applied"][np.flatnonzero(res["ball.t_rebound"] > 0)[0]]
+        t_before = math.floor(exact.time[0] / h) * h
+        sphere = r.Sphere(r.MATERIALS["s2_tool_steel"], 6.35e-3)
+        ref = r.impact_between(sphere, r.Plate(r.MATERIALS["al_6061"], 6.35e-3), v=G * t_before)
+        assert e_applied == pytest.approx(ref.e, abs=1e-9)
+        structure = ET.parse(Path(res.extra["structure"])).getroot()
+        ns = {"osp": "http://opensimulationplatform.com/MSMI/OSPSystemStructure"}
+        assert float(structure.find("osp:BaseStepSize", ns).text) == h
+        assert len(structure.findall("osp:Connections/osp:VariableConnection", ns)) == 2
+
+
+def test_state_restore_master_matches_the_event_exact_master(cosim):
+    for h in STEPS:
+        w = _row(cosim, "fmpy state restore", h)
+        assert w["bounces"] == 5
+        assert w["dt_max"] < 1e-12 and w["apex_rel_max"] < 1e-12
+        assert w["rollbacks"] == cosim["exact"].n_impacts  # one restore per impact, all inside a step
+    assert cosim["png"].stat().st_size > 10_000
+
+
+def test_state_restore_of_the_ball_alone_is_enough(cosim, fmu_dir):
+    """The impact FMU is stateless: saving only the ball's state gives the same exact bounces."""
+    from restitution.cosim import FixedStepMaster, FmuInstance, ball_bounces
+    from restitution.cosim.fixed_step import BALL_RECORD
+
+    with FmuInstance(fmu_dir / "SpherePlateImpact.fmu", "impact") as impact, \
+            FmuInstance(fmu_dir / "BouncingBall.fmu", "ball", parameters={"h0": 0.3}) as ball:
+        master = FixedStepMaster({"ball": ball, "impact": impact})
+        res = master.run(1e-2, 1.0, record=BALL_RECORD, event=("ball.impacts", "ball.t_impact"), stateful=["ball"])
+    b, exact = ball_bounces(res, G), cosim["exact"]
+    assert res.rollbacks == exact.n_impacts
+    assert np.allclose(b["t_impact"], exact.time, rtol=0, atol=1e-12)
+    assert np.allclose(b["v_rebound"][:-1], exact.v_rebound[:-1], rtol=1e-12, atol=0)  # the last one: at rest
+
+
+# --- 3. the paper's figures through the FMU ------------------------------------------------
+@pytest.fixture(scope="module")
+def figures(fmu_dir, tmp_path_factory):
+    return _load("paper_figures").run(show_plot=False, fmu_path=fmu_dir / "SpherePlateImpact.fmu", n_points=81,
+                                      out_dir=tmp_path_factory.mktemp("figs"), verbose=False)
+
+
+def _at(x, grid, values):
+    return float(np.interp(x, grid, values))
+
+
+def test_fig4_curves_rise_with_t_over_d_toward_jgm(figures):
+    for key, f in figures["fig4"].items():
+        small, large = (f["curves"][d] for d in (4.76e-3, 6.35e-3))
+        assert np.allclose(small["e"], large["e"], rtol=0, atol=1e-12)  # only t/d matters
+        e, e_ep, td = large["e"], large["e_ep"], f["t_over_d"]
+        assert np.all(np.diff(e) >= -1e-12), key
+        assert np.all(e <= e_ep + 1e-15)
+        assert 0 <= e_ep[-1] - e[-1] < 0.03, key  # at t/d = 3 within 0.03 of the JGM value
+        for d, m in f["markers"].items():  # the experiments' plates lie on the same curve
+            assert np.allclose(m["e"], np.interp(m["t_over_d"], td, e), atol=3e-3)
+    sphere = r.Sphere(r.MATERIALS["tungsten_carbide"], 4.76e-3)
+    m = figures["fig4"]["tungsten_carbide"]["markers"][4.76e-3]
+    ref = r.impact_between(sphere, r.Plate(r.MATERIALS["al_6061"], np.array(m["t_over_d"]) * 4.76e-3), v=2.3)
+    assert np.allclose(m["e"], ref.e, rtol=0, atol=1e-12)  # the FMU computes what the package does
+
+
+def test_fig6_zener_statements_and_higher_speed_below(figures):
+    f6 = figures["fig6"]
+    for key, f in f6.items():
+        td, slow, fast = f["t_over_d"], f[2.3], f[6.9]
+        e_ze1, e_ze2 = _at(1.0, td, slow["e_ze"]), _at(2.0, td, slow["e_ze"])
+        assert e_ze1 >= 0.75, key  # "about 0.8 or above" at t/d = 1
+        assert e_ze2 >= 0.93, key  # "e_ze -> 1" at t/d = 2
+        e_jgm, e_thin, e2 = slow["e_ep"][0], _at(0.25, td, slow["e"]), _at(2.0, td, slow["e"])
+        assert (e2 - e_thin) / (e_jgm - e_thin) >= 0.9, key  # asymptotic approach nearly complete at t/d = 2
+        assert np.all(fast["e"] < slow["e"]), key  # 6.9 m/s curves lie below the 2.3 m/s ones
+        assert fast["e_ep"][0] < slow["e_ep"][0] and np.all(fast["e_ze"] <= slow["e_ze"])
+        assert np.all(np.diff(fast["e"]) >= -1e-12)
+    assert np.mean([_at(1.0, f["t_over_d"], f[2.3]["e_ze"]) for f in f6.values()]) >= 0.8
+    assert list(f6) == ["tungsten_carbide", "s2_tool_steel", "borosilicate_glass"]
+
+
+def test_fig5_cases_b_reach_the_asymptote_sooner(figures):
+    f5 = figures["fig5"]
+    for case, f in f5.items():
+        assert np.all(np.diff(f["e"]) >= -1e-12), case
+        assert np.all(f["e"] <= f["e_jgm"] + 1e-15)
+    a = [f5[c]["asymptote_t_over_d"] for c in ("A1", "A2", "A3", "A4")]
+    b = [f5[c]["asymptote_t_over_d"] for c in ("B1", "B2", "B3", "B4")]
+    assert max(b) < 1.0 < 3.0 < min(a), (a, b)
+    # hard plates (Sy >= 1000 MPa) do not yield at 5 m/s: e_ep = 1, e = e_ze
+    for case in ("A3", "A4", "B3", "B4"):
+        assert f5[case]["e_jgm"] == 1.0 and np.allclose(f5[case]["e"], f5[case]["e_ze"], atol=1e-15)
+    assert f5["A1"]["e"][0] < -0.4  # the thin-plate outlier: strongly negative e
+
+
+def test_fig7_velocity_dependence(figures):
+    f = figures["fig7"]
+    assert f["V_c"] == pytest.approx(0.0265, abs=5e-5) and f["V_star_ref"] == pytest.approx(86.9, abs=0.05)
+    assert np.allclose(f["V_star_fmu"], f["V_star"], rtol=1e-9)
+    assert f["V_star"][0] == pytest.approx(8.69, rel=1e-3) and f["V_star"][-1] == pytest.approx(869, rel=1e-3)
+    for key in ("e_ze", "e_ep", "e"):
+        assert np.all(np.diff(f[key]) < 0), key
+    drop_ze, drop_ep = f["e_ze"][0] - f["e_ze"][-1], f["e_ep"][0] - f["e_ep"][-1]
+    assert drop_ep > 2 * drop_ze > 0  # Eq. (13) moderate, Eq. (8) steeper
+    assert np.all(f["e"] <= np.minimum(f["e_ze"], f["e_ep"]))
+    s2 = figures["fig4"]["s2_tool_steel"]["markers"][6.35e-3]  # Fig. 4's point at t = d = 6.35 mm
+    assert s2["t_over_d"][3] == 1.0 and float(f["ref"]["e"]) == pytest.approx(s2["e"][3], abs=1e-12)
+    above, below = f["V_star"] > f["V_star_ref"] * (1 + 1e-9), f["V_star"] < f["V_star_ref"] * (1 - 1e-9)
+    assert np.all(f["e"][above] < f["ref"]["e"]) and np.all(f["e"][below] > f["ref"]["e"])
+    assert all(p.stat().st_size > 10_000 for p in figures["png"].values())
