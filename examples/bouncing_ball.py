@@ -19,41 +19,12 @@ from pathlib import Path
 import numpy as np
 
 import restitution as r
+from restitution.viz import write_png
 from restitution.cosim import FmuInstance, bounce, build_default_fmu, fmu_rebound, impact_fmu_parameters
 
 HERE = Path(__file__).resolve().parent
 OUTPUT = HERE / "output"
 HALF_SPACE = "half-space"
-
-
-def write_png(fig, path: Path, dpi: int) -> Path:
-    """Save ``fig`` as a small PNG (128-colour palette when Pillow is there, as it is with matplotlib).
-
-    Written to a temporary file and renamed, so a reader never sees a half-written picture.
-    """
-    import os
-    import tempfile
-
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(suffix=".png", dir=path.parent)
-    os.close(fd)
-    try:
-        fig.savefig(tmp, dpi=dpi)
-        try:
-            from PIL import Image
-        except ImportError:
-            pass
-        else:
-            with Image.open(tmp) as image:
-                small = image.convert("RGB").quantize(colors=128, method=Image.Quantize.MEDIANCUT,
-                                                      dither=Image.Dither.NONE)
-            small.save(tmp, format="PNG", optimize=True)
-        os.chmod(tmp, 0o644)  # mkstemp makes it private
-        os.replace(tmp, path)
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-    return path
 
 
 def drop_on_plates(fmu_path, t_over_d=(0.25, 0.5, 1.0, 2.0), half_space=True, drop_height=0.3,

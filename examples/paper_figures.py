@@ -26,6 +26,7 @@ from pathlib import Path
 import numpy as np
 
 import restitution as r
+from restitution.viz import write_png
 from restitution.cosim import FmuInstance, build_default_fmu
 from restitution.materials import table4_case
 
@@ -41,36 +42,6 @@ OUTPUTS = ("e", "jgm.e", "zener.e", "zener.lambda", "jgm.V_star", "jgm.V_c")
 KEYS = ("e", "e_ep", "e_ze", "lam", "V_star", "V_c")
 #: |e - e_JGM| within which a curve counts as having reached its asymptote (Fig. 5 statement).
 ASYMPTOTE_TOLERANCE = 0.01
-
-
-def write_png(fig, path: Path, dpi: int) -> Path:
-    """Save ``fig`` as a small PNG (128-colour palette when Pillow is there, as it is with matplotlib).
-
-    Written to a temporary file and renamed, so a reader never sees a half-written picture.
-    """
-    import os
-    import tempfile
-
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(suffix=".png", dir=path.parent)
-    os.close(fd)
-    try:
-        fig.savefig(tmp, dpi=dpi)
-        try:
-            from PIL import Image
-        except ImportError:
-            pass
-        else:
-            with Image.open(tmp) as image:
-                small = image.convert("RGB").quantize(colors=128, method=Image.Quantize.MEDIANCUT,
-                                                      dither=Image.Dither.NONE)
-            small.save(tmp, format="PNG", optimize=True)
-        os.chmod(tmp, 0o644)  # mkstemp makes it private
-        os.replace(tmp, path)
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-    return path
 
 
 class ImpactFMU:

@@ -42,6 +42,7 @@ from pathlib import Path
 import numpy as np
 
 import restitution as r
+from restitution.viz import write_png
 from restitution.cosim import (FixedStepMaster, FmuInstance, ball_bounces, bounce, build_default_fmu,
                                fmu_rebound, impact_fmu_parameters)
 from restitution.cosim.fixed_step import BALL_IMPACT_CONNECTIONS, BALL_RECORD
@@ -54,36 +55,6 @@ EVENT = ("ball.impacts", "ball.t_impact")
 FIXED, IMMEDIATE, LIBCOSIM, RESTORE = ("fmpy fixed step", "fmpy fixed step, immediate", "libcosim fixedStep",
                                        "fmpy state restore")
 MASTERS = (FIXED, IMMEDIATE, LIBCOSIM, RESTORE)
-
-
-def write_png(fig, path: Path, dpi: int) -> Path:
-    """Save ``fig`` as a small PNG (128-colour palette when Pillow is there, as it is with matplotlib).
-
-    Written to a temporary file and renamed, so a reader never sees a half-written picture.
-    """
-    import os
-    import tempfile
-
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(suffix=".png", dir=path.parent)
-    os.close(fd)
-    try:
-        fig.savefig(tmp, dpi=dpi)
-        try:
-            from PIL import Image
-        except ImportError:
-            pass
-        else:
-            with Image.open(tmp) as image:
-                small = image.convert("RGB").quantize(colors=128, method=Image.Quantize.MEDIANCUT,
-                                                      dither=Image.Dither.NONE)
-            small.save(tmp, format="PNG", optimize=True)
-        os.chmod(tmp, 0o644)  # mkstemp makes it private
-        os.replace(tmp, path)
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-    return path
 
 
 def default_system(t_over_d: float = 1.0):
