@@ -27,7 +27,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["Bounces", "bounce", "fmu_rebound", "package_rebound", "RECORDED", "STANDARD_GRAVITY"]
+__all__ = ["Bounces", "bounce", "impact_sequence", "fmu_rebound", "package_rebound", "RECORDED", "STANDARD_GRAVITY"]
 
 STANDARD_GRAVITY = 9.80665  # [m/s^2]
 
@@ -129,12 +129,16 @@ def fmu_rebound(instance):
     return rebound
 
 
-def bounce(rebound, drop_height: float, gravity: float = STANDARD_GRAVITY, v_min: float = 0.1,
-           max_bounces: int = 100_000) -> Bounces:
-    """Drop a ball from ``drop_height`` [m] and bounce it until it rests (see module doc).
+def impact_sequence(rebound, drop_height: float, gravity: float = STANDARD_GRAVITY, v_min: float = 0.1,
+                    max_bounces: int = 100_000, advance=None):
+    """The impacts of one drop: ``([(t, v_approach, out), ...], stop_reason)``.
 
-    ``rebound(v_approach) -> dict`` gives e, e_ep, e_ze, lam, tau0, t_contact, v_rebound
-    for an impact at speed v [m/s]; :func:`fmu_rebound` and :func:`package_rebound` make one.
+    Flight is integrated in closed form and each impact located exactly; at each one
+    ``out = rebound(v_approach)`` (a mapping with at least ``v_rebound`` [m/s]; its other
+    float entries are checked for NaN too, the FMU's sign of rejected input). ``advance(t, dt)``, if given, is called for each
+    flight (to step an FMU across it). Stops on e <= 0 (``v_rebound <= 0``), on
+    ``v_rebound < v_min`` or after ``max_bounces`` impacts (see the module doc).
+    Impact times are summed with Neumaier compensation (10^4 bounces lose no digits).
     """
     if not (math.isfinite(drop_height) and drop_height > 0.0):
         raise ValueError(f"drop_height = {drop_height!r} m is outside the allowed range: finite and > 0")
@@ -142,13 +146,11 @@ def bounce(rebound, drop_height: float, gravity: float = STANDARD_GRAVITY, v_min
         raise ValueError(f"gravity = {gravity!r} m/s2 is outside the allowed range: finite and > 0")
     if not (math.isfinite(v_min) and v_min > 0.0):
         raise ValueError(f"v_min = {v_min!r} m/s is outside the allowed range: finite and > 0")
-    advance = getattr(rebound, "advance", None)
-    rows = []
+    events = []
     t = 0.0
     t_err = 0.0  # Neumaier compensation term of the running sum t
     v_up = 0.0  # upward speed at the last impact (0: released from rest)
     h = drop_height
-    stop = "max_bounces"
     for _ in range(max_bounces):
         # h + v_up s - g s^2/2 = 0; this form avoids cancellation when v_up is large.
         v_impact = math.sqrt(v_up * v_up + 2.0 * gravity * h)
@@ -160,20 +162,35 @@ def bounce(rebound, drop_height: float, gravity: float = STANDARD_GRAVITY, v_min
         t = total
         out = rebound(v_impact)
         v_reb = out["v_rebound"]
-        if not (math.isfinite(out["e"]) and math.isfinite(v_reb)):
-            raise ValueError(f"rebound at v_approach = {v_impact!r} m/s gave e = {out['e']!r}, "
-                             f"v_rebound = {v_reb!r} (impact {len(rows) + 1}, t = {t + t_err!r} s): "
+        if any(math.isnan(x) for x in out.values() if x.__class__ is float):
+            values = ", ".join(f"{k} = {x!r}" for k, x in out.items() if x.__class__ is float)
+            raise ValueError(f"rebound at v_approach = {v_impact!r} m/s gave {values} "
+                             f"(impact {len(events) + 1}, t = {t + t_err!r} s): "
                              "the impact model rejected its inputs (see its log)")
-        apex = v_reb * v_reb / (2.0 * gravity) if v_reb > 0.0 else 0.0
-        rows.append((t + t_err, v_impact, out["e"], out["e_ep"], out["e_ze"], out["lam"], out["tau0"],
-                     out["t_contact"], v_reb, apex))
-        if out["e"] <= 0.0:
-            stop = "e<=0"
-            break
+        events.append((t + t_err, v_impact, out))
+        if v_reb <= 0.0:
+            return events, "e<=0"
         if v_reb < v_min:
-            stop = "v_min"
-            break
+            return events, "v_min"
         v_up, h = v_reb, 0.0
+    return events, "max_bounces"
+
+
+def bounce(rebound, drop_height: float, gravity: float = STANDARD_GRAVITY, v_min: float = 0.1,
+           max_bounces: int = 100_000) -> Bounces:
+    """Drop a ball from ``drop_height`` [m] and bounce it until it rests (see module doc).
+
+    ``rebound(v_approach) -> dict`` gives e, e_ep, e_ze, lam, tau0, t_contact, v_rebound
+    for an impact at speed v [m/s]; :func:`fmu_rebound` and :func:`package_rebound` make one.
+    """
+    events, stop = impact_sequence(rebound, drop_height, gravity, v_min, max_bounces,
+                                   getattr(rebound, "advance", None))
+    rows = []
+    for t, v_impact, out in events:
+        v_reb = out["v_rebound"]
+        apex = v_reb * v_reb / (2.0 * gravity) if v_reb > 0.0 else 0.0
+        rows.append((t, v_impact, out["e"], out["e_ep"], out["e_ze"], out["lam"], out["tau0"],
+                     out["t_contact"], v_reb, apex))
     cols = np.array(rows, dtype=float).T
     return Bounces(time=cols[0], v_approach=cols[1], e=cols[2], e_ep=cols[3], e_ze=cols[4], lam=cols[5],
                    tau0=cols[6], t_contact=cols[7], v_rebound=cols[8], apex=cols[9], rest_time=float(cols[0][-1]),

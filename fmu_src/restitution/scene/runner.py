@@ -39,6 +39,7 @@ from ..jgm import (critical_interference, critical_load, critical_pressure, crit
                    effective_modulus, sphere_mass)
 from ..model import EFFECT_MODES, RESTITUTION_MODELS, ZENER_SLOPE_BOUND
 from ..zener import ZENER_METHODS, inelasticity_parameter
+from ..cosim.bouncing import impact_sequence
 from .loader import Drop, Scene
 
 __all__ = ["DropResult", "SceneResult", "run_scene", "ensure_fmu", "open_instance", "COLUMNS",
@@ -346,35 +347,26 @@ def _run_drop(instance, scene: Scene, drop: Drop, params: dict, read_names, read
     slave.exitInitializationMode()
 
     vr_in = [instance.vr("v_approach")]
-    vr_real = [instance.vr(n) for n in ("v_rebound", *read_names)]
+    real_names = ("v_rebound", *read_names)
+    vr_real = [instance.vr(n) for n in real_names]
     vr_bool = [instance.vr("effects.plasticity"), instance.vr("effects.plate_waves")]
     get_real, get_bool, set_real, do_step = slave.getReal, slave.getBoolean, slave.setReal, slave.doStep
 
-    times, speeds, rows, flags = [], [], [], []
-    t, v_up, h = 0.0, 0.0, drop.drop_height
-    stop = "max_bounces"
-    for _ in range(sim.max_bounces):
-        v_impact = math.sqrt(v_up * v_up + 2.0 * g * h)
-        flight = (v_up + v_impact) / g
-        do_step(t, flight)  # carries the FMU across the flight; no evaluation (inputs unchanged)
-        t += flight
-        set_real(vr_in, [v_impact])
-        values = get_real(vr_real)
-        flags.append(get_bool(vr_bool))
-        times.append(t)
-        speeds.append(v_impact)
-        rows.append(values)
-        v_reb = values[0]
-        if not all(math.isfinite(x) for x in values):
-            raise RuntimeError(f"{drop.label}: the FMU returned NaN at impact {len(rows)} "
-                               f"(v_approach = {v_impact!r} m/s); FMU log: {instance.last_message()}")
-        if v_reb <= 0.0:  # e <= 0: the ball stays with the plate
-            stop = "e<=0"
-            break
-        if v_reb < v_min:
-            stop = "v_min"
-            break
-        v_up, h = v_reb, 0.0
+    def rebound(v):  # only the requested outputs, and the effects used
+        set_real(vr_in, [v])
+        out = dict(zip(real_names, get_real(vr_real)))  # floats: checked for NaN by impact_sequence
+        out["flags"] = get_bool(vr_bool)
+        return out
+
+    try:
+        events, stop = impact_sequence(rebound, drop.drop_height, g, v_min, sim.max_bounces,
+                                       advance=do_step)  # flights need no evaluation (inputs unchanged)
+    except ValueError as exc:
+        raise RuntimeError(f"{drop.label}: {exc}; FMU log: {instance.last_message()}") from exc
+    times = [t for t, _, _ in events]
+    speeds = [v for _, v, _ in events]
+    rows = [[out[n] for n in real_names] for _, _, out in events]
+    flags = [out["flags"] for _, _, out in events]
     data = np.array(rows, dtype=float).reshape(len(rows), 1 + len(read_names))
     flags = np.array(flags, dtype=bool).reshape(len(rows), 2)
     v_reb = data[:, 0]
