@@ -555,7 +555,13 @@ __attribute__((destructor)) static void shim_unload(void)
  * shared_ptr (pointer and control block, two words), after which both the destructor and
  * onLibraryUnload do nothing; the PyState is left to the process exit (the interpreter is
  * never finalized anyway). make_standalone.py finds the symbol's offset in the binary's
- * symbol table at build time; the binary's size guards against a different binary. */
+ * symbol table at build time; the binary's size guards against a different binary.
+ * atexit() from a shared library is tied to that library: glibc runs the handler when the
+ * library is dlclosed (fmpy's freeInstance does), not at exit. It then emptied pyState at
+ * every unload, leaking the PyState and its finished but never joined std::thread (an 8 MB
+ * stack mapping per load/free cycle), and the next instance made a new one. So the shim
+ * pins itself (RTLD_NODELETE) before registering the handler: it stays loaded like the
+ * pythonfmu binary, the handler runs once at process exit, and a reload reuses the state. */
 #if defined(SHIM_PYSTATE_OFFSET) && defined(SHIM_REAL_SIZE)
 static void *g_pystate_slot = NULL;
 
@@ -572,6 +578,9 @@ static void arm_pystate_exit_fix(const char *real_path)
     if (stat(real_path, &st) != 0 || st.st_size != (off_t)SHIM_REAL_SIZE) return;
     if (dlinfo(g_real, RTLD_DI_LINKMAP, &map) != 0 || !map) return;
     g_pystate_slot = (void *)(map->l_addr + (uintptr_t)SHIM_PYSTATE_OFFSET);
+    Dl_info self;
+    if (dladdr((void *)&disarm_pythonfmu_pystate, &self) && self.dli_fname)
+        dlopen(self.dli_fname, RTLD_LAZY | RTLD_NOLOAD | RTLD_NODELETE); /* never unloaded from now on */
     atexit(disarm_pythonfmu_pystate);
 }
 #else
