@@ -294,7 +294,14 @@ def toy_fmu(tmp_path_factory):
     script.write_text(textwrap.dedent(TOY_SOURCE))
     subprocess.run([sys.executable, "-m", "pythonfmu", "build", "-f", str(script), "-d", str(work)],
                    check=True, cwd=work, capture_output=True)
-    return work / "RobustnessToyGainCounter.fmu"
+    fmu = work / "RobustnessToyGainCounter.fmu"
+    # A plain pythonfmu 0.7 binary frees its static PyState twice at process exit, which can
+    # abort the whole test process after the last test; the project's loader (the shim every
+    # project FMU carries) neutralises that, so the toy gets it too.
+    from native_host.make_standalone import make_standalone  # build_scripts/ is on sys.path (conftest)
+
+    make_standalone(fmu)
+    return fmu
 
 
 def test_runs_next_to_a_different_pythonfmu_fmu(impact_fmu, unzipped, toy_fmu):

@@ -27,7 +27,6 @@ from __future__ import annotations
 
 import csv
 import math
-import subprocess
 import sys
 import time
 from dataclasses import dataclass, field
@@ -54,27 +53,9 @@ READ_OUTPUTS = {
 #: column -> CSV header
 COLUMNS = {"apex": "apex_m", "e": "e", "e_ep": "e_ep", "e_ze": "e_ze", "t_contact": "t_contact_s"}
 
-_FMU_NAME = "SpherePlateImpact.fmu"
 
 
 # --- the FMU ---------------------------------------------------------------------------------
-
-def _repo_root() -> Path | None:
-    for parent in Path(__file__).resolve().parents:
-        if (parent / "build_scripts" / "build_fmu.py").is_file():
-            return parent
-    return None
-
-
-def _sources(root: Path):
-    """Files the FMU is built from (host-only subpackages excluded)."""
-    yield root / "fmu_src" / "sphere_plate_impact_slave.py"
-    pkg = root / "fmu_src" / "restitution"
-    for path in pkg.rglob("*"):
-        rel = path.relative_to(pkg).parts
-        if path.is_file() and rel[0] not in ("cosim", "scene", "__pycache__") and path.suffix in (".py", ".npz"):
-            yield path
-
 
 def ensure_fmu(fmu=None, rebuild: bool = False, log=None) -> Path:
     """Path of the FMU to run: ``fmu`` as given, else dist/SpherePlateImpact.fmu of the source
@@ -85,20 +66,9 @@ def ensure_fmu(fmu=None, rebuild: bool = False, log=None) -> Path:
         if not path.is_file():
             raise FileNotFoundError(f"FMU {path} not found")
         return path
-    root = _repo_root()
-    if root is None:
-        raise FileNotFoundError("no FMU given and build_scripts/build_fmu.py not found: pass --fmu PATH")
-    path = root / "dist" / _FMU_NAME
-    stale = not path.is_file() or rebuild
-    if not stale:
-        built = path.stat().st_mtime
-        stale = any(src.stat().st_mtime > built for src in _sources(root))
-    if stale:
-        if log is not None:
-            log(f"building {path} ...")
-        subprocess.run([sys.executable, str(root / "build_scripts" / "build_fmu.py"), "--out", str(path.parent)],
-                       check=True, stdout=subprocess.DEVNULL)
-    return path
+    from ..cosim.fmu import build_default_fmu
+
+    return build_default_fmu(rebuild=rebuild, log=log)
 
 
 def open_instance(fmu_path):
