@@ -410,6 +410,7 @@ FLOOR_FAST_ACCESSORS = '''
 def build_fmus(work: Path) -> dict:
     """Build SpherePlateImpact, BouncingBall and the two trivial FMUs from the working tree."""
     from build_fmu import FMUS, build_one
+    from native_host.make_standalone import make_standalone
     from pythonfmu.builder import FmuBuilder
     import sphere_plate_impact_slave as spi
 
@@ -426,6 +427,10 @@ def build_fmus(work: Path) -> dict:
         script = src / f"bench_{name.lower()}.py"
         script.write_text(FLOOR_SCRIPT.format(counts=counts, name=name, extra=extra))
         out[name] = Path(FmuBuilder.build_FMU(script, dest=work))
+        # The same native loader as the project's FMUs: a like-for-like floor (the shim's
+        # forwarding is part of every call), and the fix for pythonfmu 0.7's exit double-free,
+        # which a plain pythonfmu binary would bring into this process.
+        make_standalone(out[name])
     out["counts"] = counts
     return out
 
@@ -807,7 +812,8 @@ def markdown(res: dict, cfg_name: str, elapsed: float) -> str:
     g = fmu["get_e_only"]
     lines += [
         f"The trivial FMU has the same {n_vars} variables as SpherePlateImpact (same types and causalities) "
-        "and does nothing: its round trip is what pythonfmu and fmpy cost. The SpherePlateImpact slave reads "
+        "and does nothing, and carries the same native loader (build_scripts/native_host): its round trip is "
+        "what pythonfmu, the loader and fmpy cost. The SpherePlateImpact slave reads "
         "its cached outputs in one pass per `fmi2GetReal`/`fmi2GetBoolean` call instead of pythonfmu's "
         "getter per variable; the row *trivial FMU, one-pass getters* is the floor with that same change, "
         "so the gap between it and `exact` is the model and the adapter. Reading `e` alone instead of every "
