@@ -189,22 +189,19 @@ class SpherePlateImpact(Fmi2Slave):
     # values are those of the getters: NaN (Real) or False (Boolean) while the outputs are invalid.
     # Requests that include inputs or parameters take pythonfmu's path, with its checks.
     def get_real(self, vrs):
-        keys = self._output_keys["Real"]
-        try:
-            names = [keys[vr] for vr in vrs]
-        except KeyError:
-            return super().get_real(vrs)
-        outputs = self._evaluate()
-        return [outputs[k] for k in names] if outputs is not None else [math.nan] * len(names)
+        return self._get_outputs("Real", vrs, math.nan, super().get_real)
 
     def get_boolean(self, vrs):
-        keys = self._output_keys["Boolean"]
+        return self._get_outputs("Boolean", vrs, False, super().get_boolean)
+
+    def _get_outputs(self, vtype, vrs, invalid_value, general_get):
+        keys = self._output_keys[vtype]
         try:
             names = [keys[vr] for vr in vrs]
         except KeyError:
-            return super().get_boolean(vrs)
+            return general_get(vrs)
         outputs = self._evaluate()
-        return [outputs[k] for k in names] if outputs is not None else [False] * len(names)
+        return [outputs[k] for k in names] if outputs is not None else [invalid_value] * len(names)
 
     # --- evaluation --------------------------------------------------------------------
     def _evaluate(self):
