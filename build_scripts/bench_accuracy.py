@@ -409,10 +409,11 @@ FLOOR_FAST_ACCESSORS = '''
 
 def build_fmus(work: Path) -> dict:
     """Build SpherePlateImpact, BouncingBall and the two trivial FMUs from the working tree."""
-    from build_fmu import FMUS, build_one
-    from native_host.make_standalone import make_standalone
     from pythonfmu.builder import FmuBuilder
-    import sphere_plate_impact_slave as spi
+    from restitution.fmu.build import FMUS, _slave_module, build_one
+    from restitution.fmu.native_host.make_standalone import make_standalone
+
+    spi = _slave_module("SpherePlateImpact")
 
     out = {"SpherePlateImpact": build_one("SpherePlateImpact", work)}
     if "BouncingBall" in FMUS:

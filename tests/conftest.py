@@ -6,11 +6,13 @@ import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "build_scripts"))
+# the slave modules (sphere_plate_impact_slave, ...) import by name, as the FMUs do
+sys.path.insert(0, str(ROOT / "fmu_src" / "restitution" / "fmu" / "slaves"))
 
 
 @pytest.fixture(scope="session")
 def impact_fmu(tmp_path_factory) -> Path:
     """SpherePlateImpact.fmu built from the current sources (and validated) into a temp dir."""
-    from build_fmu import build_one
+    from restitution.fmu.build import build_one
 
     return build_one("SpherePlateImpact", tmp_path_factory.mktemp("fmu"))

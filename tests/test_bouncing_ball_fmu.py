@@ -14,7 +14,7 @@ G = 9.80665
 
 @pytest.fixture(scope="module")
 def ball_fmu(tmp_path_factory):
-    from build_fmu import build_one
+    from restitution.fmu.build import build_one
 
     return build_one("BouncingBall", tmp_path_factory.mktemp("ball"))
 

@@ -1,4 +1,4 @@
-"""A pythonfmu FMU post-processed by build_scripts/native_host/make_standalone.py
+"""A pythonfmu FMU post-processed by restitution/fmu/native_host/make_standalone.py
 must run in a plain C FMI host (no LD_PRELOAD, no PYTHONPATH/PYTHONHOME, no
 venv, PATH=/usr/bin:/bin), must keep running in Python hosts (fmpy), and must
 fail cleanly (log message + NULL instance) when its interpreter is missing.
@@ -19,7 +19,7 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 HOST_SOURCE = ROOT / "tests" / "c_host" / "fmi2_host.c"
-MAKE_STANDALONE = ROOT / "build_scripts" / "native_host" / "make_standalone.py"
+MAKE_STANDALONE = ROOT / "fmu_src" / "restitution" / "fmu" / "native_host" / "make_standalone.py"
 
 pytestmark = [
     pytest.mark.skipif(not sys.platform.startswith("linux"), reason="Linux-only (linux64 shim)"),

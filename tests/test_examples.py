@@ -32,7 +32,7 @@ def _load(name):
 @pytest.fixture(scope="module")
 def fmu_dir(impact_fmu, tmp_path_factory) -> Path:
     """BouncingBall.fmu built from the working tree, next to the session's SpherePlateImpact.fmu."""
-    from build_fmu import build_one
+    from restitution.fmu.build import build_one
 
     out = tmp_path_factory.mktemp("fmus")
     shutil.copy(impact_fmu, out / "SpherePlateImpact.fmu")

@@ -95,10 +95,6 @@ def test_array_path_outputs_are_fresh_and_do_not_alias_inputs():
 
 def test_slave_one_pass_getters_return_what_the_per_variable_getters_return():
     """SpherePlateImpact.get_real/get_boolean (one evaluation, one pass) against pythonfmu's getters."""
-    import sys
-    from pathlib import Path
-
-    sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "fmu_src"))
     from pythonfmu import Boolean, Real
     from sphere_plate_impact_slave import SpherePlateImpact
 

@@ -298,7 +298,7 @@ def toy_fmu(tmp_path_factory):
     # A plain pythonfmu 0.7 binary frees its static PyState twice at process exit, which can
     # abort the whole test process after the last test; the project's loader (the shim every
     # project FMU carries) neutralises that, so the toy gets it too.
-    from native_host.make_standalone import make_standalone  # build_scripts/ is on sys.path (conftest)
+    from restitution.fmu.native_host.make_standalone import make_standalone
 
     make_standalone(fmu)
     return fmu

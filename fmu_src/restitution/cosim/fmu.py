@@ -3,8 +3,6 @@ from __future__ import annotations
 
 import shutil
 import weakref
-import subprocess
-import sys
 from pathlib import Path
 
 __all__ = ["FmuInstance", "FmiStatusError", "build_default_fmu", "impact_fmu_parameters"]
@@ -18,49 +16,12 @@ class FmiStatusError(RuntimeError):
         self.status = status
 
 
-def _repo_root() -> Path | None:
-    here = Path(__file__).resolve()
-    for parent in here.parents:
-        if (parent / "build_scripts" / "build_fmu.py").is_file():
-            return parent
-    return None
-
-
-def fmu_sources(root: Path):
-    """Files the FMUs are built from: the slaves, the bundled package modules and data, the build
-    script and the native-host loader (host-only subpackages such as cosim/ are not bundled)."""
-    yield root / "build_scripts" / "build_fmu.py"
-    yield from (root / "build_scripts" / "native_host").glob("*.[cp]*")
-    yield from (root / "fmu_src").glob("*_slave.py")
-    package = root / "fmu_src" / "restitution"
-    yield from package.glob("*.py")
-    yield from (package / "data").glob("*")
-
-
 def build_default_fmu(out_dir: str | Path | None = None, model: str = "SpherePlateImpact",
                       rebuild: bool = False, log=None) -> Path:
-    """Path of ``<model>.fmu`` (default SpherePlateImpact) in ``out_dir`` (default dist/).
+    """Path of ``<model>.fmu``, built when missing or stale: :func:`restitution.fmu.default_fmu`."""
+    from ..fmu.build import default_fmu
 
-    The FMUs are (re)built with build_scripts/build_fmu.py when missing, older than any of
-    their sources (a stale build would run old code, or an old loader) or when ``rebuild``.
-    Only works from a source checkout (the build script is not installed with the package).
-    ``log(message)`` is told when a build starts.
-    """
-    root = _repo_root()
-    if root is None:
-        raise FileNotFoundError("build_scripts/build_fmu.py not found: build the FMU from a source checkout")
-    out = Path(out_dir) if out_dir is not None else root / "dist"
-    fmu = out / f"{model}.fmu"
-    stale = rebuild or not fmu.is_file()
-    if not stale:
-        built = fmu.stat().st_mtime
-        stale = any(src.stat().st_mtime > built for src in fmu_sources(root))
-    if stale:
-        if log is not None:
-            log(f"building {fmu} ...")
-        subprocess.run([sys.executable, str(root / "build_scripts" / "build_fmu.py"), "--out", str(out)],
-                       check=True, stdout=subprocess.DEVNULL if log is not None else None)
-    return fmu
+    return default_fmu(out_dir, model=model, rebuild=rebuild, log=log)
 
 
 def impact_fmu_parameters(sphere, plate) -> dict:

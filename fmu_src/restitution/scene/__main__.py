@@ -12,6 +12,7 @@ import argparse
 import sys
 from pathlib import Path
 
+from ..fmu.build import BuildError
 from .loader import SceneError, load_scene
 
 
@@ -92,7 +93,7 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     try:
         return args.func(args)
-    except SceneError as exc:
+    except (SceneError, BuildError) as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
 

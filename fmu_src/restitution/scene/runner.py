@@ -58,9 +58,9 @@ COLUMNS = {"apex": "apex_m", "e": "e", "e_ep": "e_ep", "e_ze": "e_ze", "t_contac
 # --- the FMU ---------------------------------------------------------------------------------
 
 def ensure_fmu(fmu=None, rebuild: bool = False, log=None) -> Path:
-    """Path of the FMU to run: ``fmu`` as given, else dist/SpherePlateImpact.fmu of the source
-    checkout, (re)built with build_scripts/build_fmu.py when missing, older than any of its
-    sources, or when ``rebuild`` is true."""
+    """Path of the FMU to run: ``fmu`` as given, else the default SpherePlateImpact.fmu
+    (dist/ of a source checkout, a per-user cache otherwise), (re)built when missing, built from
+    other sources, or when ``rebuild`` is true (:func:`restitution.fmu.default_fmu`)."""
     if fmu is not None:
         path = Path(fmu)
         if not path.is_file():

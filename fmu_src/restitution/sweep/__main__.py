@@ -119,6 +119,12 @@ def main(argv=None) -> int:
     chunk = args.chunk_size or run.get("chunk_size")
     fmu = args.fmu or run.get("fmu")
     out = args.out or run.get("out")
+    if backend in ("fmu", "both") and fmu is None and not args.dry_run:
+        from ..fmu.build import BuildError, default_fmu
+        try:
+            fmu = default_fmu(log=print)
+        except BuildError as exc:
+            parser.error(str(exc))
     if out is None:
         try:
             import pyarrow  # noqa: F401

@@ -1,0 +1,32 @@
+"""Command line: ``python -m restitution.fmu build [--out DIR] [--python-hosts-only]``."""
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from .build import FMUS, BuildError, build_all, default_fmu_dir
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(prog="restitution-fmu",
+                                     description="Build and validate the project's FMUs.")
+    commands = parser.add_subparsers(dest="command", required=True)
+    build = commands.add_parser("build", help=f"build {', '.join(f'{m}.fmu' for m in FMUS)}")
+    build.add_argument("--out", type=Path, default=None,
+                       help=f"output directory (default: {default_fmu_dir()})")
+    build.add_argument("--python-hosts-only", action="store_true",
+                       help="skip the plain-C-host loader (the FMUs then need a Python host)")
+    args = parser.parse_args(argv)
+    out = args.out if args.out is not None else default_fmu_dir()
+    try:
+        for fmu in build_all(out, standalone=not args.python_hosts_only):
+            print(f"built {fmu} (fmpy validation: 0 problems)")
+    except BuildError as exc:
+        print(f"restitution-fmu: error: {exc}", file=sys.stderr)
+        return 2
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

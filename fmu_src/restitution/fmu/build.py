@@ -1,0 +1,307 @@
+"""Build the project's FMUs with pythonfmu, complete their modelDescription.xml and validate them.
+
+    python -m restitution.fmu build [--out DIR]      (or: restitution-fmu build, build_scripts/build_fmu.py)
+
+builds DIR/SpherePlateImpact.fmu and DIR/BouncingBall.fmu, bundling the physics modules of
+the installed ``restitution`` package (the same source ``pip install`` installs), then:
+
+* rewrites modelDescription.xml with what pythonfmu cannot write (FMI-NOTES.md): units
+  and UnitDefinitions, descriptions, min/max, and a ModelStructure that declares each
+  output's direct dependence on the input (direct feedthrough) and the InitialUnknowns;
+  value references, names and types are left as pythonfmu wrote them, since the binary
+  never reads the XML;
+* records a hash of the sources it was built from (``resources/build_info.json``), which
+  :func:`default_fmu` compares to decide whether an FMU is stale;
+* makes the Linux binary loadable by plain C hosts (``native_host.make_standalone``; needs gcc,
+  without it the FMU is built for Python hosts only and the build says so);
+* checks the result with fmpy's validation.
+
+Everything is built in a temporary directory beside the output and moved into place
+(``os.replace``) only after validation, so a failed build leaves the previous FMU untouched.
+"""
+from __future__ import annotations
+
+import hashlib
+import importlib
+import json
+import os
+import shutil
+import sys
+import tempfile
+import zipfile
+from pathlib import Path
+from xml.etree import ElementTree as ET
+
+HERE = Path(__file__).resolve().parent
+PACKAGE = HERE.parent  # the restitution package the FMUs bundle
+SLAVES = HERE / "slaves"
+
+#: FMU model identifier -> pythonfmu slave script (shipped with the package).
+FMUS = {"SpherePlateImpact": SLAVES / "sphere_plate_impact_slave.py",
+        "BouncingBall": SLAVES / "bouncing_ball_slave.py"}
+
+#: Where the build records what it was built from, inside the FMU.
+BUILD_INFO = "resources/build_info.json"
+
+
+class BuildError(RuntimeError):
+    """The FMU cannot be built here (a one-line reason for the user: no pythonfmu, unwritable --out, ...)."""
+
+
+#: SI base-unit exponents of every unit the FMUs use.
+UNITS = {
+    "1": {},
+    "m": {"m": 1},
+    "s": {"s": 1},
+    "kg": {"kg": 1},
+    "m/s": {"m": 1, "s": -1},
+    "m/s2": {"m": 1, "s": -2},
+    "Pa": {"kg": 1, "m": -1, "s": -2},
+    "kg/m3": {"kg": 1, "m": -3},
+}
+
+PARAMETER_CAUSALITIES = ("parameter", "input")
+
+
+def complete_model_description(xml_text: str, variables, allowed_range, feedthrough=None) -> str:
+    """modelDescription.xml with units, descriptions, limits and a full ModelStructure.
+
+    ``variables`` is the slave's table: (name, type, causality, unit, start, description, key);
+    ``allowed_range(name)`` gives (check, text, min, max) for inputs and parameters;
+    ``feedthrough``: names of the outputs that depend directly on the inputs (default: all
+    but V_c, as in SpherePlateImpact).
+    """
+    spec = {row[0]: row for row in variables}
+    root = ET.fromstring(xml_text)
+    model_variables = root.find("ModelVariables")
+    scalar_variables = list(model_variables)
+    index = {sv.get("name"): i + 1 for i, sv in enumerate(scalar_variables)}
+
+    used_units = set()
+    for sv in scalar_variables:
+        name, vtype, causality, unit, _start, description, _key = spec[sv.get("name")]
+        sv.set("description", description)
+        type_node = sv[0]
+        if vtype == "Real" and unit is not None:
+            type_node.set("unit", unit)
+            used_units.add(unit)
+        if causality in PARAMETER_CAUSALITIES:
+            _check, _text, low, high = allowed_range(name)
+            if low is not None:
+                type_node.set("min", low)
+            if high is not None:
+                type_node.set("max", high)
+
+    unit_defs = ET.Element("UnitDefinitions")
+    for unit in sorted(used_units):
+        node = ET.SubElement(unit_defs, "Unit", name=unit)
+        if UNITS[unit]:
+            ET.SubElement(node, "BaseUnit", {k: str(v) for k, v in UNITS[unit].items()})
+    # FMI 2.0 element order: CoSimulation, UnitDefinitions, TypeDefinitions, LogCategories, ...
+    position = list(root).index(root.find("CoSimulation")) + 1
+    root.insert(position, unit_defs)
+
+    inputs = [index[row[0]] for row in variables if row[2] == "input"]
+    structure = root.find("ModelStructure")
+    for child in list(structure):
+        structure.remove(child)
+    outputs = ET.SubElement(structure, "Outputs")
+    initial = ET.SubElement(structure, "InitialUnknowns")
+    for row in variables:
+        if row[2] != "output":
+            continue
+        if feedthrough is None:
+            depends_on_input = row[6] not in ("V_c",)  # V_c depends on parameters only
+        else:
+            depends_on_input = row[0] in feedthrough
+        deps = " ".join(map(str, inputs)) if depends_on_input else ""
+        attrs = {"index": str(index[row[0]]), "dependencies": deps}
+        if deps:
+            attrs["dependenciesKind"] = " ".join("dependent" for _ in inputs)
+        ET.SubElement(outputs, "Unknown", attrs)
+        ET.SubElement(initial, "Unknown", {"index": str(index[row[0]])})
+    for element in root.iter():
+        if element.text is not None and not element.text.strip():
+            element.text = None
+        element.tail = None
+    ET.indent(root, "  ")
+    return '<?xml version="1.0" encoding="UTF-8"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
+
+
+def _rewrite_zip(fmu: Path, transform=None, member: str | None = None, extra: dict | None = None) -> None:
+    """Rewrite ``member`` of the zip at ``fmu`` through ``transform`` and add the ``extra`` files."""
+    tmp = fmu.with_suffix(".tmp")
+    with zipfile.ZipFile(fmu) as src, zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as dst:
+        for item in src.infolist():
+            if extra and item.filename in extra:
+                continue
+            data = src.read(item.filename)
+            if item.filename == member:
+                data = transform(data.decode("utf-8")).encode("utf-8")
+            dst.writestr(item, data)
+        for name, data in (extra or {}).items():
+            dst.writestr(name, data)
+    tmp.replace(fmu)
+
+
+#: Subfolders of the package the FMUs bundle; the others (cosim/, scene/, sweep/, fmu/, ...) are
+#: host-side helpers whose imports (fmpy, dask, matplotlib, ...) the slaves never need. Bundling
+#: them made the plain-C-host loader require those packages at start-up (python_env.txt require=).
+BUNDLED_SUBDIRS = {"data"}
+
+
+def _physics_only(directory, names):
+    """copytree filter: no caches, and only BUNDLED_SUBDIRS below the package root."""
+    ignored = set(shutil.ignore_patterns("__pycache__", "*.pyc", "*.egg-info")(directory, names))
+    if Path(directory).resolve() == PACKAGE.resolve():
+        ignored |= {n for n in names if (PACKAGE / n).is_dir() and n not in BUNDLED_SUBDIRS}
+    return ignored
+
+
+def source_files(model: str) -> list[Path]:
+    """Every file ``<model>.fmu`` is built from: the slave, the bundled physics modules and data,
+    this build module and the native-host loader."""
+    files = [FMUS[model], Path(__file__).resolve()]
+    files += sorted((HERE / "native_host").glob("*.[ch]")) + sorted((HERE / "native_host").glob("*.py"))
+    files += sorted(PACKAGE.glob("*.py"))
+    for sub in sorted(BUNDLED_SUBDIRS):
+        files += sorted(p for p in (PACKAGE / sub).rglob("*") if p.is_file() and "__pycache__" not in p.parts)
+    return files
+
+
+def source_hash(model: str) -> str:
+    """SHA-256 over the names and contents of :func:`source_files` (what makes an FMU stale)."""
+    digest = hashlib.sha256()
+    for path in source_files(model):
+        digest.update(path.relative_to(PACKAGE).as_posix().encode() + b"\0")
+        digest.update(path.read_bytes())
+        digest.update(b"\0")
+    return digest.hexdigest()
+
+
+def recorded_source_hash(fmu: Path) -> str | None:
+    """The source hash recorded in a built FMU, or None (not ours, older build, unreadable)."""
+    try:
+        with zipfile.ZipFile(fmu) as z:
+            return json.loads(z.read(BUILD_INFO)).get("source_hash")
+    except (OSError, KeyError, ValueError, zipfile.BadZipFile):
+        return None
+
+
+def _umask() -> int:
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
+def _writable_dir(out_dir: Path) -> Path:
+    out_dir = Path(out_dir)
+    if out_dir.exists() and not out_dir.is_dir():
+        raise BuildError(f"--out {out_dir}: exists and is not a directory")
+    try:
+        out_dir.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise BuildError(f"--out {out_dir}: cannot create the directory ({exc.strerror})") from None
+    if not os.access(out_dir, os.W_OK | os.X_OK):
+        raise BuildError(f"--out {out_dir}: directory is not writable")
+    return out_dir
+
+
+def _require_build_tools():
+    try:
+        from pythonfmu.builder import FmuBuilder
+        from fmpy.validation import validate_fmu
+    except ImportError as exc:
+        raise BuildError(f"building an FMU needs pythonfmu and fmpy ({exc.name} is missing): "
+                         "pip install 'restitution[fmu]'") from None
+    return FmuBuilder, validate_fmu
+
+
+def build_one(model: str, out_dir: Path, standalone: bool = True, log=None) -> Path:
+    """Build, complete and validate ``out_dir/<model>.fmu``; return its path.
+
+    The FMU is built and validated in a temporary directory inside ``out_dir`` and moved into
+    place only then, readable as the umask allows (0644 typically). ``log(message)`` receives
+    warnings (default: stderr).
+    """
+    if log is None:
+        def log(message):
+            print(message, file=sys.stderr)
+    FmuBuilder, validate_fmu = _require_build_tools()
+    script = FMUS[model]
+    out_dir = _writable_dir(out_dir)
+    with tempfile.TemporaryDirectory(prefix=f".{model}-build-", dir=out_dir) as tmp:
+        staged = Path(tmp) / "stage" / "restitution"
+        shutil.copytree(PACKAGE, staged, ignore=_physics_only)
+        fmu = Path(FmuBuilder.build_FMU(script, dest=tmp, project_files=[staged],
+                                        canGetAndSetFMUstate=True, canSerializeFMUstate=True))
+        slave_module = _slave_module(model)
+        info = json.dumps({"model": model, "source_hash": source_hash(model)}, indent=1)
+        _rewrite_zip(fmu, lambda xml: complete_model_description(
+            xml, slave_module.VARIABLES, slave_module.allowed_range, getattr(slave_module, "FEEDTHROUGH", None)),
+            member="modelDescription.xml", extra={BUILD_INFO: info})
+        if standalone and shutil.which("gcc") is None:
+            log(f"warning: gcc not found: {model}.fmu is built for Python hosts only (fmpy, libcosimpy); "
+                "install gcc for the plain-C-host loader")
+        elif standalone:
+            from .native_host.make_standalone import make_standalone
+            make_standalone(fmu)
+        problems = validate_fmu(str(fmu))
+        if problems:
+            raise BuildError(f"{model}.fmu failed fmpy validation: " + "; ".join(problems))
+        os.chmod(fmu, 0o666 & ~_umask())
+        target = out_dir / f"{model}.fmu"
+        os.replace(fmu, target)
+    return target
+
+
+def _slave_module(model: str):
+    """The slave module of ``model`` (its VARIABLES table, allowed_range, FEEDTHROUGH)."""
+    script = FMUS[model]
+    if str(script.parent) not in sys.path:
+        sys.path.insert(0, str(script.parent))
+    return importlib.import_module(script.stem)
+
+
+def build_all(out_dir: Path, standalone: bool = True, log=None) -> list[Path]:
+    """Build every FMU of the project into ``out_dir``."""
+    return [build_one(model, out_dir, standalone=standalone, log=log) for model in FMUS]
+
+
+def _checkout_dist() -> Path | None:
+    """dist/ of the source checkout this package runs from (editable install), else None."""
+    root = PACKAGE.parent.parent
+    if (root / "pyproject.toml").is_file() and (root / "fmu_src" / "restitution").resolve() == PACKAGE:
+        return root / "dist"
+    return None
+
+
+def default_fmu_dir() -> Path:
+    """Where :func:`default_fmu` keeps the FMUs: dist/ in a source checkout, else a per-user cache."""
+    dist = _checkout_dist()
+    if dist is not None:
+        return dist
+    cache = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache")
+    return cache / "restitution" / "fmus"
+
+
+def default_fmu(out_dir: str | Path | None = None, model: str = "SpherePlateImpact",
+                rebuild: bool = False, log=None) -> Path:
+    """Path of ``<model>.fmu`` (default SpherePlateImpact) in ``out_dir`` (default :func:`default_fmu_dir`).
+
+    The FMUs are (re)built when missing, built from other sources than the installed package's
+    (the source hash recorded in the FMU differs; a stale build would run old code), or when
+    ``rebuild``. ``log(message)`` is told when a build starts. Raises :class:`BuildError` with a
+    one-line reason naming ``--fmu PATH`` when no FMU can be built here.
+    """
+    out = Path(out_dir) if out_dir is not None else default_fmu_dir()
+    fmu = out / f"{model}.fmu"
+    if rebuild or recorded_source_hash(fmu) != source_hash(model):
+        if log is not None:
+            log(f"building {fmu} ...")
+        try:
+            build_all(out, log=log)
+        except BuildError as exc:
+            raise BuildError(f"no usable {fmu.name} at {out} and it cannot be built here ({exc}); "
+                             f"pass --fmu PATH to use an existing one") from None
+    return fmu
