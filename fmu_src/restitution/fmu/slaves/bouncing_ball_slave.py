@@ -41,6 +41,8 @@ import math
 from pythonfmu import Boolean, Fmi2Causality, Fmi2Slave, Fmi2Variability, Integer, Real
 from pythonfmu.enums import Fmi2Initial, Fmi2Status
 
+from restitution.validation import interval_check
+
 P, IN, OUT, LOCAL = "parameter", "input", "output", "local"
 
 #: A contact found within this time [s] after the end of a step still belongs to the step:
@@ -88,13 +90,22 @@ VARIABLES = (
 FEEDTHROUGH = ()
 
 
+def allowed_interval(name):
+    """(low, high, low_open, high_open) of an input or parameter (see the SpherePlateImpact slave)."""
+    if name == "contact_mode":
+        return 1, len(CONTACT_MODES), False, False
+    if name == "e":
+        return -1.0, 1.0, False, False
+    return 0.0, math.inf, True, True
+
+
 def allowed_range(name):
-    """(predicate, allowed-range text, xml min, xml max) of an input or parameter."""
+    """(predicate, allowed-range text, xml min, xml max) of an input or parameter, from :func:`allowed_interval`."""
     if name == "contact_mode":
         return (lambda v: 1 <= int(v) <= len(CONTACT_MODES)), "1 = wait or 2 = immediate", "1", "2"
     if name == "e":
-        return (lambda v: -1.0 <= v <= 1.0), "-1 <= e <= 1", "-1", "1"
-    return (lambda v: 0.0 < v < math.inf), "finite and > 0", "0", None
+        return interval_check(*allowed_interval(name), text="-1 <= e <= 1")
+    return interval_check(*allowed_interval(name))
 
 
 _INITIAL_STATE = {

@@ -28,6 +28,7 @@ if os.path.isdir(os.path.join(_HERE, "restitution")) and sys.path[0] != _HERE:
     sys.path.insert(0, _HERE)
 
 from restitution.model import EFFECT_MODES, RESTITUTION_MODELS, ZENER_METHODS, impact  # noqa: E402
+from restitution.validation import interval_check  # noqa: E402
 
 P, IN, OUT = "parameter", "input", "output"
 
@@ -90,24 +91,30 @@ _CHOICES = {
 _CODE_OFFSET = {"restitution_model": 1, "zener_method": 1, "plasticity": 0, "plate_waves": 0}
 
 
-def allowed_range(name):
-    """(predicate, allowed-range text, xml min, xml max) of an input or parameter.
-
-    The one place the interface's ranges live: the setters check values with it and
-    build_fmu.py writes the min/max attributes from it.
-    """
+def allowed_interval(name):
+    """(low, high, low_open, high_open) of an input or parameter: the one place the interface's
+    ranges live. The setters check values with it (:func:`allowed_range`), the build writes the
+    min/max attributes and the C guard's range table from it. An infinite bound is always open:
+    non-finite values are rejected."""
     if name in _CHOICES:
-        choices, text = _CHOICES[name]
         low = _CODE_OFFSET[name]
-        high = low + len(choices) - 1
-        return (lambda v: low <= int(v) <= high), text, str(low), str(high)
+        return low, low + len(_CHOICES[name][0]) - 1, False, False
     if name.endswith(".nu"):
-        return (lambda v: 0.0 <= v < 0.5), "0 <= value < 0.5", "0", "0.5"
+        return 0.0, 0.5, False, True
     if name in ("v_approach", "effect_tolerance"):
-        return (lambda v: 0.0 <= v < math.inf), "finite and >= 0", "0", None
+        return 0.0, math.inf, False, True
     if name == "zener.ode_tolerance":
-        return (lambda v: 1e-14 <= v <= 1e-2), "1e-14 <= value <= 1e-2", "1e-14", "1e-2"
-    return (lambda v: 0.0 < v < math.inf), "finite and > 0", "0", None
+        return 1e-14, 1e-2, False, False
+    return 0.0, math.inf, True, True
+
+
+def allowed_range(name):
+    """(predicate, allowed-range text, xml min, xml max) of an input or parameter, from :func:`allowed_interval`."""
+    if name in _CHOICES:
+        low, high, _, _ = allowed_interval(name)
+        return (lambda v: low <= int(v) <= high), _CHOICES[name][1], str(low), str(high)
+    text = "1e-14 <= value <= 1e-2" if name == "zener.ode_tolerance" else None
+    return interval_check(*allowed_interval(name), text=text)
 
 
 class SpherePlateImpact(Fmi2Slave):
