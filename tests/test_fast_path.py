@@ -1,5 +1,6 @@
-"""The scalar fast path of restitution.impact (Python floats) gives the same bits as the
-general path (numpy scalars), for every option: it is an optimisation, not a second model."""
+"""One impact in scalars: Python floats, ints and numpy scalars all take the one pipeline's
+scalar mode (converted to float first), so they give the same values and plain Python types;
+arrays take its array mode, equal within the conditioning (tests/agree.py)."""
 import math
 
 import numpy as np
@@ -7,6 +8,8 @@ import pytest
 
 import restitution as r
 from restitution.model import ImpactResult, impact
+
+from agree import assert_agree, stack
 
 FLAGS = {"plasticity_used", "plate_waves_used", "lambda_in_range", "vstar_in_range", "e_negative", "valid"}
 
@@ -29,7 +32,7 @@ def _cases(n, seed=5):
 
 
 @pytest.mark.parametrize("validate", [True, False])
-def test_float_fast_path_matches_general_path_bit_for_bit(validate):
+def test_numpy_scalars_give_what_python_floats_give(validate):
     n_compared = 0
     for args, options in _cases(600):
         fast = impact(*[float(x) for x in args], **options, validate=validate)
@@ -44,13 +47,8 @@ def test_float_fast_path_matches_general_path_bit_for_bit(validate):
     assert n_compared == 600
 
 
-def test_python_ints_take_the_fast_path_with_the_same_bits(monkeypatch):
-    """Unvalidated Python ints (the presets' densities are ints) give what their float values give."""
-    from restitution import model
-
-    calls = []
-    fast = model._impact_scalar
-    monkeypatch.setattr(model, "_impact_scalar", lambda *a: calls.append(1) or fast(*a))
+def test_python_ints_give_what_their_float_values_give():
+    """Unvalidated Python ints (the presets' densities are ints) are converted exactly below 2^53."""
     for k, (args, options) in enumerate(_cases(200, seed=9)):
         assert isinstance(args[4], int) and isinstance(args[9], int)
         mixed = list(args)  # densities stay ints; some speeds and thicknesses become ints too
@@ -58,11 +56,10 @@ def test_python_ints_take_the_fast_path_with_the_same_bits(monkeypatch):
             mixed[0] = int(round(args[0]))
         mixed[3] = int(args[3]) if float(args[3]).is_integer() else args[3]
         got = impact(*mixed, **options, validate=False).as_dict()
-        want = impact(*[np.float64(x) for x in mixed], **options, validate=False).as_dict()
+        want = impact(*[float(x) for x in mixed], **options, validate=False).as_dict()
         for name, value in got.items():
             assert type(value) is (bool if name in FLAGS else float), name
             assert value == want[name] or (math.isnan(value) and math.isnan(want[name])), (name, mixed, options)
-    assert len(calls) == 200  # every int call took the fast path (np.float64 calls do not)
 
 
 def test_fast_result_behaves_like_a_dataclass_instance():
@@ -86,45 +83,8 @@ def test_array_path_outputs_are_fresh_and_do_not_alias_inputs():
     for i, a in enumerate(arrays):
         for b in arrays[i + 1:]:
             assert not np.shares_memory(a, b)
-    for k in range(7):  # elementwise equal to the scalar call (to rounding: numpy vs math)
-        one = impact(float(v[k]), 207e9, 0.3, 2e9, 7861.0, 6.35e-3, 69e9, 0.33, 0.29e9, 2700.0, 6.35e-3)
-        for name, value in one.as_dict().items():
-            assert getattr(res, name)[k] == pytest.approx(value, rel=1e-13, abs=0.0) or \
-                getattr(res, name)[k] == value, name
-
-
-def test_slave_one_pass_getters_return_what_the_per_variable_getters_return():
-    """SpherePlateImpact.get_real/get_boolean (one evaluation, one pass) against pythonfmu's getters."""
-    from pythonfmu import Boolean, Real
-    from sphere_plate_impact_slave import SpherePlateImpact
-
-    slave = SpherePlateImpact(instance_name="t", visible=False)
-    real_out = [v.value_reference for v in slave.vars.values() if isinstance(v, Real) and v.causality.name == "output"]
-    bool_out = [v.value_reference for v in slave.vars.values()
-                if isinstance(v, Boolean) and v.causality.name == "output"]
-    vr = {v.name: v.value_reference for v in slave.vars.values()}
-
-    def same(got, vrs, cast):
-        want = [cast(slave.vars[k].getter()) for k in vrs]
-        assert len(got) == len(want) and all(a == b or (a != a and b != b) for a, b in zip(got, want))
-
-    for step in range(5):
-        if step == 1:
-            slave.set_real([vr["v_approach"]], [2.3])  # stale: get_real evaluates first
-        if step == 2:
-            slave.set_real([vr["plate.nu"]], [0.5])  # invalid: NaN / False
-        if step == 3:
-            slave.set_real([vr["plate.nu"]], [0.33])
-            slave.set_integer([vr["zener_method"]], [2])
-        if step == 4:
-            slave.reset()
-        got_r, got_b = slave.get_real(real_out), slave.get_boolean(bool_out)
-        same(got_r, real_out, float)
-        same(got_b, bool_out, bool)
-        if step == 2:
-            assert all(x != x for x in got_r) and not any(got_b)
-        else:
-            assert all(x == x for x in got_r)
-    # inputs and parameters mixed in: pythonfmu's path
-    assert slave.get_real([vr["v_approach"], real_out[0]]) == [slave.vars[vr["v_approach"]].getter(),
-                                                              slave.get_real(real_out[:1])[0]]
+    ones = stack([impact(float(v[k]), 207e9, 0.3, 2e9, 7861.0, 6.35e-3, 69e9, 0.33, 0.29e9, 2700.0, 6.35e-3)
+                  for k in range(7)])
+    params = dict(sphere_E=207e9, sphere_nu=0.3, sphere_Sy=2e9, sphere_rho=7861.0, sphere_d=6.35e-3,
+                  plate_E=69e9, plate_nu=0.33, plate_Sy=0.29e9, plate_rho=2700.0, plate_t=t)
+    assert_agree(res, ones, v, params, "array vs scalar")

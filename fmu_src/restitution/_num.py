@@ -11,7 +11,7 @@ import math
 
 import numpy as np
 
-__all__ = ["is_scalar", "exp", "log", "sqrt", "where", "minimum", "maximum", "as_output"]
+__all__ = ["is_scalar", "exp", "expm1", "log", "sqrt", "where", "minimum", "maximum", "as_output"]
 
 
 def is_scalar(x) -> bool:
@@ -32,6 +32,14 @@ def exp(x):
         return math.exp(x) if x >= _EXP_MIN_ARG else 0.0
     x = np.asarray(x, dtype=float)
     return np.where(x < _EXP_MIN_ARG, 0.0, np.exp(np.maximum(x, _EXP_MIN_ARG)))
+
+
+def expm1(x):
+    """exp(x) - 1 without cancellation for small |x|; -1 (no underflow flag) for x < -708."""
+    if x.__class__ is float or is_scalar(x):
+        return math.expm1(x) if x >= _EXP_MIN_ARG else -1.0
+    x = np.asarray(x, dtype=float)
+    return np.where(x < _EXP_MIN_ARG, -1.0, np.expm1(np.maximum(x, _EXP_MIN_ARG)))
 
 
 def log(x):

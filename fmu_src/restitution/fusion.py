@@ -1,5 +1,11 @@
 """Fusion of the JGM and Zener effects through an equivalent plate mass,
-I. Green, Nonlinear Dyn (2022), Eqs. (15)-(20)."""
+I. Green, Nonlinear Dyn (2022), Eqs. (15)-(20).
+
+Zener's COR enters through its deficit d = 1 - e_ze wherever 1 - e_ze appears: a plate that
+barely takes energy has e_ze within a few ulps of 1, where 1 - e_ze computed by subtraction
+keeps only the last bits of e_ze (relative condition number ~ 1/d). The callers pass d as each
+Zener method computes it without cancellation (:func:`restitution.zener.zener_solution`).
+"""
 from __future__ import annotations
 
 import math
@@ -12,27 +18,40 @@ __all__ = ["apparent_restitution", "equivalent_plate_mass", "velocities_after_im
 def apparent_restitution(e_ep, e_ze):
     """Apparent COR e = (e_ep + e_ze + e_ep e_ze - 1) / 2 [1], Eq. (20).
 
+    Evaluated as e = (e_ze (1 + e_ep) - (1 - e_ep)) / 2, the same quantity regrouped as the
+    difference of two non-negative terms: with e_ep = 1 (no plasticity) it is e_ze exactly,
+    and the sign of e (``e_negative``) is the comparison e_ze (1 + e_ep) < 1 - e_ep, decided the
+    same way on every code path. Its absolute error is a few ulps of 1 whatever the inputs (the
+    printed form sums four terms of mixed sign and can give -5.6e-17 where e = 0).
+
     e < 0 is a result, not an error: the sphere keeps moving with the plate after
     impact (possible for thin plates, where e_ze is small).
     """
-    return 0.5 * (e_ep + e_ze + e_ep * e_ze - 1.0)
+    return 0.5 * (e_ze * (1.0 + e_ep) - (1.0 - e_ep))
 
 
-def equivalent_plate_mass(m_a, e_ze):
-    """m_b = (1 + e_ze) m_a / (1 - e_ze) [kg], Eq. (19). +inf for e_ze = 1 (a half-space)."""
-    gap = 1.0 - e_ze
+def equivalent_plate_mass(m_a, e_ze, deficit=None):
+    """m_b = (1 + e_ze) m_a / (1 - e_ze) [kg], Eq. (19). +inf for e_ze = 1 (a half-space).
+
+    ``deficit``: 1 - e_ze [1] as the Zener method computed it. Relative condition number of
+    m_b in the deficit: 1 + d/(2 - d) <= 2; by subtraction, 1 - e_ze would bring in ~ 1/(1 - e_ze)
+    (1.3 % between two CPUs' last-bit exp at e_ze within an ulp of 1). Without ``deficit`` it is
+    1 - e_ze, exact only where e_ze is exact (a given value, not a computed one).
+    """
+    gap = 1.0 - e_ze if deficit is None else deficit
     positive = gap > 0.0
     return where(positive, (1.0 + e_ze) * m_a / where(positive, gap, 1.0), math.inf)
 
 
-def velocities_after_impact(v_a1, e_ep, e_ze):
+def velocities_after_impact(v_a1, e_ep, e_ze, deficit=None):
     """(v_a2, v_b2) [m/s], Eq. (17), positive in the direction of approach, plate at rest before.
 
-    With m_b from Eq. (19), m_a/(m_a + m_b) = (1 - e_ze)/2, so
-    v_a2 = -e v_a1 (e of Eq. 20) and v_b2 = (1 + e_ep)(1 - e_ze)/2 v_a1; this form
-    stays finite for the half-space (m_b = inf, v_b2 = 0).
+    With m_b from Eq. (19), m_a/(m_a + m_b) = (1 - e_ze)/2, so v_a2 = -e v_a1 (e of Eq. 20)
+    and v_b2 = (1 + e_ep)(1 - e_ze)/2 v_a1; this form stays finite for the half-space
+    (m_b = inf, v_b2 = 0). ``deficit``: 1 - e_ze as in :func:`equivalent_plate_mass` (v_b2 is
+    proportional to it, condition number 1 in d).
     """
-    share = 0.5 * (1.0 - e_ze)
-    v_a2 = (share - e_ep * (1.0 - share)) * v_a1
-    v_b2 = (1.0 + e_ep) * share * v_a1
+    gap = 1.0 - e_ze if deficit is None else deficit
+    v_a2 = -apparent_restitution(e_ep, e_ze) * v_a1
+    v_b2 = 0.5 * (1.0 + e_ep) * gap * v_a1
     return v_a2, v_b2

@@ -1,8 +1,8 @@
 """The whole model: apparent COR of a sphere hitting a plate of finite thickness,
 I. Green, Nonlinear Dyn (2022), JGM (Eqs. 1-8) and Zener (Eqs. 9-13a) fused by Eq. (20).
 
-:func:`impact` takes Python floats (one impact, fast path) or numpy arrays
-(broadcast together, one result per element).
+:func:`impact` takes Python floats (one impact) or numpy arrays (broadcast together, one
+result per element); one pipeline, :func:`_pipeline`, serves both.
 """
 from __future__ import annotations
 
@@ -20,7 +20,7 @@ from .jgm import (VSTAR_FIT_MAX, critical_interference, critical_load, critical_
 from .validation import check_choice, check_nonnegative, check_poisson, check_positive
 from .zener import (LAMBDA_STUDIED_MAX, TAU0_HERTZ, ZENER_METHODS, contact_duration,
                     hertz_stiffness, inelasticity_parameter, time_scale, zener_linear, zener_paper_fit,
-                    zener_restitution)
+                    zener_solution)
 
 __all__ = ["ImpactResult", "impact", "RESTITUTION_MODELS", "EFFECT_MODES", "ZENER_SLOPE_BOUND",
            "PARAMETERS", "validate_parameters"]
@@ -140,86 +140,76 @@ def impact(v, sphere_E, sphere_nu, sphere_Sy, sphere_rho, sphere_d,
             sphere_E=sphere_E, sphere_nu=sphere_nu, sphere_Sy=sphere_Sy, sphere_rho=sphere_rho,
             sphere_d=sphere_d, plate_E=plate_E, plate_nu=plate_nu, plate_Sy=plate_Sy,
             plate_rho=plate_rho, plate_t=plate_t).values()
-    if (v.__class__ is float and sphere_E.__class__ is float and sphere_nu.__class__ is float
-            and sphere_Sy.__class__ is float and sphere_rho.__class__ is float
-            and sphere_d.__class__ is float and plate_E.__class__ is float
-            and plate_nu.__class__ is float and plate_Sy.__class__ is float
-            and plate_rho.__class__ is float and plate_t.__class__ is float):
-        # One impact in Python floats (the FMU's case, and any validated scalar call).
-        return _impact_scalar(v, sphere_E, sphere_nu, sphere_Sy, sphere_rho, sphere_d, plate_E, plate_nu,
-                              plate_Sy, plate_rho, plate_t, restitution_model, zener_method, plasticity,
-                              plate_waves, effect_tolerance, ode_rtol)
-    params = dict(sphere_E=sphere_E, sphere_nu=sphere_nu, sphere_Sy=sphere_Sy, sphere_rho=sphere_rho,
-                  sphere_d=sphere_d, plate_E=plate_E, plate_nu=plate_nu, plate_Sy=plate_Sy,
-                  plate_rho=plate_rho, plate_t=plate_t)
-    scalar = is_scalar(v) and all(is_scalar(p) for p in params.values())
-    if scalar and all((x.__class__ is float or x.__class__ is int and -_EXACT_INT <= x <= _EXACT_INT)
-                      for x in (v, *params.values())):
-        # Python ints mixed in (unvalidated, e.g. a density of 7861): an int meets a float in every
-        # operation and converts exactly below 2^53, so the float path computes the same bits.
-        return _impact_scalar(float(v), *map(float, params.values()), restitution_model, zener_method,
-                              plasticity, plate_waves, effect_tolerance, ode_rtol)
-    if not scalar:
+    params = (sphere_E, sphere_nu, sphere_Sy, sphere_rho, sphere_d, plate_E, plate_nu, plate_Sy, plate_rho, plate_t)
+    if v.__class__ is float and all(x.__class__ is float for x in params):
+        scalar = True  # one impact in Python floats: the FMU's case, and any validated scalar call
+    elif is_scalar(v) and all(is_scalar(x) for x in params):
+        scalar = True
+        v, params = float(v), tuple(map(float, params))
+    else:
         # No up-front broadcast: what depends on the parameters only is computed once per
         # distinct parameter value (a scalar parameter stays a scalar), not once per case.
+        scalar = False
         v = np.asarray(v, dtype=float)
-        params = {name: np.asarray(value, dtype=float) for name, value in params.items()}
-        shape = np.broadcast_shapes(v.shape, *(a.shape for a in params.values()))
-    p = params
+        params = tuple(np.asarray(x, dtype=float) for x in params)
+    return _pipeline(v, params, scalar, restitution_model, zener_method, plasticity, plate_waves,
+                     effect_tolerance, ode_rtol)
+
+
+def _pipeline(v, params, scalar, restitution_model, zener_method, plasticity, plate_waves,
+              effect_tolerance, ode_rtol) -> ImpactResult:
+    """The model, written once for Python floats (``scalar``) and numpy arrays alike.
+
+    Every step goes through the float-or-array helpers of :mod:`restitution._num`; the only
+    differences are where results are stored (a memoised material step and a direct fill of the
+    result for floats; masked Zener evaluation and owned output arrays for arrays).
+    """
+    sphere_E, sphere_nu, sphere_Sy, sphere_rho, sphere_d, plate_E, plate_nu, plate_Sy, plate_rho, plate_t = params
 
     # --- JGM, Eqs. (1)-(8)
-    E_prime = effective_modulus(p["sphere_E"], p["sphere_nu"], p["plate_E"], p["plate_nu"])
-    CSy = critical_pressure(p["sphere_nu"], p["sphere_Sy"], p["plate_nu"], p["plate_Sy"])
-    eps_y = yield_strain(E_prime, p["sphere_nu"], p["sphere_Sy"], p["plate_nu"], p["plate_Sy"])
-    R = 0.5 * p["sphere_d"]
-    m_a = sphere_mass(p["sphere_rho"], p["sphere_d"])
-    V_c = critical_velocity(critical_interference(CSy, E_prime, R), critical_load(CSy, E_prime, R), m_a)
+    material_terms = _material_terms_cached if scalar else _material_terms
+    E_prime, eps_y, m_a, V_c, k = material_terms(sphere_E, sphere_nu, sphere_Sy, sphere_rho, sphere_d,
+                                                 plate_E, plate_nu, plate_Sy)
     V_star = v / V_c
     if plasticity == "off":
-        e_ep = 1.0 if scalar else np.ones_like(v)
+        e_ep = 1.0
     else:
         e_ep = (restitution_e45(V_star, eps_y) if restitution_model == "e45"
                 else restitution_e44(V_star))
-    if plasticity == "auto":
-        e_ep = where(1.0 - e_ep < effect_tolerance, 1.0, e_ep)
-    plasticity_used = e_ep < 1.0
+        if plasticity == "auto":
+            e_ep = where(1.0 - e_ep < effect_tolerance, 1.0, e_ep)
 
     # --- Zener, Eqs. (9)-(13a)
-    lam = inelasticity_parameter(v, p["sphere_E"], p["sphere_nu"], p["sphere_rho"], p["sphere_d"],
-                                 p["plate_E"], p["plate_nu"], p["plate_rho"], p["plate_t"])
-    if plate_waves == "off":
-        needed = False if scalar else np.zeros(np.shape(lam), dtype=bool)
-    elif plate_waves == "on":
-        needed = True if scalar else np.ones(np.shape(lam), dtype=bool)
-    else:
+    lam = inelasticity_parameter(v, sphere_E, sphere_nu, sphere_rho, sphere_d, plate_E, plate_nu, plate_rho,
+                                 plate_t)
+    if plate_waves == "auto":
         needed = ZENER_SLOPE_BOUND * lam >= effect_tolerance
-    e_ze, tau0 = _zener_where_needed(lam, needed, zener_method, ode_rtol, scalar)
-    if plate_waves == "auto" and _TAU0_AT_LAMBDA0[zener_method] != TAU0_HERTZ:
-        tau0 = where(needed, tau0, _TAU0_AT_LAMBDA0[zener_method])
+        skipped_tau0 = _TAU0_AT_LAMBDA0[zener_method]
+    else:
+        needed = plate_waves == "on"
+        skipped_tau0 = TAU0_HERTZ
+    e_ze, d_ze, tau0 = _zener_where_needed(lam, needed, zener_method, ode_rtol, skipped_tau0, scalar)
 
     moving = v > 0.0
-    v_safe = where(moving, v, 1.0)
-    T = where(moving, time_scale(m_a, hertz_stiffness(E_prime, p["sphere_d"]), v_safe), math.inf)
+    T = where(moving, time_scale(m_a, k, where(moving, v, 1.0)), math.inf)
     t_contact = where(moving, contact_duration(where(moving, T, 0.0), tau0), 0.0)
 
     # --- Fusion, Eqs. (17)-(20)
     e = apparent_restitution(e_ep, e_ze)
-    m_eff = equivalent_plate_mass(m_a, e_ze)
-    _, v_plate = velocities_after_impact(v, e_ep, e_ze)
+    m_eff = equivalent_plate_mass(m_a, e_ze, d_ze)
+    _, v_plate = velocities_after_impact(v, e_ep, e_ze, d_ze)
 
-    out = ImpactResult(
-        e=e, v_rebound=e * v, e_ep=e_ep, V_c=V_c, V_star=V_star, eps_y=eps_y, e_ze=e_ze, lam=lam,
-        tau0=tau0, T=T, t_contact=t_contact, m_a=m_a, m_eff=m_eff, v_plate=v_plate,
-        plasticity_used=plasticity_used, plate_waves_used=needed,
-        lambda_in_range=lam <= LAMBDA_STUDIED_MAX, vstar_in_range=V_star <= VSTAR_FIT_MAX,
-        e_negative=e < 0.0,
-    )
-    if scalar:
-        return ImpactResult(**{f.name: (bool if f.name in _FLAGS else float)(getattr(out, f.name))
-                               for f in fields(out)})
-    taken = {id(v), *(id(a) for a in params.values())}  # never hand out an input array
-    return ImpactResult(**{f.name: _own_array(getattr(out, f.name), shape, bool if f.name in _FLAGS else float,
-                                              taken) for f in fields(out)})
+    values = (e, e * v, e_ep, V_c, V_star, eps_y, e_ze, lam, tau0, T, t_contact, m_a, m_eff, v_plate,
+              e_ep < 1.0, needed, lam <= LAMBDA_STUDIED_MAX, V_star <= VSTAR_FIT_MAX, e < 0.0)
+    out = object.__new__(ImpactResult)  # frozen dataclass: fill __dict__ directly, ~5x faster
+    if scalar:  # every value is already a Python float or bool (math-module paths; the tests check it)
+        out.__dict__.update(zip(_FIELD_NAMES, values))
+        return out
+    shape = np.broadcast_shapes(v.shape, *(x.shape for x in params))
+    taken = {id(v), *(id(x) for x in params)}  # never hand out an input array
+    out.__dict__.update((name, _own_array(value, shape, bool if name in _FLAGS else float, taken))
+                        for name, value in zip(_FIELD_NAMES, values))
+    return out
 
 
 #: tau0 [1] of each Zener method at lambda = 0: what ``plate_waves="auto"`` reports where it skips
@@ -230,7 +220,6 @@ _TAU0_AT_LAMBDA0 = {"exact": TAU0_HERTZ, "ode": TAU0_HERTZ, "paper_fit": zener_p
 
 _FLAGS = frozenset({"plasticity_used", "plate_waves_used", "lambda_in_range", "vstar_in_range", "e_negative"})
 _FIELD_NAMES = tuple(f.name for f in fields(ImpactResult))
-_EXACT_INT = 2 ** 53  # every int up to this converts to float exactly
 
 
 def _own_array(x, shape, dtype, taken):
@@ -246,12 +235,9 @@ def _own_array(x, shape, dtype, taken):
     return np.broadcast_to(x, shape).astype(dtype)
 
 
-@lru_cache(maxsize=64)
 def _material_terms(sphere_E, sphere_nu, sphere_Sy, sphere_rho, sphere_d, plate_E, plate_nu, plate_Sy):
-    """What depends on the materials only, for :func:`_impact_scalar`: (E', eps_y, m_a, V_c, k).
-
-    Memoised (pure function of floats): a co-simulation or a sweep in v pays for it once.
-    """
+    """What depends on the materials only: (E' [Pa], eps_y [1], m_a [kg], V_c [m/s], k [N/m^1.5]),
+    Eqs. (1)-(6) and the Hertz stiffness of Eq. (9)."""
     E_prime = effective_modulus(sphere_E, sphere_nu, plate_E, plate_nu)
     CSy = critical_pressure(sphere_nu, sphere_Sy, plate_nu, plate_Sy)
     eps_y = yield_strain(E_prime, sphere_nu, sphere_Sy, plate_nu, plate_Sy)
@@ -261,73 +247,21 @@ def _material_terms(sphere_E, sphere_nu, sphere_Sy, sphere_rho, sphere_d, plate_
     return E_prime, eps_y, m_a, V_c, hertz_stiffness(E_prime, sphere_d)
 
 
-def _impact_scalar(v, sphere_E, sphere_nu, sphere_Sy, sphere_rho, sphere_d, plate_E, plate_nu, plate_Sy,
-                   plate_rho, plate_t, restitution_model, zener_method, plasticity, plate_waves,
-                   effect_tolerance, ode_rtol):
-    """:func:`impact` for Python floats: the same equations and operations (so the same bits)
-    without the array machinery, and the result built without the dataclass ``__init__``."""
-    # --- JGM, Eqs. (1)-(8)
-    E_prime, eps_y, m_a, V_c, k = _material_terms(sphere_E, sphere_nu, sphere_Sy, sphere_rho, sphere_d,
-                                                  plate_E, plate_nu, plate_Sy)
-    V_star = v / V_c
-    if plasticity == "off":
-        e_ep = 1.0
-    else:
-        e_ep = (restitution_e45(V_star, eps_y) if restitution_model == "e45"
-                else restitution_e44(V_star))
-        if plasticity == "auto" and 1.0 - e_ep < effect_tolerance:
-            e_ep = 1.0
-
-    # --- Zener, Eqs. (9)-(13a)
-    lam = inelasticity_parameter(v, sphere_E, sphere_nu, sphere_rho, sphere_d,
-                                 plate_E, plate_nu, plate_rho, plate_t)
-    if plate_waves == "off":
-        needed = False
-    elif plate_waves == "on":
-        needed = True
-    else:
-        needed = ZENER_SLOPE_BOUND * lam >= effect_tolerance
-    e_ze, tau0 = zener_restitution(lam, zener_method, ode_rtol) if needed else (
-        1.0, TAU0_HERTZ if plate_waves == "off" else _TAU0_AT_LAMBDA0[zener_method])
-    if v > 0.0:
-        T = time_scale(m_a, k, v)
-        t_contact = contact_duration(T, tau0)
-    else:
-        T = math.inf
-        t_contact = 0.0
-
-    # --- Fusion, Eqs. (17)-(20)
-    e = apparent_restitution(e_ep, e_ze)
-    m_eff = equivalent_plate_mass(m_a, e_ze)
-    _, v_plate = velocities_after_impact(v, e_ep, e_ze)
-
-    # Every value is a Python float here (float inputs, math-module scalar paths; the tests
-    # check it), so the float()/bool() conversions of the general path are not needed.
-    out = object.__new__(ImpactResult)  # frozen dataclass: fill __dict__ directly, ~5x faster
-    out.__dict__.update({  # keys in field order (checked at import, below)
-        "e": e, "v_rebound": e * v, "e_ep": e_ep, "V_c": V_c, "V_star": V_star, "eps_y": eps_y, "e_ze": e_ze,
-        "lam": lam, "tau0": tau0, "T": T, "t_contact": t_contact, "m_a": m_a, "m_eff": m_eff, "v_plate": v_plate,
-        "plasticity_used": e_ep < 1.0, "plate_waves_used": bool(needed),
-        "lambda_in_range": lam <= LAMBDA_STUDIED_MAX, "vstar_in_range": V_star <= VSTAR_FIT_MAX,
-        "e_negative": e < 0.0})
-    return out
+#: :func:`_material_terms` memoised for Python floats (a pure function): a co-simulation or a
+#: sweep in v pays for it once.
+_material_terms_cached = lru_cache(maxsize=64)(_material_terms)
 
 
-if tuple(_impact_scalar(1.0, 2e11, 0.3, 1e9, 8e3, 1e-2, 7e10, 0.33, 3e8, 2.7e3, 1e-2, "e45", "exact", "auto",
-                        "auto", 1e-6, 1e-10).__dict__) != _FIELD_NAMES:
-    raise RuntimeError("_impact_scalar builds ImpactResult with keys out of field order")
-
-
-def _zener_where_needed(lam, needed, method, rtol, scalar):
-    """(e_ze, tau0), computed only where the plate-wave effect is needed; half-space values elsewhere."""
+def _zener_where_needed(lam, needed, method, rtol, skipped_tau0, scalar):
+    """(e_ze, 1 - e_ze, tau0), computed only where the plate-wave effect is needed;
+    (1, 0, ``skipped_tau0``) elsewhere."""
     if scalar:
-        return zener_restitution(lam, method, rtol) if needed else (1.0, TAU0_HERTZ)
+        return zener_solution(lam, method, rtol) if needed else (1.0, 0.0, skipped_tau0)
     lam = np.asarray(lam, dtype=float)
     needed = np.broadcast_to(needed, lam.shape)
     if needed.all():  # elementwise methods: same values as the masked evaluation, no gather/scatter
-        return zener_restitution(lam, method, rtol)
-    e_ze = np.ones(lam.shape)
-    tau0 = np.full(lam.shape, TAU0_HERTZ)
+        return zener_solution(lam, method, rtol)
+    e_ze, d_ze, tau0 = np.ones(lam.shape), np.zeros(lam.shape), np.full(lam.shape, skipped_tau0)
     if needed.any():
-        e_ze[needed], tau0[needed] = zener_restitution(lam[needed], method, rtol)
-    return e_ze, tau0
+        e_ze[needed], d_ze[needed], tau0[needed] = zener_solution(lam[needed], method, rtol)
+    return e_ze, d_ze, tau0

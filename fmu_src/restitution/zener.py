@@ -15,15 +15,16 @@ import math
 
 import numpy as np
 
-from ._num import exp, is_scalar, minimum, sqrt, where
+from ._num import exp, expm1, is_scalar, minimum, sqrt, where
 from .jgm import reduced_modulus
-from .zener_exact import zener_exact
+from .zener_exact import zener_exact_solution
 from .zener_ode import solve_zener_ode
 
 __all__ = [
     "ZENER_METHODS", "LAMBDA_STUDIED_MAX", "TAU0_HERTZ", "plate_wave_speed", "inelasticity_parameter",
-    "hertz_stiffness", "time_scale", "zener_paper_fit", "zener_linear", "zener_linear_fit",
-    "zener_ode", "zener_restitution", "contact_duration",
+    "hertz_stiffness", "time_scale", "zener_paper_fit", "zener_paper_fit_deficit", "zener_linear",
+    "zener_linear_deficit", "zener_linear_fit", "zener_ode", "zener_restitution", "zener_solution",
+    "contact_duration",
 ]
 
 ZENER_METHODS = ("exact", "paper_fit", "linear", "ode")
@@ -83,6 +84,17 @@ def zener_paper_fit(lam):
     return exp(-1.68374 * lam), 3.215 * exp(0.318 * minimum(lam, _PAPER_FIT_LAMBDA_CAP) ** 1.5)
 
 
+def zener_paper_fit_deficit(lam):
+    """1 - e_ze [1] of the paper fit, Eq. (13), as -expm1(-1.68374 lambda).
+
+    Computing 1 - exp(-1.68374 lambda) by subtraction has relative condition number
+    ~ 1/(1 - e_ze) ~ 1/(1.68 lambda) (1e16 near lambda = 1e-16: a last-bit difference in exp,
+    as between numpy's SIMD kernels and the C library, changes the result by 100 %); expm1
+    has condition number ~ 1 in lambda.
+    """
+    return -expm1(-1.68374 * lam)
+
+
 #: lambda above which Eq. (13a)'s exponent 0.318 lambda^1.5 would pass 700 (exp overflows at ~709.8).
 _PAPER_FIT_LAMBDA_CAP = (700.0 / 0.318) ** (2.0 / 3.0)
 
@@ -101,6 +113,15 @@ def zener_linear(lam):
     e = where(under, exp(-math.pi * lam_u / root), 0.0)
     tau0 = where(under, 2.0 * math.pi / root, math.inf)
     return e, tau0
+
+
+def zener_linear_deficit(lam):
+    """1 - e_ze [1] of the linearised ODE, Eq. (22): -expm1(-pi lambda / sqrt(4 - lambda^2)) for
+    lambda < 2, 1 beyond. The expm1 form avoids the cancellation of 1 - e_ze near lambda = 0
+    (condition number ~ 1/(pi lambda / 2) by subtraction, ~ 1 this way)."""
+    under = lam < 2.0
+    lam_u = where(under, lam, 0.0)
+    return where(under, -expm1(-math.pi * lam_u / sqrt(4.0 - lam_u * lam_u)), 1.0)
 
 
 def zener_linear_fit(lam):
@@ -123,14 +144,31 @@ def zener_ode(lam, rtol: float = 1e-10):
     return e, tau0
 
 
+def zener_solution(lam, method: str = "exact", rtol: float = 1e-10):
+    """(e_ze, 1 - e_ze, tau0) [1] for Zener's parameter lambda [1] by ``method`` (see module doc).
+
+    The deficit 1 - e_ze is computed directly by each method (``exact``: its own interpolant,
+    ``paper_fit`` and ``linear``: expm1 forms), never as 1 - e_ze, which has relative condition
+    number ~ 1/(1 - e_ze) and would make the equivalent plate mass, Eq. (19), and the plate
+    velocity, Eq. (17), depend on the last bit of exp (see :func:`zener_paper_fit_deficit`).
+    ``ode``: 1 - e_ze of the integrated solution, accurate to the solve's tolerance ``rtol``
+    in absolute terms (the method's own accuracy, not a conditioning loss).
+    """
+    if method == "exact":
+        return zener_exact_solution(lam)
+    if method == "paper_fit":
+        e, tau0 = zener_paper_fit(lam)
+        return e, zener_paper_fit_deficit(lam), tau0
+    if method == "linear":
+        e, tau0 = zener_linear(lam)
+        return e, zener_linear_deficit(lam), tau0
+    if method == "ode":
+        e, tau0 = zener_ode(lam, rtol=rtol)
+        return e, 1.0 - e, tau0
+    raise ValueError(f"zener_method = {method!r} is not one of {ZENER_METHODS}")
+
+
 def zener_restitution(lam, method: str = "exact", rtol: float = 1e-10):
     """(e_ze, tau0) [1] for Zener's parameter lambda [1] by ``method`` (see module doc)."""
-    if method == "exact":
-        return zener_exact(lam)
-    if method == "paper_fit":
-        return zener_paper_fit(lam)
-    if method == "linear":
-        return zener_linear(lam)
-    if method == "ode":
-        return zener_ode(lam, rtol=rtol)
-    raise ValueError(f"zener_method = {method!r} is not one of {ZENER_METHODS}")
+    e, _, tau0 = zener_solution(lam, method, rtol)
+    return e, tau0

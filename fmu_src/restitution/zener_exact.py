@@ -49,7 +49,7 @@ import os
 
 import numpy as np
 
-__all__ = ["zener_exact", "LAMBDA_TABLE_MAX", "E_INF", "TAU0_LAMBDA0"]
+__all__ = ["zener_exact", "zener_exact_solution", "LAMBDA_TABLE_MAX", "E_INF", "TAU0_LAMBDA0"]
 
 _DATA_NAME = "zener_table.npz"
 
@@ -96,8 +96,12 @@ def _build_pieces(T):
     k = np.asarray(T["k"], dtype=np.int64)
     if k[0] != 0 or np.any(np.diff(k) <= 0) or k[-1] * _H <= LAMBDA_TABLE_MAX:
         raise RuntimeError(f"{_DATA_NAME}: bad node layout")
-    # one row per piece: (k_j, a0..a3 for e_ze, b0..b3 for tau0)
-    rows = np.stack((k[:-1].astype(float),) + _hermite(k, T["e"], T["de"], _H)
+    # one row per piece: (k_j, a0..a3 for e_ze, c0..c3 for 1 - e_ze, b0..b3 for tau0).
+    # The deficit's pieces are c0 = 1 - a0 (exact: a0 >= 0.5 on every piece where it matters,
+    # Sterbenz) and c_i = -a_i, so 1 - e_ze is interpolated directly: at small lambda it is
+    # t (|a1| + ...) with full relative accuracy instead of the difference of two numbers near 1.
+    a = _hermite(k, T["e"], T["de"], _H)
+    rows = np.stack((k[:-1].astype(float),) + a + (1.0 - a[0], -a[1], -a[2], -a[3])
                     + _hermite(k, T["tau0"], T["dtau0"], _H), axis=1)
     cell_to_piece = np.repeat(np.arange(len(rows)), np.diff(k))  # fine cell -> piece
     # scalar path: a list over fine cells whose entries share the piece tuples (small, and
@@ -138,29 +142,30 @@ def _scalar_general(lam):
         raise _bad_lambda(x)
     if x <= LAMBDA_TABLE_MAX:
         y = x * _INV_H
-        k, a0, a1, a2, a3, b0, b1, b2, b3 = _COEF[int(y)]
+        k, a0, a1, a2, a3, c0, c1, c2, c3, b0, b1, b2, b3 = _COEF[int(y)]
         t = y - k
-        return a0 + t * (a1 + t * (a2 + t * a3)), b0 + t * (b1 + t * (b2 + t * b3))
-    return _asym_scalar(x)
+        return (a0 + t * (a1 + t * (a2 + t * a3)), c0 + t * (c1 + t * (c2 + t * c3)),
+                b0 + t * (b1 + t * (b2 + t * b3)))
+    e, tau0 = _asym_scalar(x)
+    return e, 1.0 - e, tau0
+
+
+def _horner_cubic(c, first, t):
+    """c[..., first] + t (c[..., first+1] + t (c[..., first+2] + t c[..., first+3])), in place."""
+    out = c[..., first + 3] * t
+    out += c[..., first + 2]
+    out *= t
+    out += c[..., first + 1]
+    out *= t
+    out += c[..., first]
+    return out
 
 
 def _table_array(lam):
     x = lam * _INV_H
-    c = _COEF_ARR[x.astype(np.intp)]  # gather (..., 9)
+    c = _COEF_ARR[x.astype(np.intp)]  # gather (..., 13)
     t = x - c[..., 0]
-    e = c[..., 4] * t
-    e += c[..., 3]
-    e *= t
-    e += c[..., 2]
-    e *= t
-    e += c[..., 1]
-    tau = c[..., 8] * t
-    tau += c[..., 7]
-    tau *= t
-    tau += c[..., 6]
-    tau *= t
-    tau += c[..., 5]
-    return e, tau
+    return _horner_cubic(c, 1, t), _horner_cubic(c, 5, t), _horner_cubic(c, 9, t)
 
 
 def _asym_array(lam):
@@ -175,13 +180,13 @@ def _asym_array(lam):
     with np.errstate(under="ignore", over="ignore"):
         e = E_INF * (1.0 / lam) ** 5
         tau = lam * (5.0 * np.log(lam) + g)
-    return e, tau
+    return e, 1.0 - e, tau
 
 
 def _array(lam):
     a = np.asarray(lam, dtype=float)
     if a.size == 0:
-        return np.empty(a.shape), np.empty(a.shape)
+        return np.empty(a.shape), np.empty(a.shape), np.empty(a.shape)
     lo = a.min()
     hi = a.max()
     if not (lo >= 0.0 and hi < math.inf):  # also catches nan (min/max propagate it)
@@ -190,17 +195,17 @@ def _array(lam):
         raise _bad_lambda(float(a[tuple(idx)]), f" (at index {tuple(int(j) for j in idx)})"
                           if a.ndim else "")
     if a.ndim == 0:
-        e, tau = _scalar_general(float(a))
-        return np.array(e), np.array(tau)
+        return tuple(np.array(x) for x in _scalar_general(float(a)))
     if hi <= LAMBDA_TABLE_MAX:
         return _table_array(a)
     big = a > LAMBDA_TABLE_MAX
-    e = np.empty(a.shape)
-    tau = np.empty(a.shape)
+    out = tuple(np.empty(a.shape) for _ in range(3))
     small = ~big
-    e[small], tau[small] = _table_array(a[small])
-    e[big], tau[big] = _asym_array(a[big])
-    return e, tau
+    for target, part in zip(out, _table_array(a[small])):
+        target[small] = part
+    for target, part in zip(out, _asym_array(a[big])):
+        target[big] = part
+    return out
 
 
 def zener_exact(lam):
@@ -234,11 +239,25 @@ def zener_exact(lam):
     ValueError
         If lambda (or any element) is negative, nan or infinite.
     """
+    e, _, tau0 = zener_exact_solution(lam)
+    return e, tau0
+
+
+def zener_exact_solution(lam):
+    """(e_ze, 1 - e_ze, tau0) [1] of the "exact" method: :func:`zener_exact` and the deficit 1 - e_ze.
+
+    The deficit is interpolated from its own pieces (1 - a0, -a1, -a2, -a3), not computed as
+    1 - e_ze: near lambda = 0, where e_ze = 1 - 1.7302 lambda + ..., the subtraction would leave
+    only the bits of lambda that survive rounding e_ze to a number near 1 (relative condition
+    number ~ 1/(1 - e_ze), 1e16 at lambda ~ 1e-16). Interpolated directly it keeps full relative
+    accuracy (condition number ~ 1 in lambda), and e_ze + (1 - e_ze) = 1 to rounding.
+    """
     if lam.__class__ is float and 0.0 <= lam <= 100.0:  # fast path (LAMBDA_TABLE_MAX = 100)
         x = lam * _INV_H
-        k, a0, a1, a2, a3, b0, b1, b2, b3 = _COEF[int(x)]
+        k, a0, a1, a2, a3, c0, c1, c2, c3, b0, b1, b2, b3 = _COEF[int(x)]
         t = x - k
-        return a0 + t * (a1 + t * (a2 + t * a3)), b0 + t * (b1 + t * (b2 + t * b3))
+        return (a0 + t * (a1 + t * (a2 + t * a3)), c0 + t * (c1 + t * (c2 + t * c3)),
+                b0 + t * (b1 + t * (b2 + t * b3)))
     if isinstance(lam, (int, float, np.number)) and not isinstance(lam, np.complexfloating):
         return _scalar_general(lam)
     if isinstance(lam, np.ndarray) or isinstance(lam, (list, tuple)):
