@@ -1,23 +1,31 @@
 #!/usr/bin/env bash
-# One-command set-up and run, for a fresh machine with Python >= 3.10 and gcc.
+# One-command set-up and run, for a fresh machine with Python >= 3.11 and gcc.
 #   bash build_scripts/quickstart.sh demo   # build dist/SpherePlateImpact.fmu and bounce a ball through it
-#   bash build_scripts/quickstart.sh test   # run the test suite
-# Creates .venv/ in the repository (once) and installs the package with its extras into it.
+#   bash build_scripts/quickstart.sh test   # run the test suite (extra arguments go to pytest)
+# Creates .venv/ in the repository (once) and installs into it exactly the versions of
+# requirements/dev.lock (hash-checked; refresh it with build_scripts/lock.sh), then the package
+# itself (editable, no dependencies of its own: the lock has them all).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 PYTHON="${PYTHON:-python3}"
+if ! "$PYTHON" -c 'import sys; sys.exit(sys.version_info < (3, 11))' 2>/dev/null; then
+    echo "quickstart: needs Python >= 3.11 as '$PYTHON' (set PYTHON=/path/to/python3.11)" >&2
+    exit 2
+fi
 if [ ! -x .venv/bin/python ]; then
     "$PYTHON" -m venv .venv
 fi
-stamp=.venv/.installed-$(sha1sum pyproject.toml | cut -c1-12)
+stamp=.venv/.installed-$(cat pyproject.toml requirements/dev.lock | sha1sum | cut -c1-12)
 if [ ! -f "$stamp" ]; then
-    .venv/bin/python -m pip install --quiet --upgrade pip
-    .venv/bin/python -m pip install --quiet -e ".[dev]"
+    .venv/bin/python -m pip install --quiet --disable-pip-version-check --require-hashes \
+        -r requirements/dev.lock
+    .venv/bin/python -m pip install --quiet --disable-pip-version-check --no-deps --no-build-isolation -e .
+    rm -f .venv/.installed-*
     touch "$stamp"
 fi
 case "${1:-demo}" in
     demo)
-        .venv/bin/python build_scripts/build_fmu.py --out dist
+        .venv/bin/python -m restitution.fmu build --out dist
         .venv/bin/python examples/quickstart_bounce.py --fmu dist/SpherePlateImpact.fmu
         ;;
     test)
