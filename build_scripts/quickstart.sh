@@ -19,7 +19,7 @@ stamp=.venv/.installed-$(cat pyproject.toml requirements/dev.lock | sha1sum | cu
 if [ ! -f "$stamp" ]; then
     .venv/bin/python -m pip install --quiet --disable-pip-version-check --require-hashes \
         -r requirements/dev.lock
-    .venv/bin/python -m pip install --quiet --disable-pip-version-check --no-deps --no-build-isolation -e .
+    .venv/bin/python -m pip install --quiet --disable-pip-version-check --no-deps -e .
     rm -f .venv/.installed-*
     touch "$stamp"
 fi

@@ -81,8 +81,33 @@ _T2 = "Green (2022) Table 2"
 _T3 = "Green (2022) Table 3"
 _HB = "handbook value, not from the paper"
 
+class MaterialTable(dict):
+    """The presets by short name; an unknown name raises a KeyError that lists the known names
+    and suggests the closest ones (by spelling, or by the material's full name)."""
+
+    def __missing__(self, name):
+        hint = suggest_material(name, self)
+        raise KeyError(f"unknown material {name!r}{hint}; known: {', '.join(sorted(self))}")
+
+
+def suggest_material(name, materials) -> str:
+    """" (did you mean 'a' or 'b'?)" for an unknown material ``name`` among ``materials`` (a mapping
+    of short names to :class:`Material`, or just names), or "" when nothing is close."""
+    import difflib
+
+    query = str(name).lower()
+    close = difflib.get_close_matches(query, list(materials), n=2, cutoff=0.6)
+    if not close and hasattr(materials, "items"):
+        words = [w for w in query.replace("_", " ").split() if len(w) >= 3]
+        close = [key for key, mat in materials.items()
+                 if isinstance(mat, Material) and words and all(w in mat.name.lower() for w in words)][:3]
+    if not close:
+        return ""
+    return " (did you mean " + " or ".join(repr(c) for c in close) + "?)"
+
+
 #: Every material of the paper's Tables 1-3, keyed by a short name.
-MATERIALS: dict[str, Material] = {
+MATERIALS: dict[str, Material] = MaterialTable({
     # Table 3 (Patil & Higgs 2018): complete property sets.
     "brass_260": Material("Brass alloy 260", 103e9, 0.35, 0.393e9, 8525, _T3),
     "al_1100_h16": Material("Aluminum 1100-H16", 70e9, 0.33, 0.103e9, 2710, _T3),
@@ -104,7 +129,7 @@ MATERIALS: dict[str, Material] = {
                               f"{_T2}; E = 207 GPa is a {_HB} (AISI S7)"),
     "stainless_440c": Material("Stainless steel 440C", 200e9, 0.30, 0.448e9, 7750,
                                f"{_T2}; E = 200 GPa is a {_HB} (AISI 440C)"),
-}
+})
 # Table 1 repeats these Table 3 materials with the same values.
 MATERIALS["al_110_h16"] = MATERIALS["al_1100_h16"]
 

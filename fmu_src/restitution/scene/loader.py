@@ -60,7 +60,7 @@ from pathlib import Path
 
 import tomllib  # Python >= 3.11
 
-from ..materials import BRITTLE_SY, MATERIALS, TABLE4_CASES, Material, table4_case
+from ..materials import BRITTLE_SY, MATERIALS, TABLE4_CASES, Material, suggest_material, table4_case
 from ..model import EFFECT_MODES, RESTITUTION_MODELS
 from ..zener import ZENER_METHODS
 from .units import UnitError, parse_quantity
@@ -280,8 +280,7 @@ def _material(ctx, value, where, custom) -> Material:
         try:
             return resolve_material(value, custom)
         except KeyError as exc:
-            close = difflib.get_close_matches(value, list(MATERIALS) + list(custom), n=1)
-            hint = f" (did you mean {close[0]!r}?)" if close else ""
+            hint = suggest_material(value, {**MATERIALS, **custom})
             raise ctx.error(where, f"{exc.args[0]}{hint}") from None
     if not isinstance(value, dict):
         raise ctx.error(where, f"{value!r}: expected a material name or a table {{E, nu, Sy, rho}}")
