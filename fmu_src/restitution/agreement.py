@@ -101,9 +101,12 @@ def tolerances(v, params: dict, **options) -> tuple[dict, dict]:
 
 def disagreements(a, b, tol: dict, flips: dict) -> list[str]:
     """Descriptions of every output where results ``a`` and ``b`` (ImpactResult-like, same shape)
-    differ by more than ``tol`` or in a flag that may not differ; empty when they agree."""
+    differ by more than ``tol`` or in a flag that may not differ; empty when they agree. Outputs
+    that either result lacks (an FMU has no eps_y) are skipped."""
     problems = []
     for name in REALS:
+        if not (hasattr(a, name) and hasattr(b, name)):
+            continue
         x, y = np.asarray(getattr(a, name), dtype=float), np.asarray(getattr(b, name), dtype=float)
         with np.errstate(invalid="ignore"):
             ok = (x == y) | (np.abs(x - y) <= tol[name])
@@ -112,6 +115,8 @@ def disagreements(a, b, tol: dict, flips: dict) -> list[str]:
             problems.append(f"{name}: {x[i]!r} vs {y[i]!r} (allowed {np.broadcast_to(tol[name], ok.shape)[i]:.3g}) "
                             f"at index {tuple(int(j) for j in i)}")
     for name in FLAGS:
+        if not (hasattr(a, name) and hasattr(b, name)):
+            continue
         x, y = np.asarray(getattr(a, name)), np.asarray(getattr(b, name))
         bad = (x != y) & ~np.broadcast_to(flips[name], np.shape(x))
         if np.any(bad):

@@ -7,7 +7,7 @@ import sys
 from pathlib import Path
 
 from ..materials import MATERIALS, TABLE4_CASES
-from .spec import CODES, INPUTS, T_OVER_D, SweepSpec, canonical_name, load_spec
+from .spec import CODES, INPUT_NAMES, INPUTS, T_OVER_D, SweepSpec, canonical_name, load_spec
 
 EXAMPLES = """examples:
   # e over speed and t/d for two material pairs, on a local Dask cluster (one worker per core)
@@ -86,7 +86,8 @@ def main(argv=None) -> int:
     parser.add_argument("--seed", type=int, help="seed of the random draws")
     parser.add_argument("--backend", choices=("package", "fmu", "both"),
                         help="package: vectorized (default); fmu: the FMU itself; both: run both and "
-                             "compare (exit 1 if they differ by more than --tolerance)")
+                             "compare (exit 1 if any output differs by more than its conditioning allows, "
+                             "restitution.agreement)")
     parser.add_argument("--fmu", help="FMU for the fmu back end (default: dist/SpherePlateImpact.fmu, "
                                       "built if missing)")
     parser.add_argument("--scheduler", help="address of a running dask.distributed scheduler "
@@ -100,8 +101,6 @@ def main(argv=None) -> int:
     parser.add_argument("--plot", help="COR map image (default: <out>_cor_map.png)")
     parser.add_argument("--no-plot", action="store_true", help="skip the COR map")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
-    parser.add_argument("--tolerance", type=float, default=1e-12,
-                        help="--backend both: largest allowed difference (relative, floor 1; default 1e-12)")
     parser.add_argument("--dry-run", action="store_true", help="print what the sweep covers and stop")
     parser.add_argument("--list", action="store_true", help="list parameter names and materials and stop")
     args = parser.parse_args(argv)
@@ -143,7 +142,7 @@ def main(argv=None) -> int:
     if args.dry_run:
         return 0
 
-    from .run import compare_results, open_client, run_sweep
+    from .run import open_client, run_sweep
 
     progress = not args.no_progress
     columns = args.columns or run.get("columns")
@@ -160,15 +159,20 @@ def main(argv=None) -> int:
             print(res.summary())
             results[name] = res
     if backend == "both":
-        diffs = compare_results(results["fmu"], results["package"])
-        worst = max(diffs.items(), key=lambda kv: kv[1])
-        print("largest difference fmu vs package per output: "
-              + ", ".join(f"{k} {v:.2g}" for k, v in diffs.items()))
-        if not worst[1] <= args.tolerance:
-            print(f"FAIL: {worst[0]} differs by {worst[1]:.3g} > {args.tolerance:g}", file=sys.stderr)
+        from .compare import agreement_report
+
+        a_cols, b_cols = results["fmu"].columns, results["package"].columns
+        missing = [c for c in ("case", "ok", *INPUT_NAMES) if c not in a_cols or c not in b_cols]
+        if missing:
+            parser.error(f"--backend both compares every case from its inputs: --columns must keep {', '.join(missing)}")
+        compared, problems = agreement_report(a_cols, b_cols)
+        if problems:
+            for name, description in problems.items():
+                print(f"FAIL: fmu vs package, {description}", file=sys.stderr)
             status = 1
         else:
-            print(f"the FMU and the package agree within {args.tolerance:g}")
+            print(f"the FMU and the package agree on all {compared} cases within each output's conditioning "
+                  "(restitution.agreement)")
     result = results[backends[0]]
     print(f"table: {result.write(out)}")
     if plot is not None:

@@ -67,8 +67,28 @@ def open_client(scheduler=None, n_workers: int | None = None, threads_per_worker
     kwargs = dict(n_workers=n_workers or machine_workers(), threads_per_worker=threads_per_worker,
                   processes=True, dashboard_address=None, silence_logs=logging.ERROR)
     kwargs.update(cluster_kwargs)
-    with LocalCluster(**kwargs) as cluster, Client(cluster) as client:
+    with _without_fmu_resources_on_sys_path():  # the workers start with this process's sys.path
+        cluster = LocalCluster(**kwargs)
+    with cluster, Client(cluster) as client:
         yield client
+
+
+@contextlib.contextmanager
+def _without_fmu_resources_on_sys_path():
+    """sys.path minus the resources/ directories of pythonfmu FMUs loaded in this process.
+
+    pythonfmu prepends an FMU's resources/ to sys.path when it instantiates it; worker processes
+    started afterwards would inherit that entry and import the FMU's physics-only copy of
+    ``restitution`` (no ``restitution.sweep``) instead of this one, and die.
+    """
+    import sys
+
+    saved = list(sys.path)
+    sys.path[:] = [p for p in saved if not (p and os.path.isfile(os.path.join(p, "slavemodule.txt")))]
+    try:
+        yield
+    finally:
+        sys.path[:] = saved
 
 
 def _run_chunk(start: int, stop: int, spec: SweepSpec, backend: Backend, payload=None, keep=None):
