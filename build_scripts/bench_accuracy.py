@@ -813,7 +813,7 @@ def markdown(res: dict, cfg_name: str, elapsed: float) -> str:
     g = fmu["get_e_only"]
     lines += [
         f"The trivial FMU has the same {n_vars} variables as SpherePlateImpact (same types and causalities) "
-        "and does nothing, and carries the same native loader (build_scripts/native_host): its round trip is "
+        "and does nothing, and carries the same native loader (restitution/fmu/native_host): its round trip is "
         "what pythonfmu, the loader and fmpy cost. The SpherePlateImpact slave reads "
         "its cached outputs in one pass per `fmi2GetReal`/`fmi2GetBoolean` call instead of pythonfmu's "
         "getter per variable; the row *trivial FMU, one-pass getters* is the floor with that same change, "

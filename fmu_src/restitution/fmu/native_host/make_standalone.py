@@ -22,7 +22,7 @@ Usage::
     from make_standalone import make_standalone
     make_standalone(Path("build/Model.fmu"))            # this interpreter / venv
 
-    python build_scripts/native_host/make_standalone.py build/Model.fmu \
+    python -m restitution.fmu.native_host.make_standalone build/Model.fmu \
         [--python /path/to/venv/bin/python] [--require numpy --require scipy]
 """
 from __future__ import annotations
@@ -151,7 +151,7 @@ def _detect_requirements(entries: dict[str, bytes]) -> set[str]:
 
 def _config_text(info: dict, requires: Sequence[str]) -> str:
     lines = [
-        "# Written by build_scripts/native_host/make_standalone.py.",
+        "# Written by restitution.fmu.native_host.make_standalone.",
         "# Read by the FMU's binaries/linux64 shim when the host process has no Python",
         "# (plain C/C++ FMI hosts). Edit the paths to move the FMU to another Python",
         f"# {'.'.join(info['version'].split('.')[:2])} installation; ignored inside Python hosts (fmpy, libcosimpy).",
