@@ -79,23 +79,20 @@ def tolerances(v, params: dict, **options) -> tuple[dict, dict]:
         for flag in FLAGS:
             b = getattr(base, flag)
             flips[flag] |= (getattr(up, flag) != b) | (getattr(down, flag) != b)
-    tol = {}
-    for out in REALS:
-        scale = 1.0 if out in ABSOLUTE else np.abs(getattr(base, out))
+    def scale(out):  # what the bound multiplies: |y| for relative outputs, 1 (or v, in m/s) for absolute ones
         if out == "v_rebound":
-            scale = values["v"]
-        tol[out] = ULPS * EPS * (1.0 + total[out]) * scale
-    if method == "ode":
+            return values["v"]
+        return 1.0 if out in ABSOLUTE else np.abs(getattr(base, out))
+
+    tol = {out: ULPS * EPS * (1.0 + total[out]) * scale(out) for out in REALS}
+    if method == "ode":  # plus the solver's own tolerance: its adaptive steps may be chosen differently
         rtol = options.get("ode_rtol", 1e-10)
         d_ze = 1.0 - np.asarray(base.e_ze)
         with np.errstate(divide="ignore", invalid="ignore"):
             via_deficit = np.where(d_ze > 0.0, np.asarray(base.e_ze) / d_ze, 0.0)
         for out in REALS:
-            scale = 1.0 if out in ABSOLUTE else np.abs(getattr(base, out))
-            if out == "v_rebound":
-                scale = values["v"]
             factor = 1.0 + via_deficit if out in ("m_eff", "v_plate") else 1.0
-            tol[out] = tol[out] + 100.0 * rtol * factor * scale
+            tol[out] = tol[out] + 100.0 * rtol * factor * scale(out)
     return tol, flips
 
 
