@@ -113,15 +113,21 @@ def test_monotonic_on_dense_grid():
 
 
 # (e) ----------------------------------------------------------------------------------------
-def test_array_and_scalar_paths_agree_exactly():
+def test_array_and_scalar_paths_agree_to_rounding():
+    """Not bit identity between the two paths: within a few ulps. Up to lambda = 100 both evaluate
+    the same cubic by Horner's rule with + and * (4 ulps covers a compiler contracting a step into
+    an FMA); above, e_ze = E_INF lambda^-5 and tau0 = lambda (5 ln lambda + g) go through pow/log,
+    where numpy's SIMD kernels and libm differ by an ulp, and both forms have condition number <= 5
+    in their arguments (1e-15 = 4.5 ulps)."""
+    eps = np.finfo(float).eps
     lam = np.concatenate([LAMS, [0.0, 1e-300, 99.999999, 100.0, 100.0 + 1e-12, 150.0, 1e3, 1e7]])
     e_arr, t_arr = zener_exact(lam)
     for i, x in enumerate(lam):
         e, t = zener_exact(float(x))
         assert type(e) is float and type(t) is float
-        if x <= LAMBDA_TABLE_MAX:  # only + and *: bit-for-bit
-            assert e == e_arr[i] and t == t_arr[i], x
-        else:  # numpy's log/pow may differ from libm's in the last bit
+        if x <= LAMBDA_TABLE_MAX:
+            assert rel(e, e_arr[i]) <= 4 * eps and rel(t, t_arr[i]) <= 4 * eps, x
+        else:
             assert rel(e, e_arr[i]) <= 1e-15 and rel(t, t_arr[i]) <= 1e-15, x
         assert zener_exact(np.float64(x)) == (e, t)
     # shapes: any shape in, same shape out; lists; 0-d arrays; empty arrays
