@@ -220,9 +220,9 @@ def zener_exact(lam):
     lam : float or array_like
         Zener's "inelasticity" parameter lambda [1], Eq. (12); finite and >= 0.
         A Python (or numpy) scalar gives Python floats; an array (any shape, including
-        0-d) or a list gives ndarrays of that shape.  Array and scalar results are
-        identical bit for bit up to lambda = 100 (above, numpy's log/pow may differ
-        from the C library's in the last bit).
+        0-d) or a list gives ndarrays of that shape.  Array and scalar results agree to
+        rounding: the same Horner evaluation up to lambda = 100; above, numpy's log/pow
+        may differ from the C library's in the last bit.
 
     Returns
     -------
