@@ -21,7 +21,8 @@ def impact_fmu(tmp_path_factory) -> Path:
 #: Test files whose results depend on floating-point kernels: .ci/run runs them (``-m numerics``)
 #: a second time with numpy's SIMD dispatch switched off (build_scripts/cpu_dispatch.py).
 NUMERICAL_TEST_FILES = {"test_physics.py", "test_hard_cases.py", "test_fast_path.py", "test_zener_exact.py",
-                        "test_conditioning.py", "test_references.py", "test_sweep_agreement.py"}
+                        "test_conditioning.py", "test_references.py", "test_sweep_agreement.py",
+                        "test_paper_references.py", "test_paper_tables.py"}
 
 
 def pytest_configure(config):

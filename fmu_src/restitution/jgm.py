@@ -101,14 +101,22 @@ def restitution_e45(v_star, eps_y):
     e = 1 - 0.0361 eps_y^-0.114 ln(V*) (V* - 1)^(9.5 eps_y) for V* > 1, e = 1 for V* <= 1.
     The fit covers 1 < V* <= 1000. Extension: beyond that range the fit can fall
     below 0, which no elastoplastic rebound can do; it is floored at 0 there
-    (the caller flags V* > 1000 as outside the validated range). The power is
-    evaluated in log space so brittle pairs (eps_y ~ 10) cannot overflow.
+    (the caller flags V* > 1000 as outside the validated range).
+
+    Reformulation: the plastic loss 0.0361 eps_y^-0.114 ln(V*) (V* - 1)^(9.5 eps_y) is computed
+    as one exp of the sum of the factors' logarithms. Multiplied out, the factors can make a
+    subnormal (glass on glass just above V* = 1: (V* - 1)^(9.5 eps_y) ~ 1e-306, the product
+    ~ 1e-307, an underflow) or overflow (brittle pairs, eps_y ~ 10); in log space the loss is
+    0 exactly below exp's range (no underflow flag) and capped above it.
     """
     above, vm1 = _above_one(v_star)
-    log_v = log(where(above, v_star, 1.0))
-    power = exp(minimum(9.5 * eps_y * log(vm1), _EXP_ARG_CAP))
-    e = 1.0 - 0.0361 * eps_y ** -0.114 * log_v * power
+    log_v = log(where(above, v_star, 2.0))  # ln V* > 0 wherever it is used
+    log_loss = _LOG_E45_COEFFICIENT - 0.114 * log(eps_y) + log(log_v) + 9.5 * eps_y * log(vm1)
+    e = 1.0 - exp(minimum(log_loss, _EXP_ARG_CAP))
     return where(above, maximum(e, 0.0), 1.0)
+
+
+_LOG_E45_COEFFICIENT = math.log(0.0361)
 
 
 def restitution_e44(v_star):
