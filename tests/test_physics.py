@@ -226,16 +226,28 @@ def test_validity_flags_thin_plate_and_negative_cor():
 PARAMS = dict(v=2.3, **S2.params(), **AL.params())
 
 
-@pytest.mark.parametrize("name", list(PARAMS))
-@pytest.mark.parametrize("bad", [math.nan, math.inf, -math.inf, -1.0, 0.0])
+ZERO_IS_VALID = ("v", "sphere_nu", "plate_nu")  # a ball at rest; a material with nu = 0
+
+
+@pytest.mark.parametrize("name,bad", [(name, bad) for name in PARAMS
+                                      for bad in (math.nan, math.inf, -math.inf, -1.0, 0.0)
+                                      if not (bad == 0.0 and name in ZERO_IS_VALID)])
 def test_bad_input_names_parameter_value_and_range(name, bad):
-    if name == "v" and bad == 0.0 or name.endswith("_nu") and bad == 0.0:
-        return  # zero speed and nu = 0 are valid
     args = dict(PARAMS, **{name: bad})
     with pytest.raises(ValueError) as err:
         r.impact(**args)
     label = "v_approach" if name == "v" else name.replace("_", ".", 1)
     assert label in str(err.value) and repr(bad) in str(err.value) and "allowed range" in str(err.value)
+
+
+@pytest.mark.parametrize("name", ZERO_IS_VALID)
+def test_zero_speed_and_zero_poisson_ratio_are_valid(name):
+    res = r.impact(**dict(PARAMS, **{name: 0.0}))
+    assert all(math.isfinite(x) for x in (res.e, res.e_ep, res.e_ze, res.lam, res.V_c, res.t_contact))
+    if name == "v":  # no impact: no loss, no contact time, e = 1
+        assert res.e == 1.0 and res.t_contact == 0.0 and res.lam == 0.0
+    else:  # E_i' = E_i exactly
+        assert 0.0 < res.e < 1.0
 
 
 @pytest.mark.parametrize("nu", [0.5, 0.7])
