@@ -11,26 +11,16 @@ import math
 import mpmath as mp
 import numpy as np
 import pytest
-from scipy.integrate import solve_ivp
 from scipy.optimize import curve_fit
 
 import restitution as r
 from restitution import jgm, zener
 
+from independent import e44_printed, e45_printed, hertz_duration, solve_zener
+
 M = r.MATERIALS
 PAIRS = [("s2_tool_steel", "al_6061"), ("tungsten_carbide", "stainless_440c"), ("brass_260", "s7_tool_steel"),
          ("borosilicate_glass", "borosilicate_glass"), ("nitinol_60", "nitinol_60"), ("chrome_steel", "s7_tool_steel")]
-
-
-def hertz_duration(sphere, plate, d, v):
-    """Hertz contact duration of a sphere on a half-space [s], written here from the textbook
-    (Johnson, Contact Mechanics, Sec. 11.4): t = 2.94328 (5 m / (4 k))^(2/5) v^(-1/5), F = k delta^(3/2),
-    k = (4/3) E* sqrt(R), R = d/2, 1/E* = (1 - nu_a^2)/E_a + (1 - nu_b^2)/E_b, m = rho pi d^3 / 6.
-    2.94328 = 2 int_0^1 dx / sqrt(1 - x^(5/2)) (the constant is checked below)."""
-    e_star = 1.0 / ((1 - sphere.nu ** 2) / sphere.E + (1 - plate.nu ** 2) / plate.E)
-    k = 4.0 / 3.0 * e_star * math.sqrt(d / 2)
-    m = sphere.rho * math.pi * d ** 3 / 6
-    return 2.94328 * (5 * m / (4 * k)) ** 0.4 * v ** -0.2
 
 
 def test_hertz_constant():
@@ -87,19 +77,6 @@ def test_eq23_is_the_fit_of_eq22_on_the_studied_range():
 
 
 # --- JGM Eqs. (7), (8) as printed, in 30-digit arithmetic -----------------------------------------
-def e45_printed(v_star, eps_y):
-    v, eps = mp.mpf(v_star), mp.mpf(eps_y)
-    return 1 - mp.mpf("0.0361") * eps ** mp.mpf("-0.114") * mp.log(v) * (v - 1) ** (mp.mpf("9.5") * eps)
-
-
-def e44_printed(v_star):
-    v = mp.mpf(v_star)
-    if v <= 60:
-        return 1 - mp.mpf("0.1") * mp.log(v) * ((v - 1) / 59) ** mp.mpf("0.156")
-    # second branch as reconstructed (ERRATA.md): ((V* - 60)/940)^2.366
-    return 1 - mp.mpf("0.1") * mp.log(60) - mp.mpf("0.11") * mp.log(v / 60) * ((v - 60) / 940) ** mp.mpf("2.366")
-
-
 @pytest.mark.parametrize("v_star", [1.0 + 1e-9, 1.001, 1.5, 10.0, 86.9, 500.0, 1000.0])
 @pytest.mark.parametrize("eps_y", [0.001, 0.0050200821, 0.03])
 def test_e45_equals_the_printed_equation(v_star, eps_y):
@@ -128,27 +105,6 @@ def test_checkpoint_e45_at_the_paper_speed():
 
 
 # --- Zener's ODE, Eq. (10), solved here ---------------------------------------------------------------
-def solve_zener(lam, rtol=1e-12):
-    """e_ze and tau0 of Eq. (10)-(11) in Zener's p-form (sigma' = p - lambda sigma^1.5,
-    p' = -sigma^1.5), Radau with its Jacobian, the rebound as a terminal event. Written for the
-    tests, independent of restitution.zener_ode and of the exact method's table."""
-    def rhs(t, y):
-        s15 = max(y[0], 0.0) ** 1.5
-        return [y[1] - lam * s15, -s15]
-
-    def jac(t, y):
-        s = max(y[0], 0.0)
-        return [[-1.5 * lam * s ** 0.5, 1.0], [-1.5 * s ** 0.5, 0.0]]
-
-    def back(t, y):
-        return y[0]
-    back.terminal, back.direction = True, -1
-    t0 = 1e-6  # sigma = tau, p = 1 to O(tau^2.5) = 1e-15
-    sol = solve_ivp(rhs, (t0, 50.0 + 20 * lam * math.log1p(lam)), [t0, 1.0], method="Radau", jac=jac,
-                    rtol=rtol, atol=1e-14 * min(1.0, lam ** -5), events=back, first_step=1e-7)
-    return -sol.y_events[0][0][1], sol.t_events[0][0]
-
-
 def test_first_order_loss_is_the_hertz_energy_integral():
     """1 - e_ze = c1 lambda + ...: to first order the energy the damping term takes from the Hertz
     trajectory, c1 = 3 int_0^sm sigma^(1/2) sqrt(1 - (4/5) sigma^(5/2)) dsigma, sm = (5/4)^(2/5)."""

@@ -5,22 +5,15 @@ critical velocity and Eq. (12)'s lambda evaluated here in 30-digit arithmetic fr
 from __future__ import annotations
 
 import itertools
-import tomllib
-from pathlib import Path
 
 import mpmath as mp
 import pytest
 
 import restitution as r
 
-TABLES = tomllib.loads((Path(__file__).parent / "data" / "paper_tables.toml").read_text())
+from independent import TABLES, printed_equations, table_material, table_rows
+
 M = r.MATERIALS
-
-
-def table_rows():
-    for table in ("table1", "table2", "table3"):
-        for key, row in TABLES[table].items():
-            yield table, key, row
 
 
 @pytest.mark.parametrize("table,key,row", list(table_rows()), ids=lambda x: x if isinstance(x, str) else "")
@@ -53,40 +46,13 @@ def test_table4_cases(case):
     assert plate.Sy == t4["plate_Sy"][case[1]] and sphere.Sy == 1e12
 
 
-def _table_material(key):
-    """E, nu, Sy, rho of a preset, merged from the table rows (never from restitution)."""
-    merged = {}
-    for _table, k, row in table_rows():
-        if k == key:
-            merged.update({p: row[p] for p in ("E", "nu", "Sy", "rho") if p in row})
-    return {p: mp.mpf(repr(float(merged[p]))) for p in ("E", "nu", "Sy", "rho")}
-
-
-def printed_equations(a, b, d, t, v):
-    """(eps_y, V_c, lambda) of Eqs. (1)-(6), (12) as printed, in mpmath."""
-    ea, eb = a["E"] / (1 - a["nu"] ** 2), b["E"] / (1 - b["nu"] ** 2)   # Eq. (1)
-    e_prime = ea * eb / (ea + eb)
-    ca, cb = 1.295 * mp.exp(mp.mpf("0.736") * a["nu"]), 1.295 * mp.exp(mp.mpf("0.736") * b["nu"])  # Eq. (2)
-    c_sy = min(ca * a["Sy"], cb * b["Sy"])
-    eps_y = (a["Sy"] if ca * a["Sy"] <= cb * b["Sy"] else b["Sy"]) / e_prime    # Eq. (3)
-    R = mp.mpf(d) / 2
-    omega_c = (mp.pi * c_sy / (2 * e_prime)) ** 2 * R                           # Eq. (4)
-    p_c = mp.mpf(4) / 3 * (R / e_prime) ** 2 * (mp.pi / 2 * c_sy) ** 3           # Eq. (5)
-    m_a = a["rho"] * mp.pi * mp.mpf(d) ** 3 / 6
-    v_c = mp.sqrt(4 * omega_c * p_c / (5 * m_a))                                # Eq. (6)
-    v_prime = mp.sqrt(eb / b["rho"])
-    lam = (mp.pi ** (mp.mpf(3) / 5) / mp.sqrt(3) * (R / mp.mpf(t)) ** 2 * (mp.mpf(v) / v_prime) ** (mp.mpf(1) / 5)
-           * (a["rho"] / b["rho"]) ** (mp.mpf(3) / 5) * (ea / (ea + eb)) ** (mp.mpf(2) / 5))  # Eq. (12)
-    return eps_y, v_c, lam
-
-
 @pytest.mark.parametrize("sphere,plate", list(itertools.product(sorted(M), ["al_6061", "s7_tool_steel",
                                                                                "stainless_440c", "nitinol_60",
                                                                                "borosilicate_glass"])))
 def test_every_preset_through_the_printed_equations(sphere, plate):
     mp.mp.dps = 30
     d, t, v = 6.35e-3, 3.18e-3, 2.3
-    eps_y, v_c, lam = printed_equations(_table_material(sphere), _table_material(plate), d, t, v)
+    eps_y, v_c, lam = printed_equations(table_material(sphere), table_material(plate), d, t, v)
     res = r.impact_between(r.Sphere(M[sphere], d), r.Plate(M[plate], t), v)
     assert res.eps_y == pytest.approx(float(eps_y), rel=1e-13)
     assert res.V_c == pytest.approx(float(v_c), rel=1e-13)
@@ -96,5 +62,5 @@ def test_every_preset_through_the_printed_equations(sphere, plate):
 def test_paper_checkpoint_from_the_table():
     """Sec. 7: S2 tool steel on Al 6061 (Table 3): V_c = 0.0265 m/s, V* = 86.9 at 2.3 m/s."""
     mp.mp.dps = 30
-    _eps, v_c, _lam = printed_equations(_table_material("s2_tool_steel"), _table_material("al_6061"), 6.35e-3, 6.35e-3, 2.3)
+    _eps, v_c, _lam = printed_equations(table_material("s2_tool_steel"), table_material("al_6061"), 6.35e-3, 6.35e-3, 2.3)
     assert round(float(v_c), 4) == 0.0265 and round(2.3 / float(v_c), 1) == 86.9
