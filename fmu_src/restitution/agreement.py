@@ -79,6 +79,7 @@ def tolerances(v, params: dict, **options) -> tuple[dict, dict]:
         for flag in FLAGS:
             b = getattr(base, flag)
             flips[flag] |= (getattr(up, flag) != b) | (getattr(down, flag) != b)
+
     def scale(out):  # what the bound multiplies: |y| for relative outputs, 1 (or v, in m/s) for absolute ones
         if out == "v_rebound":
             return values["v"]
@@ -87,9 +88,9 @@ def tolerances(v, params: dict, **options) -> tuple[dict, dict]:
     tol = {out: ULPS * EPS * (1.0 + total[out]) * scale(out) for out in REALS}
     if method == "ode":  # plus the solver's own tolerance: its adaptive steps may be chosen differently
         rtol = options.get("ode_rtol", 1e-10)
-        d_ze = 1.0 - np.asarray(base.e_ze)
+        e_ze = np.asarray(base.e_ze)
         with np.errstate(divide="ignore", invalid="ignore"):
-            via_deficit = np.where(d_ze > 0.0, np.asarray(base.e_ze) / d_ze, 0.0)
+            via_deficit = np.where(e_ze < 1.0, e_ze / (1.0 - e_ze), 0.0)
         for out in REALS:
             factor = 1.0 + via_deficit if out in ("m_eff", "v_plate") else 1.0
             tol[out] = tol[out] + 100.0 * rtol * factor * scale(out)

@@ -120,29 +120,36 @@ class PackageBackend(Backend):
     default_chunk = 100_000
 
     def evaluate(self, cases: dict, payload=None, outputs=None):
-        from ..model import EFFECT_MODES, RESTITUTION_MODELS, ZENER_METHODS, impact
+        from ..model import impact
 
         n = np.size(cases["v_approach"])
         out = _empty_outputs(n)
-        ok = inputs_ok(cases)
-        if ok.any():
-            options = np.stack([np.asarray(cases[k], dtype=float) for k in _OPTION_NAMES], axis=1)
-            groups, inverse = np.unique(options[ok], axis=0, return_inverse=True)
-            rows = np.flatnonzero(ok)
-            for g, opt in enumerate(groups):
-                sel = rows[inverse.ravel() == g]
-                kwargs = {kw: np.asarray(cases[name], dtype=float)[sel]
-                          for name, kw, _t, _s in INPUTS if name not in _OPTION_NAMES}
-                result = impact(**kwargs,
-                                restitution_model=RESTITUTION_MODELS[int(opt[0]) - 1],
+        for sel, inputs, options in impact_groups(cases, np.flatnonzero(inputs_ok(cases))):
+            values = impact(**inputs, **options, validate=False).as_dict()
+            for name, field_name, _t in OUTPUTS:
+                out[name][sel] = values[field_name]
+            out["ok"][sel] = True
+        return out, {"code": _own_fingerprint(), "pid": os.getpid()}
+
+
+def impact_groups(cases: dict, rows):
+    """(rows, impact() input arrays, impact() option keywords) for the ``rows`` of ``cases``,
+    grouped by their integer-coded options (one vectorized call per group)."""
+    from ..model import EFFECT_MODES, RESTITUTION_MODELS, ZENER_METHODS
+
+    rows = np.asarray(rows)
+    if rows.size == 0:
+        return
+    options = np.stack([np.asarray(cases[k], dtype=float)[rows] for k in _OPTION_NAMES], axis=1)
+    groups, inverse = np.unique(options, axis=0, return_inverse=True)
+    for g, opt in enumerate(groups):
+        sel = rows[inverse.ravel() == g]
+        inputs = {kw: np.asarray(cases[name], dtype=float)[sel]
+                  for name, kw, _t, _s in INPUTS if name not in _OPTION_NAMES}
+        yield sel, inputs, dict(restitution_model=RESTITUTION_MODELS[int(opt[0]) - 1],
                                 zener_method=ZENER_METHODS[int(opt[1]) - 1],
                                 plasticity=EFFECT_MODES[int(opt[2])], plate_waves=EFFECT_MODES[int(opt[3])],
-                                effect_tolerance=float(opt[4]), ode_rtol=float(opt[5]), validate=False)
-                values = result.as_dict()
-                for name, field_name, _t in OUTPUTS:
-                    out[name][sel] = values[field_name]
-                out["ok"][sel] = True
-        return out, {"code": _own_fingerprint(), "pid": os.getpid()}
+                                effect_tolerance=float(opt[4]), ode_rtol=float(opt[5]))
 
 
 # --- the FMU back end --------------------------------------------------------------------

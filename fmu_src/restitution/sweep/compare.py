@@ -10,14 +10,12 @@ from __future__ import annotations
 import numpy as np
 
 from ..agreement import disagreements, tolerances
-from ..model import EFFECT_MODES, RESTITUTION_MODELS, ZENER_METHODS
-from .spec import INPUTS, OUTPUTS
+from .backends import impact_groups
+from .spec import OUTPUTS
 
 __all__ = ["agreement_report"]
 
-_OPTIONS = ("restitution_model", "zener_method", "plasticity", "plate_waves", "effect_tolerance",
-            "zener.ode_tolerance")
-_FIELD = {name: field for name, field, _type in OUTPUTS}
+_NAME_OF_FIELD = {field: name for name, field, _type in OUTPUTS}  # ImpactResult field -> column
 
 
 class _Columns:
@@ -27,10 +25,9 @@ class _Columns:
         self._columns, self._sel = columns, sel
 
     def __getattr__(self, field):
-        for name, f in _FIELD.items():
-            if f == field:
-                return np.asarray(self._columns[name])[self._sel]
-        raise AttributeError(field)
+        if field not in _NAME_OF_FIELD:
+            raise AttributeError(field)
+        return np.asarray(self._columns[_NAME_OF_FIELD[field]])[self._sel]
 
 
 def agreement_report(a: dict, b: dict) -> tuple[int, dict]:
@@ -41,21 +38,8 @@ def agreement_report(a: dict, b: dict) -> tuple[int, dict]:
     ok = np.asarray(a["ok"], dtype=bool) & np.asarray(b["ok"], dtype=bool)
     problems: dict = {}
     rows = np.flatnonzero(ok)
-    if rows.size == 0:
-        return 0, problems
-    options = np.stack([np.asarray(a[name], dtype=float)[rows] for name in _OPTIONS], axis=1)
-    groups, inverse = np.unique(options, axis=0, return_inverse=True)
-    for g, opt in enumerate(groups):
-        sel = rows[inverse.ravel() == g]
-        kwargs = dict(restitution_model=RESTITUTION_MODELS[int(opt[0]) - 1],
-                      zener_method=ZENER_METHODS[int(opt[1]) - 1], plasticity=EFFECT_MODES[int(opt[2])],
-                      plate_waves=EFFECT_MODES[int(opt[3])], effect_tolerance=float(opt[4]),
-                      ode_rtol=float(opt[5]))
-        inputs = {kw: np.asarray(a[name], dtype=float)[sel] for name, kw, _t, _s in INPUTS if name not in _OPTIONS}
-        v = inputs.pop("v")
-        tol, flips = tolerances(v, inputs, **kwargs)
+    for sel, inputs, options in impact_groups(a, rows):
+        tol, flips = tolerances(inputs.pop("v"), inputs, **options)
         for line in disagreements(_Columns(a, sel), _Columns(b, sel), tol, flips):
-            field = line.split(":", 1)[0]
-            name = next(n for n, f in _FIELD.items() if f == field)
-            problems.setdefault(name, line)
+            problems.setdefault(_NAME_OF_FIELD[line.split(":", 1)[0]], line)
     return int(rows.size), problems
