@@ -163,3 +163,47 @@ def test_e45_never_underflows_just_above_yield_onset_for_any_preset_pair():
             assert np.all((e >= 0.0) & (e <= 1.0)), (a, b)
             assert np.all(np.diff(e) <= 1e-15), (a, b)
             np.testing.assert_allclose(scalars, e[::37], rtol=0, atol=1e-15)
+
+
+@pytest.mark.parametrize("lam", [1e-12, 1e-6, 0.01, 0.5, 1.0, 1.5, 1.99])
+def test_linear_method_equals_the_closed_form_of_eq22_in_mpmath(lam):
+    """Eq. (22)'s closed form (ERRATA.md): e = exp(-pi lam / sqrt(4 - lam^2)), tau0 = 2 pi / sqrt(4 - lam^2),
+    evaluated in 40 digits; the deficit 1 - e to full relative accuracy (condition number ~1 in lam)."""
+    mp.mp.dps = 40
+    x = mp.mpf(lam)
+    e_ref = mp.exp(-mp.pi * x / mp.sqrt(4 - x * x))
+    tau_ref = 2 * mp.pi / mp.sqrt(4 - x * x)
+    for arg in (lam, np.array([lam])):
+        e, d, tau0 = zener.zener_solution(arg, "linear")
+        assert float(np.squeeze(e)) == pytest.approx(float(e_ref), rel=4e-16)
+        assert float(np.squeeze(d)) == pytest.approx(float(1 - e_ref), rel=4e-15)
+        assert float(np.squeeze(tau0)) == pytest.approx(float(tau_ref), rel=4e-16)
+
+
+@pytest.mark.parametrize("lam", [2.0, 2.5, 1e3])
+def test_linear_method_beyond_critical_damping_holds_contact_without_a_floating_point_error(lam):
+    """At and above lambda = 2 the linear oscillator never returns to sigma = 0: e = 0, 1 - e = 1,
+    tau0 = inf (exactly, with no division by zero on the way)."""
+    with np.errstate(all="raise"):
+        for arg in (lam, np.array([lam, 0.5])):
+            e, d, tau0 = zener.zener_solution(arg, "linear")
+            assert float(np.ravel(e)[0]) == 0.0 and float(np.ravel(d)[0]) == 1.0
+            assert math.isinf(float(np.ravel(tau0)[0]))
+
+
+def test_eq3_sends_a_tie_to_the_sphere_as_printed():
+    """Eq. (3) as printed: eps_y = S_ya / E' when C(nu_a) S_ya <= C(nu_b) S_yb. An exact floating-point
+    tie with different nu and Sy (found by search around the real root) must take the sphere's Sy."""
+    nu_a, nu_b, sy_a = 0.3, 0.2, 500e6
+    target = jgm.poisson_coefficient(nu_a) * sy_a
+    guess = target / jgm.poisson_coefficient(nu_b)
+    tie = None
+    for steps in range(-8, 9):
+        sy_b = guess + steps * math.ulp(guess)
+        if jgm.poisson_coefficient(nu_b) * sy_b == target:
+            tie = sy_b
+            break
+    assert tie is not None and tie != sy_a
+    assert jgm.sphere_yields_first(nu_a, sy_a, nu_b, tie)
+    assert jgm.yield_strain(100e9, nu_a, sy_a, nu_b, tie) == sy_a / 100e9
+    assert not jgm.sphere_yields_first(nu_a, sy_a, nu_b, tie - math.ulp(tie))

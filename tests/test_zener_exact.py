@@ -223,3 +223,49 @@ def test_invalid_message_names_value():
         zener_exact(-1.0)
     with pytest.raises(ValueError, match=r"got lambda=nan \(at index \(1, 0\)\)"):
         zener_exact(np.array([[1.0, 2.0], [np.nan, 3.0]]))
+
+
+# (h) ----------------------------------------------------------------------------------------
+# The table's pieces are built once at import. Rebuilding them here, at test time, from the data
+# file through the same functions, and checking the rebuilt interpolant against the independent
+# solves, tests the loader and the Hermite construction themselves (a mutation tool switches
+# mutants on per call, after import, so the import-time build is out of its reach otherwise).
+def _rebuilt_pieces(monkeypatch, table):
+    import restitution.zener_exact as ze
+
+    coef, coef_arr = ze._build_pieces(table)
+    monkeypatch.setattr(ze, "_COEF", coef)
+    monkeypatch.setattr(ze, "_COEF_ARR", coef_arr)
+    return ze
+
+
+@pytest.mark.parametrize("from_zip", [False, True], ids=["file", "importlib.resources"])
+def test_table_rebuilt_at_test_time_matches_independent_solution(monkeypatch, ref_values, from_zip):
+    import restitution.zener_exact as ze
+
+    if from_zip:  # the package imported from a zip: the file path does not exist
+        monkeypatch.setattr(ze.os.path, "exists", lambda path: False)
+    table = ze._load_table()
+    assert {"k", "e", "de", "tau0", "dtau0", "h"} <= set(table)
+    ze = _rebuilt_pieces(monkeypatch, table)
+    lams = np.array(sorted(ref_values))
+    e_arr, d_arr, t_arr = ze.zener_exact_solution(lams)
+    for i, lam in enumerate(lams):
+        e_ref, t_ref = ref_values[float(lam)]
+        e, d, t = ze.zener_exact_solution(float(lam))
+        for got in ((e, d, t), (e_arr[i], d_arr[i], t_arr[i])):
+            assert rel(got[0], e_ref) <= 1e-8 and rel(got[2], t_ref) <= 1e-8, (lam, got, e_ref, t_ref)
+            # the deficit pieces: 1 - e_ze to the reference's absolute accuracy, and
+            # relative accuracy where it is small (lambda -> 0: 1.7302 lambda)
+            assert abs(got[1] - (1.0 - e_ref)) <= 1e-8 * max(e_ref, 1e-3), (lam, got[1], 1.0 - e_ref)
+    tiny = 1e-9
+    assert rel(ze.zener_exact_solution(tiny)[1], 1.7301733 * tiny) < 1e-6
+
+
+def test_table_with_a_bad_node_layout_is_refused():
+    import restitution.zener_exact as ze
+
+    good = ze._load_table()
+    for broken_k in (good["k"] + 1, good["k"][::-1], good["k"][:-200]):
+        with pytest.raises(RuntimeError, match="bad node layout"):
+            ze._build_pieces(dict(good, k=broken_k))

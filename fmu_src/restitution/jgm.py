@@ -12,7 +12,7 @@ from ._num import exp, log, minimum, maximum, sqrt, where
 
 __all__ = [
     "reduced_modulus", "effective_modulus", "poisson_coefficient", "critical_pressure",
-    "sphere_yields_first", "yield_strain", "critical_interference", "critical_load",
+    "sphere_yields_first", "vstar_in_fit_range", "yield_strain", "critical_interference", "critical_load",
     "sphere_mass", "critical_velocity", "restitution_e45", "restitution_e44",
     "VSTAR_FIT_MAX", "E44_BRANCH_JOIN",
 ]
@@ -47,6 +47,11 @@ def poisson_coefficient(nu):
 def critical_pressure(nu_a, Sy_a, nu_b, Sy_b):
     """C S_y = min[C(nu_a) S_ya, C(nu_b) S_yb] [Pa], Eq. (2): the body with the smaller value yields first."""
     return minimum(poisson_coefficient(nu_a) * Sy_a, poisson_coefficient(nu_b) * Sy_b)
+
+
+def vstar_in_fit_range(v_star):
+    """True where V* <= 1000 [1], the range JGM's Eqs. (7)-(8) were fitted on (V* = 1000 included)."""
+    return v_star <= VSTAR_FIT_MAX
 
 
 def sphere_yields_first(nu_a, Sy_a, nu_b, Sy_b):

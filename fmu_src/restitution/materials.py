@@ -153,6 +153,7 @@ def table4_case(case: str) -> tuple[Material, Material]:
     light = dict(E=10e9, rho=2000.0)
     sphere_props, plate_props = (heavy, light) if family == "A" else (light, heavy)
     plate_sy = 10e6 * 10 ** (int(number) - 1)
+    case = family + number  # "a1" names the same case as "A1"
     sphere = Material(f"Table 4 {case} sphere", sphere_props["E"], 0.3, BRITTLE_SY, sphere_props["rho"], _T4_SPHERE_SY)
     plate = Material(f"Table 4 {case} plate", plate_props["E"], 0.3, plate_sy, plate_props["rho"], _T4)
     return sphere, plate

@@ -14,12 +14,12 @@ import numpy as np
 
 from ._num import is_scalar, where
 from .fusion import apparent_restitution, equivalent_plate_mass, velocities_after_impact
-from .jgm import (VSTAR_FIT_MAX, critical_interference, critical_load, critical_pressure,
+from .jgm import (critical_interference, critical_load, critical_pressure,
                   critical_velocity, effective_modulus, restitution_e44, restitution_e45,
-                  sphere_mass, yield_strain)
+                  sphere_mass, vstar_in_fit_range, yield_strain)
 from .validation import check_choice, check_nonnegative, check_poisson, check_positive
-from .zener import (LAMBDA_STUDIED_MAX, TAU0_HERTZ, ZENER_METHODS, contact_duration,
-                    hertz_stiffness, inelasticity_parameter, time_scale, zener_linear, zener_paper_fit,
+from .zener import (TAU0_HERTZ, ZENER_METHODS, contact_duration, hertz_stiffness, inelasticity_parameter,
+                    lambda_in_studied_range, time_scale, zener_linear, zener_paper_fit,
                     zener_solution)
 
 __all__ = ["ImpactResult", "impact", "RESTITUTION_MODELS", "EFFECT_MODES", "ZENER_SLOPE_BOUND",
@@ -87,9 +87,7 @@ class ImpactResult:
         return np.logical_and(self.lambda_in_range, self.vstar_in_range)
 
     def as_dict(self) -> dict:
-        d = dict(self.__dict__)  # the fields, in order (no other instance attributes)
-        if len(d) != len(_FIELD_NAMES):
-            d = {name: getattr(self, name) for name in _FIELD_NAMES}
+        d = dict(self.__dict__)  # the fields, in order: a frozen dataclass has no other instance attributes
         d["valid"] = self.valid
         return d
 
@@ -204,7 +202,7 @@ def _pipeline(v, params, scalar, restitution_model, zener_method, plasticity, pl
     _, v_plate = velocities_after_impact(v, e_ep, e_ze, d_ze)
 
     values = (e, e * v, e_ep, V_c, V_star, eps_y, e_ze, lam, tau0, T, t_contact, m_a, m_eff, v_plate,
-              e_ep < 1.0, needed, lam <= LAMBDA_STUDIED_MAX, V_star <= VSTAR_FIT_MAX, e < 0.0)
+              e_ep < 1.0, needed, lambda_in_studied_range(lam), vstar_in_fit_range(V_star), e < 0.0)
     out = object.__new__(ImpactResult)  # frozen dataclass: fill __dict__ directly, ~5x faster
     if scalar:  # every value is already a Python float or bool (math-module paths; the tests check it)
         out.__dict__.update(zip(_FIELD_NAMES, values))
@@ -261,7 +259,7 @@ def _zener_where_needed(lam, needed, method, rtol, skipped_tau0, scalar):
     (1, 0, ``skipped_tau0``) elsewhere."""
     if scalar:
         return zener_solution(lam, method, rtol) if needed else (1.0, 0.0, skipped_tau0)
-    lam = np.asarray(lam, dtype=float)
+    lam = np.asarray(lam)  # float already: Eq. (12) of float arrays
     needed = np.broadcast_to(needed, lam.shape)
     if needed.all():  # elementwise methods: same values as the masked evaluation, no gather/scatter
         return zener_solution(lam, method, rtol)

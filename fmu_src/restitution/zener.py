@@ -21,7 +21,7 @@ from .zener_exact import zener_exact_solution
 from .zener_ode import solve_zener_ode
 
 __all__ = [
-    "ZENER_METHODS", "LAMBDA_STUDIED_MAX", "TAU0_HERTZ", "plate_wave_speed", "inelasticity_parameter",
+    "ZENER_METHODS", "LAMBDA_STUDIED_MAX", "lambda_in_studied_range", "TAU0_HERTZ", "plate_wave_speed", "inelasticity_parameter",
     "hertz_stiffness", "time_scale", "zener_paper_fit", "zener_paper_fit_deficit", "zener_linear",
     "zener_linear_deficit", "zener_linear_fit", "zener_ode", "zener_restitution", "zener_solution",
     "contact_duration",
@@ -64,6 +64,11 @@ def hertz_stiffness(E_prime, d):
 def time_scale(m_a, k, v0):
     """Zener's time unit T = (m / (k v0^(1/2)))^(2/5) [s], Eq. (9). Infinite at v0 = 0."""
     return (m_a / (k * sqrt(v0))) ** 0.4
+
+
+def lambda_in_studied_range(lam):
+    """True where lambda <= 1.5 [1], the range on which Zener's Eqs. (13)-(13a) were fitted and studied."""
+    return lam <= LAMBDA_STUDIED_MAX
 
 
 def contact_duration(T, tau0):
@@ -136,7 +141,7 @@ def zener_ode(lam, rtol: float = 1e-10):
     """
     if is_scalar(lam):
         return solve_zener_ode(float(lam), rtol=rtol)
-    lam = np.asarray(lam, dtype=float)
+    lam = np.asarray(lam)  # each element goes through float() below
     e = np.empty(lam.shape)
     tau0 = np.empty(lam.shape)
     for i, value in np.ndenumerate(lam):

@@ -120,6 +120,15 @@ def _bad_lambda(value, where=""):
     )
 
 
+def _table_scalar(lam):
+    """(e_ze, 1 - e_ze, tau0) of a float 0 <= lambda <= LAMBDA_TABLE_MAX: one piece, three cubics."""
+    x = lam * _INV_H
+    k, a0, a1, a2, a3, c0, c1, c2, c3, b0, b1, b2, b3 = _COEF[int(x)]
+    t = x - k
+    return (a0 + t * (a1 + t * (a2 + t * a3)), c0 + t * (c1 + t * (c2 + t * c3)),
+            b0 + t * (b1 + t * (b2 + t * b3)))
+
+
 def _asym_scalar(lam):
     """Large-lambda form (lambda >= 6, used above LAMBDA_TABLE_MAX) for a float."""
     u = lam ** (-5.0 / 3.0)
@@ -134,6 +143,8 @@ def _asym_scalar(lam):
 
 def _scalar_general(lam):
     """Slow scalar path: ints, numpy scalars, lambda > LAMBDA_TABLE_MAX, and the errors."""
+    if isinstance(lam, (complex, np.complexfloating)):  # float() would drop the imaginary part
+        raise _bad_lambda(lam)
     try:
         x = float(lam)
     except (TypeError, ValueError):
@@ -141,11 +152,7 @@ def _scalar_general(lam):
     if not (x >= 0.0 and x < math.inf):
         raise _bad_lambda(x)
     if x <= LAMBDA_TABLE_MAX:
-        y = x * _INV_H
-        k, a0, a1, a2, a3, c0, c1, c2, c3, b0, b1, b2, b3 = _COEF[int(y)]
-        t = y - k
-        return (a0 + t * (a1 + t * (a2 + t * a3)), c0 + t * (c1 + t * (c2 + t * c3)),
-                b0 + t * (b1 + t * (b2 + t * b3)))
+        return _table_scalar(x)
     e, tau0 = _asym_scalar(x)
     return e, 1.0 - e, tau0
 
@@ -169,15 +176,18 @@ def _table_array(lam):
 
 
 def _asym_array(lam):
-    u = lam ** (-5.0 / 3.0)
-    z2 = 2.0 * (2.0 * u / _U_MAX - 1.0)
-    c = _G_CHEB
-    b1 = np.zeros_like(u)
-    b2 = np.zeros_like(u)
-    for k in range(len(c) - 1, 0, -1):
-        b1, b2 = c[k] + z2 * b1 - b2, b1
-    g = c[0] + 0.5 * z2 * b1 - b2
+    """:func:`_asym_scalar` for an array. u = lambda^(-5/3) and e_ze underflow to 0 for huge lambda
+    (u from ~1e184, e_ze from ~1e61): harmless, and the same silent 0 the float path gives, so numpy's
+    underflow flag is not raised to the caller; tau0 overflows to inf above lambda ~ 5e304."""
     with np.errstate(under="ignore", over="ignore"):
+        u = lam ** (-5.0 / 3.0)
+        z2 = 2.0 * (2.0 * u / _U_MAX - 1.0)
+        c = _G_CHEB
+        b1 = np.zeros_like(u)
+        b2 = np.zeros_like(u)
+        for k in range(len(c) - 1, 0, -1):
+            b1, b2 = c[k] + z2 * b1 - b2, b1
+        g = c[0] + 0.5 * z2 * b1 - b2
         e = E_INF * (1.0 / lam) ** 5
         tau = lam * (5.0 * np.log(lam) + g)
     return e, 1.0 - e, tau
@@ -252,19 +262,11 @@ def zener_exact_solution(lam):
     number ~ 1/(1 - e_ze), 1e16 at lambda ~ 1e-16). Interpolated directly it keeps full relative
     accuracy (condition number ~ 1 in lambda), and e_ze + (1 - e_ze) = 1 to rounding.
     """
-    if lam.__class__ is float and 0.0 <= lam <= 100.0:  # fast path (LAMBDA_TABLE_MAX = 100)
-        x = lam * _INV_H
-        k, a0, a1, a2, a3, c0, c1, c2, c3, b0, b1, b2, b3 = _COEF[int(x)]
-        t = x - k
-        return (a0 + t * (a1 + t * (a2 + t * a3)), c0 + t * (c1 + t * (c2 + t * c3)),
-                b0 + t * (b1 + t * (b2 + t * b3)))
-    if isinstance(lam, (int, float, np.number)) and not isinstance(lam, np.complexfloating):
-        return _scalar_general(lam)
-    if isinstance(lam, np.ndarray) or isinstance(lam, (list, tuple)):
+    if lam.__class__ is float and 0.0 <= lam <= 100.0:  # the common case first (LAMBDA_TABLE_MAX = 100)
+        return _table_scalar(lam)
+    if isinstance(lam, (np.ndarray, list, tuple)) or np.ndim(lam) != 0:
         return _array(lam)
-    if np.ndim(lam) == 0:  # other real scalars (Fraction, Decimal, ...)
-        return _scalar_general(lam)
-    return _array(lam)
+    return _scalar_general(lam)  # other scalars: int, numpy's, Fraction, Decimal; errors
 
 
 if LAMBDA_TABLE_MAX != 100.0:  # the literal in the fast path must match the table
