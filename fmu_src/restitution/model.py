@@ -23,7 +23,7 @@ from .zener import (TAU0_HERTZ, ZENER_METHODS, contact_duration, hertz_stiffness
                     zener_solution)
 
 __all__ = ["ImpactResult", "impact", "RESTITUTION_MODELS", "EFFECT_MODES", "ZENER_SLOPE_BOUND",
-           "PARAMETERS", "validate_parameters"]
+           "PARAMETERS", "DOMAIN", "validate_parameters"]
 
 RESTITUTION_MODELS = ("e45", "e44")
 EFFECT_MODES = ("off", "on", "auto")
@@ -40,6 +40,19 @@ PARAMETERS = (
     ("plate_rho", "kg/m3", "positive"), ("plate_t", "m", "positive"),
 )
 
+
+#: The domain the FMUs declare (min/max in modelDescription.xml) and the property tests cover, per
+#: argument of :func:`impact`: (low, high) [SI units of :data:`PARAMETERS`], both included; nu has
+#: its own [0, 0.5). Inside it every output is finite except the documented infinities (m_eff for
+#: e_ze = 1, T at v = 0, the linear method's tau0 and t_contact for lambda >= 2): wide enough for
+#: any solid (foams to osmium, rubber to diamond; BRITTLE_SY = 1e12 Pa included), spheres from
+#: 1 um to 10 m, plates from 0.1 um to 100 m, speeds up to 10 km/s. :func:`impact` itself accepts
+#: any positive value, where intermediate results may leave double range (over- or underflow).
+DOMAIN = {
+    "v": (0.0, 1e4),
+    "sphere_E": (1e5, 1e13), "sphere_Sy": (1e3, 1e13), "sphere_rho": (1.0, 1e5), "sphere_d": (1e-6, 10.0),
+    "plate_E": (1e5, 1e13), "plate_Sy": (1e3, 1e13), "plate_rho": (1.0, 1e5), "plate_t": (1e-7, 100.0),
+}
 
 _PARAMETER_CHECKS = tuple((name, name.replace("_", ".", 1), unit, kind) for name, unit, kind in PARAMETERS)
 

@@ -27,7 +27,7 @@ _HERE = os.path.dirname(os.path.abspath(__file__))
 if os.path.isdir(os.path.join(_HERE, "restitution")) and sys.path[0] != _HERE:
     sys.path.insert(0, _HERE)
 
-from restitution.model import EFFECT_MODES, RESTITUTION_MODELS, ZENER_METHODS, impact  # noqa: E402
+from restitution.model import DOMAIN, EFFECT_MODES, RESTITUTION_MODELS, ZENER_METHODS, impact  # noqa: E402
 from restitution.validation import interval_check  # noqa: E402
 
 P, IN, OUT = "parameter", "input", "output"
@@ -36,17 +36,17 @@ P, IN, OUT = "parameter", "input", "output"
 # inputs/parameters and the ImpactResult field for outputs. build_fmu.py reads this table
 # to write units, ranges and descriptions into modelDescription.xml.
 VARIABLES = (
-    ("v_approach", "Real", IN, "m/s", 1.0, "Normal approach speed of the sphere toward the plate, >= 0", "v"),
-    ("sphere.E", "Real", P, "Pa", 207e9, "Sphere elastic modulus, > 0 (default: S2 tool steel, Table 3)", "sphere_E"),
+    ("v_approach", "Real", IN, "m/s", 1.0, "Normal approach speed of the sphere toward the plate, 0 to 1e4 m/s", "v"),
+    ("sphere.E", "Real", P, "Pa", 207e9, "Sphere elastic modulus, 1e5 to 1e13 Pa (default: S2 tool steel, Table 3)", "sphere_E"),
     ("sphere.nu", "Real", P, "1", 0.30, "Sphere Poisson's ratio, 0 <= nu < 0.5", "sphere_nu"),
-    ("sphere.Sy", "Real", P, "Pa", 2.0e9, "Sphere yield strength, > 0 (1e12 for brittle materials)", "sphere_Sy"),
-    ("sphere.rho", "Real", P, "kg/m3", 7861.0, "Sphere density, > 0", "sphere_rho"),
-    ("sphere.d", "Real", P, "m", 6.35e-3, "Sphere diameter, > 0", "sphere_d"),
-    ("plate.E", "Real", P, "Pa", 69e9, "Plate elastic modulus, > 0 (default: Al 6061, Table 3)", "plate_E"),
+    ("sphere.Sy", "Real", P, "Pa", 2.0e9, "Sphere yield strength, 1e3 to 1e13 Pa (1e12 for brittle materials)", "sphere_Sy"),
+    ("sphere.rho", "Real", P, "kg/m3", 7861.0, "Sphere density, 1 to 1e5 kg/m3", "sphere_rho"),
+    ("sphere.d", "Real", P, "m", 6.35e-3, "Sphere diameter, 1e-6 to 10 m", "sphere_d"),
+    ("plate.E", "Real", P, "Pa", 69e9, "Plate elastic modulus, 1e5 to 1e13 Pa (default: Al 6061, Table 3)", "plate_E"),
     ("plate.nu", "Real", P, "1", 0.33, "Plate Poisson's ratio, 0 <= nu < 0.5", "plate_nu"),
-    ("plate.Sy", "Real", P, "Pa", 0.290e9, "Plate yield strength, > 0 (1e12 for brittle materials)", "plate_Sy"),
-    ("plate.rho", "Real", P, "kg/m3", 2700.0, "Plate density, > 0", "plate_rho"),
-    ("plate.t", "Real", P, "m", 6.35e-3, "Plate thickness, > 0", "plate_t"),
+    ("plate.Sy", "Real", P, "Pa", 0.290e9, "Plate yield strength, 1e3 to 1e13 Pa (1e12 for brittle materials)", "plate_Sy"),
+    ("plate.rho", "Real", P, "kg/m3", 2700.0, "Plate density, 1 to 1e5 kg/m3", "plate_rho"),
+    ("plate.t", "Real", P, "m", 6.35e-3, "Plate thickness, 1e-7 to 100 m", "plate_t"),
     ("restitution_model", "Integer", P, None, 1,
      "Elastoplastic COR: 1 = e45 (Eq. 8, default), 2 = e44 (Eq. 7, second branch reconstructed)",
      "restitution_model"),
@@ -89,6 +89,7 @@ _CHOICES = {
     "plate_waves": (EFFECT_MODES, "0 = off, 1 = on or 2 = auto"),
 }
 _CODE_OFFSET = {"restitution_model": 1, "zener_method": 1, "plasticity": 0, "plate_waves": 0}
+_PACKAGE_KEY = {row[0]: row[6] for row in VARIABLES}
 
 
 def allowed_interval(name):
@@ -101,7 +102,10 @@ def allowed_interval(name):
         return low, low + len(_CHOICES[name][0]) - 1, False, False
     if name.endswith(".nu"):
         return 0.0, 0.5, False, True
-    if name in ("v_approach", "effect_tolerance"):
+    if _PACKAGE_KEY.get(name) in DOMAIN:  # the package's declared domain: every output finite inside it
+        low, high = DOMAIN[_PACKAGE_KEY[name]]
+        return low, high, False, False
+    if name == "effect_tolerance":
         return 0.0, math.inf, False, True
     if name == "zener.ode_tolerance":
         return 1e-14, 1e-2, False, False
