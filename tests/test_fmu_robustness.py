@@ -28,18 +28,19 @@ from fmpy import extract
 
 import restitution as r
 from restitution.cosim import FmiStatusError, FmuInstance, impact_fmu_parameters
+from restitution.model import DOMAIN
 
 FMI_OK, FMI_DISCARD, FMI_ERROR, FMI_FATAL = 0, 2, 3, 4
 
 # name: (start value, allowed-range text as logged) -- the public interface contract
 INPUTS = {
-    "v_approach": (1.0, "finite and >= 0"),
-    "sphere.E": (207e9, "finite and > 0"), "sphere.nu": (0.30, "0 <= value < 0.5"),
-    "sphere.Sy": (2.0e9, "finite and > 0"), "sphere.rho": (7861.0, "finite and > 0"),
-    "sphere.d": (6.35e-3, "finite and > 0"),
-    "plate.E": (69e9, "finite and > 0"), "plate.nu": (0.33, "0 <= value < 0.5"),
-    "plate.Sy": (0.290e9, "finite and > 0"), "plate.rho": (2700.0, "finite and > 0"),
-    "plate.t": (6.35e-3, "finite and > 0"),
+    "v_approach": (1.0, "0 <= value <= 10000"),
+    "sphere.E": (207e9, "100000 <= value <= 1e+13"), "sphere.nu": (0.30, "0 <= value < 0.5"),
+    "sphere.Sy": (2.0e9, "1000 <= value <= 1e+13"), "sphere.rho": (7861.0, "1 <= value <= 100000"),
+    "sphere.d": (6.35e-3, "1e-06 <= value <= 10"),
+    "plate.E": (69e9, "100000 <= value <= 1e+13"), "plate.nu": (0.33, "0 <= value < 0.5"),
+    "plate.Sy": (0.290e9, "1000 <= value <= 1e+13"), "plate.rho": (2700.0, "1 <= value <= 100000"),
+    "plate.t": (6.35e-3, "1e-07 <= value <= 100"),
     "effect_tolerance": (1e-6, "finite and >= 0"),
     "zener.ode_tolerance": (1e-10, "1e-14 <= value <= 1e-2"),
     "restitution_model": (1, "1 = e45 or 2 = e44"),
@@ -49,6 +50,8 @@ INPUTS = {
 }
 CODES = {"restitution_model": (1, 2), "zener_method": (1, 4), "plasticity": (0, 2), "plate_waves": (0, 2)}
 INF, NAN = math.inf, math.nan
+DOMAIN_OF = {"v_approach": "v", **{f"{body}.{p}": f"{body}_{p}" for body in ("sphere", "plate")
+                                   for p in ("E", "Sy", "rho")}, "sphere.d": "sphere_d", "plate.t": "plate_t"}
 
 
 def _bad_values(name):
@@ -58,7 +61,10 @@ def _bad_values(name):
     values = [NAN, INF, -INF]
     if name.endswith(".nu"):
         return values + [-0.1, 0.5, 0.7]
-    if name in ("v_approach", "effect_tolerance"):
+    if name in DOMAIN_OF:  # the declared domain (restitution.model.DOMAIN): just outside either end
+        low, high = DOMAIN[DOMAIN_OF[name]]
+        return values + [-1.0, math.nextafter(low, -INF), high * (1 + 1e-15), 1e300]
+    if name == "effect_tolerance":
         return values + [-1.0, -5e-324]
     if name == "zener.ode_tolerance":
         return values + [-1e-10, 0.0, 1e-15, 0.1]
@@ -168,11 +174,12 @@ def test_bad_value_during_initialization(impact_fmu, unzipped, name, value):
         assert_outputs(fmu, {}, name)
 
 
-@pytest.mark.parametrize("name,value", [("sphere.E", 1e308), ("plate.t", 1e-300), ("sphere.d", 5e-324),
-                                        ("plate.E", 5e-324), ("v_approach", 1e300), ("sphere.rho", 1e300)])
+@pytest.mark.parametrize("name,value", [("sphere.E", 1e13), ("plate.t", 1e-7), ("sphere.d", 1e-6),
+                                        ("plate.E", 1e5), ("v_approach", 1e4), ("sphere.rho", 1e5),
+                                        ("plate.t", 100.0), ("sphere.Sy", 1e3)])
 def test_valid_but_absurd_values_are_never_fatal(impact_fmu, unzipped, name, value):
-    """In range but physically absurd: either finite results, or a logged evaluation failure and
-    fmi2Discard; never fmi2Fatal, and valid values recover."""
+    """At the ends of the declared domain (physically extreme): either finite results, or a logged
+    evaluation failure and fmi2Discard; never fmi2Fatal, and valid values recover."""
     with FmuInstance(impact_fmu, "absurd", unzip_dir=unzipped) as fmu:
         fmu.set(**{name: value})
         try:
@@ -379,7 +386,7 @@ def test_state_captured_while_invalid_restores_the_complaint(impact_fmu, unzippe
         fmu.do_step(0.0, 0.1)
         assert_outputs(fmu, {}, "good state")
         fmu.slave.setFMUstate(fmu.slave.deSerializeFMUstate(bad_blob))
-        assert fmu.messages[-1] == (FMI_ERROR, _message_for("plate.t", NAN, "finite and > 0"))
+        assert fmu.messages[-1] == (FMI_ERROR, _message_for("plate.t", NAN, INPUTS["plate.t"][1]))
         with pytest.raises(FmiStatusError) as err:
             fmu.do_step(0.1, 0.1)
         assert err.value.status == FMI_DISCARD

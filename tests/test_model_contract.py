@@ -223,6 +223,21 @@ def test_zener_exact_array_of_only_large_lambda_raises_no_floating_point_error()
         assert (e[i], d[i]) == pytest.approx(zener_exact.zener_exact_solution(lam)[:2], rel=8e-16, abs=0.0)
 
 
+def test_zener_exact_takes_any_array_like():
+    e, d, tau0 = zener_exact.zener_exact_solution(range(3))
+    assert e.__class__ is np.ndarray and e.shape == (3,) and e[0] == 1.0
+
+
+def test_unchecked_calls_still_read_exact_numbers_as_floats():
+    """validate=False skips the checks, not the conversion to float arrays."""
+    ref = r.impact(np.array([2.0, 4.0]), **PARAMS)
+    exact = {name: np.array([Fraction(value)] * 2, dtype=object) for name, value in PARAMS.items()}
+    got = r.impact(np.array([Fraction(2), Fraction(4)], dtype=object), **exact, validate=False)
+    for f in FIELDS:
+        assert getattr(got, f).dtype == getattr(ref, f).dtype
+        assert np.allclose(getattr(got, f), getattr(ref, f), rtol=1e-15, atol=0.0), f
+
+
 def test_zener_exact_reads_a_list_of_exact_numbers_as_floats():
     e, d, tau0 = zener_exact.zener_exact_solution([Fraction(1, 2), Fraction(3, 2)])
     assert all(x.dtype == np.float64 for x in (e, d, tau0))
@@ -301,3 +316,39 @@ def test_zener_restitution_passes_its_tolerance_on():
     loose = zener.zener_restitution(0.7, "ode", 1e-3)
     tight = zener.zener_restitution(0.7, "ode")
     assert loose != tight and loose == pytest.approx(tight, rel=1e-2)
+
+
+@pytest.mark.parametrize("typo,suggested", [("al6061", "al_6061"), ("s2 tool steel", "s2_tool_steel"),
+                                            ("aluminum", "al_1100_h16"), ("Brass", "brass_260")])
+def test_an_unknown_material_suggests_the_close_ones(typo, suggested):
+    with pytest.raises(KeyError) as err:
+        MATERIALS[typo]
+    text = str(err.value)
+    assert f"unknown material {typo!r} (did you mean " in text and repr(suggested) in text
+    assert text.rstrip("\"'").endswith(", ".join(sorted(MATERIALS)))
+
+
+def test_no_suggestion_when_nothing_is_close():
+    from restitution.materials import suggest_material
+
+    assert suggest_material("unobtainium", MATERIALS) == ""
+    assert suggest_material("xy", ["al_6061"]) == ""
+    assert suggest_material("al_6016", ["al_6061", "s2_tool_steel"]) == " (did you mean 'al_6061'?)"
+    assert suggest_material("AL_6016", ["al_6061", "al_6063", "s2"]) == " (did you mean 'al_6063' or 'al_6061'?)"  # closest first
+    with pytest.raises(KeyError, match=r"unknown material 'unobtainium'; known: "):
+        MATERIALS["unobtainium"]
+
+
+def test_plate_wave_speed_is_the_thin_plate_longitudinal_speed():
+    """The plate wave speed of Eq. (12), sqrt(E' / rho) with E' = E / (1 - nu^2), is the thin-plate
+    longitudinal wave speed: ~5.35 km/s in aluminium and ~5.4 km/s in steel (Graff, Wave Motion in Elastic
+    Solids, Sec. 8.1, with handbook moduli), to 1 %; it scales as sqrt(E / rho) and grows with nu."""
+    assert zener.plate_wave_speed(69e9, 0.33, 2700.0) == pytest.approx(5350.0, rel=1e-2)
+    assert zener.plate_wave_speed(207e9, 0.30, 7861.0) == pytest.approx(5400.0, rel=1e-2)
+    base = zener.plate_wave_speed(69e9, 0.33, 2700.0)
+    assert zener.plate_wave_speed(4 * 69e9, 0.33, 2700.0) == pytest.approx(2 * base, rel=1e-15)
+    assert zener.plate_wave_speed(69e9, 0.33, 4 * 2700.0) == pytest.approx(base / 2, rel=1e-15)
+    bar = zener.plate_wave_speed(69e9, 0.0, 2700.0)  # nu = 0: the bar speed sqrt(E / rho)
+    assert bar == pytest.approx(math.sqrt(69e9 / 2700.0), rel=1e-15) and bar < base
+    arr = zener.plate_wave_speed(np.array([69e9, 207e9]), np.array([0.33, 0.30]), np.array([2700.0, 7861.0]))
+    assert arr.shape == (2,) and arr[0] == pytest.approx(base, rel=1e-15)

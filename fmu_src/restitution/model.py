@@ -106,8 +106,6 @@ class ImpactResult:
 
 
 def _mode(name, value):
-    if value.__class__ is str and value in EFFECT_MODES:
-        return value
     if isinstance(value, (int, np.integer)) and not isinstance(value, bool):
         if not 0 <= value < len(EFFECT_MODES):
             raise ValueError(f"{name} = {value!r} is not one of 0 = off, 1 = on, 2 = auto")
@@ -221,8 +219,7 @@ def _pipeline(v, params, scalar, restitution_model, zener_method, plasticity, pl
         out.__dict__.update(zip(_FIELD_NAMES, values))
         return out
     shape = np.broadcast_shapes(v.shape, *(x.shape for x in params))
-    taken = {id(v), *(id(x) for x in params)}  # never hand out an input array
-    out.__dict__.update((name, _own_array(value, shape, bool if name in _FLAGS else float, taken))
+    out.__dict__.update((name, _own_array(value, shape, bool if name in _FLAGS else float))
                         for name, value in zip(_FIELD_NAMES, values))
     return out
 
@@ -237,15 +234,16 @@ _FLAGS = frozenset({"plasticity_used", "plate_waves_used", "lambda_in_range", "v
 _FIELD_NAMES = tuple(f.name for f in fields(ImpactResult))
 
 
-def _own_array(x, shape, dtype, taken):
+def _own_array(x, shape, dtype):
     """``x`` as an array of ``shape`` and ``dtype`` that no other field or input shares.
 
     A temporary that already is one is used as is (copying 1e5-element results cost as
-    much as computing them); anything else (scalars, views, inputs) is broadcast and copied.
+    much as computing them); anything else (scalars, views) is broadcast and copied. Every value
+    the pipeline hands over is a fresh temporary or a scalar, never an input and never the same
+    object twice (tests/test_model_contract.py checks that no field shares memory with an input
+    or another field, in every effect mode), so an owned array of the right kind is safe to keep.
     """
-    if (x.__class__ is np.ndarray and x.shape == shape and x.dtype == dtype and x.flags.owndata
-            and id(x) not in taken):
-        taken.add(id(x))
+    if x.__class__ is np.ndarray and x.shape == shape and x.dtype == dtype and x.flags.owndata:
         return x
     return np.broadcast_to(x, shape).astype(dtype)
 

@@ -49,7 +49,7 @@ def inelasticity_parameter(v0, E_a, nu_a, rho_a, d, E_b, nu_b, rho_b, t):
     Ea = reduced_modulus(E_a, nu_a)
     Eb = reduced_modulus(E_b, nu_b)
     r_over_t = 0.5 * d / t
-    return (_LAMBDA_PREFACTOR * r_over_t * r_over_t * (v0 / sqrt(Eb / rho_b)) ** 0.2
+    return (_LAMBDA_PREFACTOR * r_over_t * r_over_t * (v0 / plate_wave_speed(E_b, nu_b, rho_b)) ** 0.2
             * (rho_a / rho_b) ** 0.6 * (Ea / (Ea + Eb)) ** 0.4)
 
 

@@ -45,9 +45,11 @@ from __future__ import annotations
 
 import io
 import math
-import os
+from importlib.resources import files
 
 import numpy as np
+
+from ._num import log
 
 __all__ = ["zener_exact", "zener_exact_solution", "LAMBDA_TABLE_MAX", "E_INF", "TAU0_LAMBDA0"]
 
@@ -55,15 +57,9 @@ _DATA_NAME = "zener_table.npz"
 
 
 def _load_table():
-    path = os.path.join(os.path.dirname(os.path.abspath(__file__)), "data", _DATA_NAME)
-    if os.path.exists(path):
-        src = path
-    else:  # e.g. imported from a zip: go through importlib.resources
-        from importlib.resources import files
-
-        res = files(__package__ or "restitution").joinpath("data", _DATA_NAME)
-        src = io.BytesIO(res.read_bytes())
-    with np.load(src) as d:
+    """The arrays of data/zener_table.npz, read through importlib.resources (also from a zip)."""
+    data = files(__package__).joinpath("data", _DATA_NAME).read_bytes()
+    with np.load(io.BytesIO(data)) as d:
         return {k: d[k] for k in d.files}
 
 
@@ -72,7 +68,7 @@ def _hermite(k, f, df, h):
 
     The widths w_j are powers of 2, so the divisions below are exact.
     """
-    w = np.diff(k).astype(float)
+    w = np.diff(k)
     hw = h * w
     f0, f1, d0, d1 = f[:-1], f[1:], hw * df[:-1], hw * df[1:]
     return (f0, d0 / w, (3.0 * (f1 - f0) - 2.0 * d0 - d1) / w**2,
@@ -93,7 +89,7 @@ _G_CHEB = [float(c) for c in _T["asym_g_cheb"]]
 
 
 def _build_pieces(T):
-    k = np.asarray(T["k"], dtype=np.int64)
+    k = T["k"]
     if k[0] != 0 or np.any(np.diff(k) <= 0) or k[-1] * _H <= LAMBDA_TABLE_MAX:
         raise RuntimeError(f"{_DATA_NAME}: bad node layout")
     # one row per piece: (k_j, a0..a3 for e_ze, c0..c3 for 1 - e_ze, b0..b3 for tau0).
@@ -101,7 +97,7 @@ def _build_pieces(T):
     # Sterbenz) and c_i = -a_i, so 1 - e_ze is interpolated directly: at small lambda it is
     # t (|a1| + ...) with full relative accuracy instead of the difference of two numbers near 1.
     a = _hermite(k, T["e"], T["de"], _H)
-    rows = np.stack((k[:-1].astype(float),) + a + (1.0 - a[0], -a[1], -a[2], -a[3])
+    rows = np.stack((k[:-1],) + a + (1.0 - a[0], -a[1], -a[2], -a[3])
                     + _hermite(k, T["tau0"], T["dtau0"], _H), axis=1)
     cell_to_piece = np.repeat(np.arange(len(rows)), np.diff(k))  # fine cell -> piece
     # scalar path: a list over fine cells whose entries share the piece tuples (small, and
@@ -129,16 +125,23 @@ def _table_scalar(lam):
             b0 + t * (b1 + t * (b2 + t * b3)))
 
 
-def _asym_scalar(lam):
-    """Large-lambda form (lambda >= 6, used above LAMBDA_TABLE_MAX) for a float."""
-    u = lam ** (-5.0 / 3.0)
-    z2 = 2.0 * (2.0 * u / _U_MAX - 1.0)
-    c = _G_CHEB
-    b1 = b2 = 0.0
-    for k in range(len(c) - 1, 0, -1):
-        b1, b2 = c[k] + z2 * b1 - b2, b1
-    g = c[0] + 0.5 * z2 * b1 - b2
-    return E_INF * (1.0 / lam) ** 5, lam * (5.0 * math.log(lam) + g)
+def _asym(lam):
+    """(e_ze, 1 - e_ze, tau0) [1] of the large-lambda form (lambda >= 6; used above LAMBDA_TABLE_MAX),
+    for a float or an array: e_ze = E_INF lambda^-5, tau0 = lambda (5 ln lambda + g(lambda^(-5/3))), g by
+    Clenshaw's recurrence on its Chebyshev series. u = lambda^(-5/3) and e_ze underflow to 0 for huge
+    lambda (u from ~1e184, e_ze from ~1e61), harmlessly and silently on both paths (numpy's underflow
+    flag is not raised to the caller); tau0 overflows to inf above lambda ~ 5e304."""
+    with np.errstate(under="ignore", over="ignore"):
+        u = lam ** (-5.0 / 3.0)
+        z2 = 2.0 * (2.0 * u / _U_MAX - 1.0)
+        c = _G_CHEB
+        b1 = b2 = 0.0
+        for k in range(len(c) - 1, 0, -1):
+            b1, b2 = c[k] + z2 * b1 - b2, b1
+        g = c[0] + 0.5 * z2 * b1 - b2
+        e = E_INF * (1.0 / lam) ** 5
+        tau0 = lam * (5.0 * log(lam) + g)
+    return e, 1.0 - e, tau0
 
 
 def _scalar_general(lam):
@@ -153,8 +156,7 @@ def _scalar_general(lam):
         raise _bad_lambda(x)
     if x <= LAMBDA_TABLE_MAX:
         return _table_scalar(x)
-    e, tau0 = _asym_scalar(x)
-    return e, 1.0 - e, tau0
+    return _asym(x)
 
 
 def _horner_cubic(c, first, t):
@@ -175,24 +177,6 @@ def _table_array(lam):
     return _horner_cubic(c, 1, t), _horner_cubic(c, 5, t), _horner_cubic(c, 9, t)
 
 
-def _asym_array(lam):
-    """:func:`_asym_scalar` for an array. u = lambda^(-5/3) and e_ze underflow to 0 for huge lambda
-    (u from ~1e184, e_ze from ~1e61): harmless, and the same silent 0 the float path gives, so numpy's
-    underflow flag is not raised to the caller; tau0 overflows to inf above lambda ~ 5e304."""
-    with np.errstate(under="ignore", over="ignore"):
-        u = lam ** (-5.0 / 3.0)
-        z2 = 2.0 * (2.0 * u / _U_MAX - 1.0)
-        c = _G_CHEB
-        b1 = np.zeros_like(u)
-        b2 = np.zeros_like(u)
-        for k in range(len(c) - 1, 0, -1):
-            b1, b2 = c[k] + z2 * b1 - b2, b1
-        g = c[0] + 0.5 * z2 * b1 - b2
-        e = E_INF * (1.0 / lam) ** 5
-        tau = lam * (5.0 * np.log(lam) + g)
-    return e, 1.0 - e, tau
-
-
 def _array(lam):
     a = np.asarray(lam, dtype=float)
     if a.size == 0:
@@ -201,9 +185,8 @@ def _array(lam):
     hi = a.max()
     if not (lo >= 0.0 and hi < math.inf):  # also catches nan (min/max propagate it)
         bad = ~(np.isfinite(a) & (a >= 0.0))
-        idx = np.argwhere(bad)[0] if a.ndim else ()
-        raise _bad_lambda(float(a[tuple(idx)]), f" (at index {tuple(int(j) for j in idx)})"
-                          if a.ndim else "")
+        idx = tuple(int(j) for j in np.argwhere(bad)[0])  # () for a 0-d array
+        raise _bad_lambda(float(a[idx]), f" (at index {idx})" if a.ndim else "")
     if a.ndim == 0:
         return tuple(np.array(x) for x in _scalar_general(float(a)))
     if hi <= LAMBDA_TABLE_MAX:
@@ -213,7 +196,7 @@ def _array(lam):
     small = ~big
     for target, part in zip(out, _table_array(a[small])):
         target[small] = part
-    for target, part in zip(out, _asym_array(a[big])):
+    for target, part in zip(out, _asym(a[big])):
         target[big] = part
     return out
 
