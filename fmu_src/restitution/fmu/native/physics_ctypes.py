@@ -1,0 +1,70 @@
+"""Call the compiled native physics (``rst_impact`` of rst_physics.c) from Python through ctypes,
+with :func:`restitution.impact`'s argument names, for the equivalence tests and the benchmark."""
+from __future__ import annotations
+
+import ctypes
+from types import SimpleNamespace
+
+import numpy as np
+
+from ...agreement import FLAGS, REALS
+
+_INPUT_REALS = ("v", "sphere_E", "sphere_nu", "sphere_Sy", "sphere_rho", "sphere_d",
+                "plate_E", "plate_nu", "plate_Sy", "plate_rho", "plate_t")
+#: Codes of the FMU's Integer parameters, as rst_physics.h numbers them.
+MODEL_CODE = {"e45": 1, "e44": 2}
+METHOD_CODE = {"exact": 1, "paper_fit": 2, "linear": 3, "ode": 4}
+MODE_CODE = {"off": 0, "on": 1, "auto": 2}
+OK, BAD_CODE, UNSUPPORTED = 0, 1, 2
+_RESULT_REALS = ("e", "v_rebound", "e_ep", "V_c", "V_star", "eps_y", "e_ze", "lam", "tau0", "T", "t_contact",
+                 "m_a", "m_eff", "v_plate")
+_RESULT_FLAGS = ("plasticity_used", "plate_waves_used", "lambda_in_range", "vstar_in_range", "e_negative", "valid")
+assert set(_RESULT_REALS) == set(REALS) and set(_RESULT_FLAGS) == set(FLAGS)
+
+
+class Inputs(ctypes.Structure):
+    _fields_ = ([(n, ctypes.c_double) for n in _INPUT_REALS]
+                + [(n, ctypes.c_int) for n in ("restitution_model", "zener_method", "plasticity", "plate_waves")]
+                + [("effect_tolerance", ctypes.c_double), ("ode_rtol", ctypes.c_double)])
+
+
+class Result(ctypes.Structure):
+    _fields_ = [(n, ctypes.c_double) for n in _RESULT_REALS] + [(n, ctypes.c_int) for n in _RESULT_FLAGS]
+
+
+class NativePhysics:
+    """The library at ``path``; :meth:`impact` mirrors :func:`restitution.impact` for one or many cases."""
+
+    def __init__(self, path):
+        self.lib = ctypes.CDLL(str(path))
+        self.lib.rst_impact.argtypes = (ctypes.POINTER(Inputs), ctypes.POINTER(Result))
+        self.lib.rst_impact.restype = ctypes.c_int
+
+    def call(self, v, params: dict, restitution_model="e45", zener_method="exact", plasticity="auto",
+             plate_waves="auto", effect_tolerance=1e-6, ode_rtol=1e-10):
+        """(status, Result) of one impact, floats in."""
+        inp = Inputs(float(v), *(float(params[n]) for n in _INPUT_REALS[1:]), MODEL_CODE[restitution_model],
+                     METHOD_CODE[zener_method], MODE_CODE[plasticity], MODE_CODE[plate_waves],
+                     float(effect_tolerance), float(ode_rtol))
+        out = Result()
+        status = self.lib.rst_impact(ctypes.byref(inp), ctypes.byref(out))
+        return status, out
+
+    def impact(self, v, params: dict, **options) -> SimpleNamespace:
+        """Every case of the broadcast inputs; arrays named as ImpactResult's fields. Raises on a non-OK status."""
+        arrays = np.broadcast_arrays(np.asarray(v, dtype=float), *(np.asarray(params[n], dtype=float)
+                                                                   for n in _INPUT_REALS[1:]))
+        shape = arrays[0].shape
+        flat = [a.ravel() for a in arrays]
+        reals = {n: np.empty(flat[0].size) for n in _RESULT_REALS}
+        flags = {n: np.empty(flat[0].size, dtype=bool) for n in _RESULT_FLAGS}
+        for i in range(flat[0].size):
+            status, out = self.call(flat[0][i], {n: flat[j + 1][i] for j, n in enumerate(_INPUT_REALS[1:])},
+                                    **options)
+            if status != OK:
+                raise RuntimeError(f"rst_impact returned {status} for case {i}")
+            for n in _RESULT_REALS:
+                reals[n][i] = getattr(out, n)
+            for n in _RESULT_FLAGS:
+                flags[n][i] = bool(getattr(out, n))
+        return SimpleNamespace(**{n: a.reshape(shape) for n, a in {**reals, **flags}.items()})

@@ -1,0 +1,201 @@
+"""The native C physics (fmu_src/restitution/fmu/native/rst_physics.c) is the package's model.
+
+The C is compiled into a shared library in a temp dir and called through ctypes. Every output and
+every flag is compared with :func:`restitution.impact` (the authoritative implementation) within
+the per-case tolerance :func:`restitution.agreement.tolerances` derives from each output's measured
+conditioning (ULPS ulps times 1 + the sum of its log-sensitivities to the 11 inputs): libm and
+numpy's kernels may differ in the last bit, which an ill-conditioned output amplifies; bit identity
+is never asserted. A flag may differ only where a relative perturbation of STEP flips it.
+
+Cases: a random sample over the FMU's declared domain (restitution.model.DOMAIN, log-uniform) for
+every Zener method the C implements, both JGM models and all nine effect-mode pairs; the hard-case
+matrix of tests/test_hard_cases.py; and the paper's checkpoint (V_c = 0.0265 m/s, V* = 86.9 at
+2.3 m/s for S2 tool steel on Al 6061, Green 2022 Sec. 7). A sanitizer build (ASan + UBSan) runs
+the same kinds of cases in a child process.
+"""
+from __future__ import annotations
+
+import itertools
+import math
+import shutil
+import subprocess
+
+import numpy as np
+import pytest
+
+import restitution as r
+from restitution.agreement import disagreements, tolerances
+from restitution.fmu.native.compile import CFLAGS, compile_shared, prepare_sources
+from restitution.fmu.native.physics_ctypes import METHOD_CODE, MODE_CODE, MODEL_CODE, UNSUPPORTED, NativePhysics
+from restitution.model import DOMAIN, PARAMETERS
+
+from test_hard_cases import PAIRS, SPEEDS, T_OVER_D, params_for
+
+pytestmark = pytest.mark.skipif(shutil.which("gcc") is None, reason="gcc is needed to compile the native physics")
+
+NATIVE_METHODS = ("exact", "paper_fit", "linear")  # `ode` is rejected by the native FMU (see docs/native.md)
+NAMES = tuple(name for name, _unit, _kind in PARAMETERS)
+
+
+@pytest.fixture(scope="module")
+def native(tmp_path_factory):
+    return NativePhysics(compile_shared(tmp_path_factory.mktemp("native")))
+
+
+def random_cases(rng, n):
+    """n cases log-uniform over DOMAIN (nu uniform in [0, 0.5)), a few at v = 0 and at the bounds."""
+    def logu(lo, hi):
+        return np.exp(rng.uniform(math.log(lo), math.log(hi), n))
+
+    lo_v = 1e-9
+    v = logu(lo_v, DOMAIN["v"][1])
+    v[:3] = (0.0, DOMAIN["v"][1], 1e-300)
+    params = {}
+    for name in NAMES:
+        if name.endswith("_nu"):
+            params[name] = rng.uniform(0.0, 0.5, n)
+            params[name][0] = 0.0
+            params[name][1] = np.nextafter(0.5, 0.0)
+        else:
+            lo, hi = DOMAIN[name]
+            params[name] = logu(lo, hi)
+            params[name][1] = hi
+            params[name][2] = lo
+    return v, params
+
+
+def assert_same_model(native, v, params, **options):
+    expected = r.impact(v, **params, **options)
+    got = native.impact(v, params, **options)
+    tol, flips = tolerances(v, params, **options)
+    problems = disagreements(got, expected, tol, flips)
+    assert not problems, f"{options}: " + "; ".join(problems[:5])
+    return got, expected
+
+
+@pytest.mark.parametrize("method", NATIVE_METHODS)
+@pytest.mark.parametrize("model", r.RESTITUTION_MODELS)
+def test_random_cases_over_the_domain(native, method, model):
+    rng = np.random.default_rng([12, METHOD_CODE[method], MODEL_CODE[model]])
+    for plasticity, plate_waves in itertools.product(MODE_CODE, MODE_CODE):
+        v, params = random_cases(rng, 120)
+        for tol in (0.0, 1e-6, 1e-3):
+            assert_same_model(native, v, params, restitution_model=model, zener_method=method,
+                              plasticity=plasticity, plate_waves=plate_waves, effect_tolerance=tol)
+
+
+@pytest.mark.parametrize("method", NATIVE_METHODS)
+def test_hard_case_matrix(native, method):
+    for pair in PAIRS:
+        for t_over_d in T_OVER_D:
+            params = params_for(pair, t_over_d)
+            v = np.asarray(SPEEDS)
+            for model, mode in itertools.product(r.RESTITUTION_MODELS, MODE_CODE):
+                assert_same_model(native, v, params, restitution_model=model, zener_method=method,
+                                  plasticity=mode, plate_waves=mode)
+
+
+def test_zener_branches_and_lambda_sweep(native):
+    """lambda from 1e-12 to 1e4 (through t) across the table's nodes, lambda = 100 and the fits' caps."""
+    params = params_for("T4-A1")
+    lam1 = r.impact(1.0, **params).lam  # lambda ~ (d/t)^2: pick t to land on chosen lambdas
+    targets = np.concatenate([np.geomspace(1e-12, 1e4, 400), [1.5, 2.0, 100.0, np.nextafter(100.0, 200.0), 169.2]])
+    t = params["plate_t"] * np.sqrt(lam1 / targets)
+    for method in NATIVE_METHODS:
+        assert_same_model(native, 1.0, dict(params, plate_t=t), zener_method=method, plate_waves="on")
+
+
+def test_paper_checkpoint(native):
+    """Green (2022) Sec. 7: V_c = 0.0265 m/s and V* = 86.9 at 2.3 m/s, S2 tool steel on Al 6061."""
+    params = params_for("s2/al6061")
+    status, out = native.call(2.3, params)
+    assert status == 0
+    assert out.V_c == pytest.approx(0.0265, abs=5e-5)
+    assert out.V_star == pytest.approx(86.9, abs=0.05)
+    assert out.valid and out.vstar_in_range and out.plasticity_used
+
+
+def test_ode_and_bad_codes_are_rejected(native):
+    params = params_for("s2/al6061")
+    status, out = native.call(1.0, params, zener_method="ode")
+    assert status == UNSUPPORTED
+    assert math.isnan(out.e) and math.isnan(out.tau0) and not out.valid
+    # ode with plate waves off needs no Zener solution, but the method is still refused: one rule
+    status, _ = native.call(1.0, params, zener_method="ode", plate_waves="off")
+    assert status == UNSUPPORTED
+
+
+_DRIVER = r"""
+#include <stdio.h>
+#include "rst_physics.h"
+int main(void)
+{
+    rst_impact_inputs in;
+    rst_impact_result o;
+    while (scanf("%lf %lf %lf %lf %lf %lf %lf %lf %lf %lf %lf %d %d %d %d %lf %lf", &in.v, &in.sphere_E,
+                 &in.sphere_nu, &in.sphere_Sy, &in.sphere_rho, &in.sphere_d, &in.plate_E, &in.plate_nu,
+                 &in.plate_Sy, &in.plate_rho, &in.plate_t, &in.restitution_model, &in.zener_method,
+                 &in.plasticity, &in.plate_waves, &in.effect_tolerance, &in.ode_rtol) == 17) {
+        int status = rst_impact(&in, &o);
+        printf("%d %a %a %a %a %a %a %a %a %a %a %a %a %a %a %d %d %d %d %d %d\n", status, o.e, o.v_rebound,
+               o.e_ep, o.V_c, o.V_star, o.eps_y, o.e_ze, o.lam, o.tau0, o.T, o.t_contact, o.m_a, o.m_eff,
+               o.v_plate, o.plasticity_used, o.plate_waves_used, o.lambda_in_range, o.vstar_in_range,
+               o.e_negative, o.valid);
+    }
+    return 0;
+}
+"""
+
+
+def test_sanitizers(tmp_path):
+    """ASan + UBSan build (any report aborts: -fno-sanitize-recover) over random and hard cases, every
+    code (including bad ones); run in a child process; its results still agree with the package."""
+    src = prepare_sources(tmp_path / "src")
+    (src / "driver.c").write_text(_DRIVER)
+    exe = tmp_path / "driver"
+    build = subprocess.run(["gcc", *CFLAGS, "-g", "-fsanitize=address,undefined", "-fno-sanitize-recover=all",
+                            "-o", str(exe), str(src / "driver.c"), str(src / "rst_physics.c"), "-lm"],
+                           capture_output=True, text=True)
+    if build.returncode != 0 and "sanitize" in build.stderr and "cannot find" in build.stderr:
+        pytest.skip(f"sanitizer runtime missing: {build.stderr.strip()}")
+    assert build.returncode == 0, build.stderr
+    rng = np.random.default_rng(1212)
+    v, params = random_cases(rng, 60)
+    codes = [(m, z, p, w) for m in (1, 2) for z in (1, 2, 3, 4) for p in (0, 1, 2) for w in (0, 1, 2)]
+    codes += [(0, 1, 2, 2), (3, 1, 2, 2), (1, 0, 2, 2), (1, 5, 2, 2), (1, 1, -1, 2), (1, 1, 2, 3)]
+    lines, cases = [], []
+    for i, code in enumerate(codes):
+        j = i % len(v)
+        case = [v[j]] + [params[n][j] for n in NAMES]
+        cases.append((case, code))
+        lines.append(" ".join(repr(float(x)) for x in case) + " " + " ".join(map(str, code)) + " 1e-06 1e-10")
+    run = subprocess.run([str(exe)], input="\n".join(lines) + "\n", capture_output=True, text=True, timeout=120,
+                         env={"PATH": "/usr/bin:/bin", "ASAN_OPTIONS": "detect_leaks=1",
+                              "UBSAN_OPTIONS": "print_stacktrace=1"})
+    assert run.returncode == 0, run.stderr[-3000:]
+    assert "runtime error" not in run.stderr, run.stderr[-3000:]
+    outputs = run.stdout.splitlines()
+    assert len(outputs) == len(cases)
+    inv = {code: name for name, code in MODEL_CODE.items()}, {c: n for n, c in METHOD_CODE.items()}, \
+        {c: n for n, c in MODE_CODE.items()}
+    for (case, (m, z, p, w)), line in zip(cases, outputs):
+        fields = line.split()
+        status = int(fields[0])
+        if not (m in inv[0] and z in inv[1] and p in inv[2] and w in inv[2]):
+            assert status == 1 and math.isnan(float.fromhex(fields[1]))
+            continue
+        if z == 4:
+            assert status == UNSUPPORTED
+            continue
+        assert status == 0
+        options = dict(restitution_model=inv[0][m], zener_method=inv[1][z], plasticity=inv[2][p],
+                       plate_waves=inv[2][w])
+        got = dict(zip(("e", "v_rebound", "e_ep", "V_c", "V_star", "eps_y", "e_ze", "lam", "tau0", "T",
+                        "t_contact", "m_a", "m_eff", "v_plate"), (float.fromhex(x) for x in fields[1:15])))
+        got.update(zip(("plasticity_used", "plate_waves_used", "lambda_in_range", "vstar_in_range", "e_negative",
+                        "valid"), (bool(int(x)) for x in fields[15:])))
+        p_case = dict(zip(NAMES, case[1:]))
+        expected = r.impact(case[0], **p_case, **options)
+        tol, flips = tolerances(case[0], p_case, **options)
+        problems = disagreements(type("R", (), got), expected, tol, flips)
+        assert not problems, f"{options}: {problems}"
