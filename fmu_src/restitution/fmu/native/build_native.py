@@ -1,0 +1,170 @@
+"""Build ``DIR/native/SpherePlateImpact.fmu``: the same interface as ``DIR/SpherePlateImpact.fmu``,
+no Python at run time.
+
+The FMU is the project's generic C FMI front (``restitution/fmu/cfront``, the guard's state machine,
+checks, logging and value store, driven by the table :func:`restitution.fmu.interface.c_header`
+generates from the slave's ``VARIABLES``) with the native-physics backend of this directory. Its
+modelDescription.xml is the pythonfmu FMU's (which the build completed from the same ``VARIABLES``:
+names, value references, types, causalities, variabilities, units, starts, min/max, descriptions,
+ModelStructure), with what belongs to pythonfmu replaced (generation tool, needsExecutionTool) and
+the C sources declared in ``<SourceFiles>`` so a host on another platform can compile ``sources/``.
+
+Binaries: ``binaries/linux64`` with gcc, ``binaries/win64`` with mingw-w64's ``x86_64-w64-mingw32-gcc``
+(runtime linked statically: the DLL needs only Windows' own DLLs). A missing compiler skips that
+binary with a message; with neither, no native FMU is written (and the build says why).
+"""
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import zipfile
+from pathlib import Path
+from xml.etree import ElementTree as ET
+
+from .compile import CFLAGS, prepare_sources
+
+HERE = Path(__file__).resolve().parent
+FRONT = HERE.parent / "cfront"
+#: Model identifier -> the backend C file of this directory that implements it.
+BACKENDS = {"SpherePlateImpact": "rst_native_impact.c"}
+#: The FMI 2.0 headers fmpy ships (used at build time only; not copied into the FMU: FMI 2.0 hosts bring them).
+FMI2_HEADERS = ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h")
+INTERFACE_HEADER = "rst_{model}_interface.h"
+COMPILERS = {  # platform folder -> (compiler, extra flags, binary suffix)
+    "linux64": ("gcc", ("-fPIC", "-fvisibility=hidden"), ".so"),
+    "win64": ("x86_64-w64-mingw32-gcc", ("-static", "-static-libgcc"), ".dll"),
+}
+GENERATION_TOOL = "restitution native build (C99 front + native physics)"
+
+
+class NativeBuildSkipped(RuntimeError):
+    """The native FMU cannot be built here; the message says why."""
+
+
+def fmi2_include_dir() -> Path:
+    """fmpy's copy of the FMI 2.0 C headers."""
+    try:
+        import fmpy
+    except ImportError:
+        raise NativeBuildSkipped("fmpy is not installed (its FMI 2.0 headers are needed)") from None
+    path = Path(fmpy.__file__).resolve().parent / "c-code"
+    if not all((path / h).is_file() for h in FMI2_HEADERS):
+        raise NativeBuildSkipped(f"FMI 2.0 headers not found in {path}")
+    return path
+
+
+def front_files() -> list[Path]:
+    """The generic C FMI front's sources (issue 11's cfront/); NativeBuildSkipped while it is missing."""
+    if not (FRONT / "rst_front.h").is_file():
+        raise NativeBuildSkipped(f"the C FMI front is not there yet ({FRONT / 'rst_front.h'} missing)")
+    return sorted(p for p in FRONT.iterdir() if p.suffix in (".c", ".h"))
+
+
+def write_sources(model: str, directory: Path) -> list[str]:
+    """Every C file of ``model``'s native FMU into ``directory``; returns the .c files to compile."""
+    from ..interface import c_header
+
+    prepare_sources(directory)
+    for path in front_files():
+        shutil.copyfile(path, directory / path.name)
+    shutil.copyfile(HERE / BACKENDS[model], directory / BACKENDS[model])
+    (directory / INTERFACE_HEADER.format(model=model)).write_text(c_header(model), encoding="utf-8")
+    return sorted(p.name for p in directory.glob("*.c"))
+
+
+def native_model_description(xml_text: str, c_files: list[str]) -> str:
+    """The pythonfmu FMU's modelDescription.xml for the native FMU: same interface, C sources declared."""
+    root = ET.fromstring(xml_text)
+    root.set("generationTool", GENERATION_TOOL)
+    cosim = root.find("CoSimulation")
+    cosim.set("needsExecutionTool", "false")
+    cosim.set("canBeInstantiatedOnlyOncePerProcess", "false")
+    for old in cosim.findall("SourceFiles"):
+        cosim.remove(old)
+    files = ET.SubElement(cosim, "SourceFiles")
+    for name in c_files:
+        ET.SubElement(files, "File", name=name)
+    ET.indent(root, "  ")
+    return '<?xml version="1.0" encoding="UTF-8"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
+
+
+def compile_binary(model: str, sources: Path, c_files: list[str], platform: str, out: Path,
+                   extra_flags=()) -> Path:
+    """Compile ``out/binaries/<platform>/<model>.<so|dll>``; NativeBuildSkipped when the compiler is missing."""
+    cc, flags, suffix = COMPILERS[platform]
+    if shutil.which(cc) is None:
+        raise NativeBuildSkipped(f"{cc} not found: no binaries/{platform}"
+                                 + (" (Debian: apt-get install gcc-mingw-w64-x86-64)" if platform == "win64" else ""))
+    target = out / "binaries" / platform / f"{model}{suffix}"
+    target.parent.mkdir(parents=True, exist_ok=True)
+    cmd = [cc, *CFLAGS, *flags, *extra_flags, "-shared", f"-I{sources}", f"-I{fmi2_include_dir()}",
+           "-o", str(target), *(str(sources / f) for f in c_files), "-lm"]
+    done = subprocess.run(cmd, capture_output=True, text=True)
+    if done.returncode != 0:
+        raise RuntimeError(f"{cc} failed for {model} ({platform}):\n{done.stderr}")
+    return target
+
+
+def _zip_dir(directory: Path, fmu: Path) -> None:
+    with zipfile.ZipFile(fmu, "w", zipfile.ZIP_DEFLATED) as z:
+        for path in sorted(directory.rglob("*")):
+            if path.is_file():
+                z.write(path, path.relative_to(directory).as_posix())
+
+
+def build_native_one(model: str, out_dir: Path, python_fmu: Path, log=None) -> Path:
+    """Build and validate ``out_dir/native/<model>.fmu`` beside the pythonfmu ``python_fmu``."""
+    from fmpy.validation import validate_fmu
+
+    from ..build import BUILD_INFO, source_hash
+
+    log = log or (lambda message: print(message, file=sys.stderr))
+    target_dir = Path(out_dir) / "native"
+    target_dir.mkdir(parents=True, exist_ok=True)
+    with tempfile.TemporaryDirectory(prefix=f".{model}-native-", dir=target_dir) as tmp:
+        stage = Path(tmp) / "fmu"
+        sources = stage / "sources"
+        c_files = write_sources(model, sources)
+        with zipfile.ZipFile(python_fmu) as z:
+            xml = z.read("modelDescription.xml").decode("utf-8")
+        (stage / "modelDescription.xml").write_text(native_model_description(xml, c_files), encoding="utf-8")
+        built = []
+        for platform in COMPILERS:
+            try:
+                built.append(compile_binary(model, sources, c_files, platform, stage))
+            except NativeBuildSkipped as exc:
+                log(f"warning: native {model}.fmu: {exc}")
+        if not built:
+            raise NativeBuildSkipped(f"no C compiler for any platform: native {model}.fmu not built")
+        info = {"model": model, "native": True, "source_hash": source_hash(model),
+                "platforms": sorted(p.parent.name for p in built)}
+        (stage / BUILD_INFO).parent.mkdir(parents=True, exist_ok=True)
+        (stage / BUILD_INFO).write_text(json.dumps(info, indent=1), encoding="utf-8")
+        fmu = Path(tmp) / f"{model}.fmu"
+        _zip_dir(stage, fmu)
+        problems = validate_fmu(str(fmu))
+        if problems:
+            raise RuntimeError(f"native {model}.fmu failed fmpy validation: " + "; ".join(problems))
+        mask = os.umask(0o022)
+        os.umask(mask)
+        os.chmod(fmu, 0o666 & ~mask)
+        target = target_dir / f"{model}.fmu"
+        os.replace(fmu, target)
+    return target
+
+
+def build_native(out_dir: Path, log=None) -> list[Path]:
+    """Every native FMU there is a backend for, beside the pythonfmu ones already in ``out_dir``;
+    a model that cannot be built here is skipped with a message (the Python FMUs stay usable)."""
+    log = log or (lambda message: print(message, file=sys.stderr))
+    built = []
+    for model in BACKENDS:
+        try:
+            built.append(build_native_one(model, out_dir, Path(out_dir) / f"{model}.fmu", log=log))
+        except NativeBuildSkipped as exc:
+            log(f"warning: {exc}")
+    return built
