@@ -264,8 +264,10 @@ def _slave_module(model: str):
 
 
 def build_all(out_dir: Path, standalone: bool = True, log=None) -> list[Path]:
-    """Build every FMU of the project into ``out_dir``."""
-    return [build_one(model, out_dir, standalone=standalone, log=log) for model in FMUS]
+    """Build every FMU of the project into ``out_dir``, then their native twins into ``out_dir/native``."""
+    built = [build_one(model, out_dir, standalone=standalone, log=log) for model in FMUS]
+    from .native.build_native import build_native  # native FMUs (issue 12): skipped with a message where they cannot be built
+    return built + build_native(out_dir, log=log)
 
 
 def _checkout_dist() -> Path | None:

@@ -67,7 +67,11 @@ def front_files() -> list[Path]:
 def write_sources(model: str, directory: Path) -> list[str]:
     """Every C file of ``model``'s native FMU into ``directory``; returns the .c files to compile."""
     from ..interface import c_header
+    from .compile import PHYSICS_SOURCES
 
+    missing = [name for name in (*PHYSICS_SOURCES, BACKENDS[model]) if not (HERE / name).is_file()]
+    if missing:  # an installed package without its C files (package-data)
+        raise NativeBuildSkipped(f"C sources missing from {HERE}: {', '.join(missing)}")
     prepare_sources(directory)
     for path in front_files():
         shutil.copyfile(path, directory / path.name)

@@ -1,0 +1,158 @@
+"""The native SpherePlateImpact.fmu (C front + C physics, no Python at run time) is the same
+component as the pythonfmu one: the same interface, variable by variable, and the package's numbers.
+
+The interface test runs everywhere. The tests of the built FMU need the generic C FMI front
+(fmu_src/restitution/fmu/cfront/, issue 11) and gcc; they skip saying which is missing. Numbers are
+compared with restitution.agreement's per-case tolerances (derived from each output's conditioning),
+never bit for bit: the C uses libm, the package numpy and CPython's math.
+"""
+from __future__ import annotations
+
+import shutil
+import subprocess
+import zipfile
+from xml.etree import ElementTree as ET
+
+import numpy as np
+import pytest
+
+import restitution as r
+from restitution.agreement import disagreements, tolerances
+from restitution.fmu.native.build_native import (GENERATION_TOOL, NativeBuildSkipped, build_native_one,
+                                                 front_files, native_model_description)
+
+from test_hard_cases import FMU_FLAGS, FMU_REALS, params_for
+
+INTERFACE_ATTRIBUTES = ("name", "valueReference", "causality", "variability", "initial", "description")
+TYPE_ATTRIBUTES = ("unit", "start", "min", "max", "declaredType")
+
+
+def _model_description(fmu):
+    with zipfile.ZipFile(fmu) as z:
+        return z.read("modelDescription.xml").decode("utf-8")
+
+
+def _interface(root):
+    rows = []
+    for sv in root.find("ModelVariables"):
+        typ = sv[0]
+        rows.append((tuple(sv.get(a) for a in INTERFACE_ATTRIBUTES), typ.tag,
+                     tuple(typ.get(a) for a in TYPE_ATTRIBUTES)))
+    structure = ET.tostring(root.find("ModelStructure"))
+    units = ET.tostring(root.find("UnitDefinitions"))
+    return rows, structure, units
+
+
+def test_model_description_has_the_same_interface(impact_fmu):
+    """Every variable (name, vr, type, causality, variability, initial, unit, start, min/max, description),
+    the ModelStructure and the units equal the pythonfmu FMU's; the C sources are declared."""
+    python_xml = _model_description(impact_fmu)
+    native_xml = native_model_description(python_xml, ["a.c", "b.c"])
+    py, nat = ET.fromstring(python_xml), ET.fromstring(native_xml)
+    assert _interface(nat) == _interface(py)
+    assert nat.get("guid") == py.get("guid") and nat.get("modelName") == py.get("modelName")
+    cosim = nat.find("CoSimulation")
+    assert cosim.get("modelIdentifier") == "SpherePlateImpact"
+    assert cosim.get("needsExecutionTool") == "false"
+    assert [f.get("name") for f in cosim.find("SourceFiles")] == ["a.c", "b.c"]
+    assert nat.get("generationTool") == GENERATION_TOOL
+
+
+def _front_missing():
+    try:
+        front_files()
+    except NativeBuildSkipped as exc:
+        return str(exc)
+    return None
+
+
+needs_front = pytest.mark.skipif(_front_missing() is not None or shutil.which("gcc") is None,
+                                 reason=f"native FMU not buildable here: {_front_missing() or 'gcc missing'}")
+
+
+@pytest.fixture(scope="module")
+def native_fmu(impact_fmu, tmp_path_factory):
+    return build_native_one("SpherePlateImpact", impact_fmu.parent, impact_fmu)
+
+
+@needs_front
+def test_native_fmu_validates_and_has_no_python(native_fmu):
+    from fmpy.validation import validate_fmu
+
+    assert validate_fmu(str(native_fmu)) == []
+    with zipfile.ZipFile(native_fmu) as z:
+        names = z.namelist()
+        assert "binaries/linux64/SpherePlateImpact.so" in names
+        assert not any(n.endswith(".py") for n in names)
+        assert _interface(ET.fromstring(z.read("modelDescription.xml")))[0]
+
+
+@needs_front
+@pytest.mark.parametrize("method", ["exact", "paper_fit", "linear"])
+def test_native_fmu_equals_the_package(native_fmu, method):
+    from restitution.cosim import FmuInstance
+
+    rng = np.random.default_rng(7)
+    for pair in ("s2/al6061", "T4-A1", "glass/glass", "nu0/nu0.499"):
+        for t_over_d in (0.05, 1.0, 100.0):
+            params = params_for(pair, t_over_d)
+            options = dict(zener_method=method)
+            v = np.concatenate([[0.0], np.exp(rng.uniform(np.log(1e-6), np.log(1e3), 8))])
+            with FmuInstance(native_fmu, parameters={**_fmu_parameters(params), "zener_method": {"exact": 1,
+                             "paper_fit": 2, "linear": 3}[method]}) as fmu:
+                got = {}
+                for name in list(FMU_REALS) + list(FMU_FLAGS):
+                    got[name] = []
+                for speed in v:
+                    fmu.set(v_approach=float(speed))
+                    values = fmu.get(*FMU_REALS, *FMU_FLAGS)
+                    for name, value in zip(list(FMU_REALS) + list(FMU_FLAGS), values):
+                        got[name].append(value)
+            result = type("R", (), {**{FMU_REALS[k]: np.array(x, dtype=float) for k, x in got.items() if k in FMU_REALS},
+                                    **{FMU_FLAGS[k]: np.array(x, dtype=bool) for k, x in got.items() if k in FMU_FLAGS}})
+            expected = r.impact(v, **params, **options)
+            tol, flips = tolerances(v, params, **options)
+            problems = disagreements(result, expected, tol, flips)
+            assert not problems, f"{pair} t/d={t_over_d}: {problems}"
+
+
+def _fmu_parameters(params):
+    return {name.replace("_", ".", 1): float(value) for name, value in params.items()}
+
+
+@needs_front
+def test_binaries_need_no_python_and_no_extra_dll(native_fmu, tmp_path):
+    with zipfile.ZipFile(native_fmu) as z:
+        z.extractall(tmp_path)
+    so = tmp_path / "binaries/linux64/SpherePlateImpact.so"
+    needed = subprocess.run(["objdump", "-p", str(so)], capture_output=True, text=True).stdout
+    assert "libpython" not in needed
+    dll = tmp_path / "binaries/win64/SpherePlateImpact.dll"
+    if not dll.exists():
+        pytest.skip("no win64 binary (x86_64-w64-mingw32-gcc missing at build time)")
+    imports = subprocess.run(["objdump", "-p", str(dll)], capture_output=True, text=True).stdout
+    dlls = {line.split()[-1].lower() for line in imports.splitlines() if "DLL Name:" in line}
+    assert dlls <= {"kernel32.dll", "msvcrt.dll", "user32.dll", "advapi32.dll"} or all(
+        d.startswith("api-ms-win-") or d in ("kernel32.dll", "msvcrt.dll") for d in dlls), dlls
+    assert not any("python" in d or "libgcc" in d or "winpthread" in d for d in dlls), dlls
+
+
+@needs_front
+@pytest.mark.skipif(shutil.which("cmake") is None, reason="cmake is needed by fmpy's build_platform_binary")
+def test_rebuilt_from_sources_by_fmpy(native_fmu, tmp_path):
+    """The Linux binary removed and rebuilt from sources/ by fmpy (its CMake project), then simulated."""
+    from fmpy import extract
+    from fmpy.build import build_platform_binary
+    from restitution.cosim import FmuInstance
+
+    unzip = tmp_path / "unzipped"
+    extract(str(native_fmu), str(unzip))
+    (unzip / "binaries/linux64/SpherePlateImpact.so").unlink()
+    build_platform_binary(unzip, build_dir=tmp_path / "build")
+    assert (unzip / "binaries/linux64/SpherePlateImpact.so").is_file()
+    with FmuInstance(native_fmu, unzip_dir=unzip) as fmu:
+        fmu.set(v_approach=2.3)
+        e, v_star = fmu.get("e", "jgm.V_star")
+    assert v_star == pytest.approx(86.9, abs=0.05)  # Green (2022) Sec. 7 checkpoint
+    expected = r.impact(2.3, **params_for("s2/al6061")).e
+    assert e == pytest.approx(expected, rel=1e-12, abs=1e-14)
