@@ -69,11 +69,12 @@ def write_sources(model: str, directory: Path) -> list[str]:
     from ..interface import c_header
     from .compile import PHYSICS_SOURCES
 
+    front = front_files()
     missing = [name for name in (*PHYSICS_SOURCES, BACKENDS[model]) if not (HERE / name).is_file()]
     if missing:  # an installed package without its C files (package-data)
         raise NativeBuildSkipped(f"C sources missing from {HERE}: {', '.join(missing)}")
     prepare_sources(directory)
-    for path in front_files():
+    for path in front:
         shutil.copyfile(path, directory / path.name)
     shutil.copyfile(HERE / BACKENDS[model], directory / BACKENDS[model])
     (directory / INTERFACE_HEADER.format(model=model)).write_text(c_header(model), encoding="utf-8")
