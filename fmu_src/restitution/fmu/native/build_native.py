@@ -30,7 +30,7 @@ from .compile import CFLAGS, prepare_sources
 HERE = Path(__file__).resolve().parent
 FRONT = HERE.parent / "cfront"
 #: Model identifier -> the backend C file of this directory that implements it.
-BACKENDS = {"SpherePlateImpact": "rst_native_impact.c"}
+BACKENDS = {"SpherePlateImpact": ("rst_native_impact.h", "rst_native_impact.c")}
 #: The FMI 2.0 headers fmpy ships (used at build time only; not copied into the FMU: FMI 2.0 hosts bring them).
 FMI2_HEADERS = ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h")
 INTERFACE_HEADER = "rst_{model}_interface.h"
@@ -66,19 +66,26 @@ def front_files() -> list[Path]:
 
 def write_sources(model: str, directory: Path) -> list[str]:
     """Every C file of ``model``'s native FMU into ``directory``; returns the .c files to compile."""
-    from ..interface import c_header
     from .compile import PHYSICS_SOURCES
 
     front = front_files()
-    missing = [name for name in (*PHYSICS_SOURCES, BACKENDS[model]) if not (HERE / name).is_file()]
+    missing = [name for name in (*PHYSICS_SOURCES, *BACKENDS[model]) if not (HERE / name).is_file()]
     if missing:  # an installed package without its C files (package-data)
         raise NativeBuildSkipped(f"C sources missing from {HERE}: {', '.join(missing)}")
     prepare_sources(directory)
     for path in front:
         shutil.copyfile(path, directory / path.name)
-    shutil.copyfile(HERE / BACKENDS[model], directory / BACKENDS[model])
-    (directory / INTERFACE_HEADER.format(model=model)).write_text(c_header(model), encoding="utf-8")
+    write_backend(model, directory)
     return sorted(p.name for p in directory.glob("*.c"))
+
+
+def write_backend(model: str, directory: Path) -> None:
+    """The backend's C files and the interface header they include, generated from the slave's VARIABLES."""
+    from ..interface import c_header
+
+    for name in BACKENDS[model]:
+        shutil.copyfile(HERE / name, directory / name)
+    (directory / INTERFACE_HEADER.format(model=model)).write_text(c_header(model), encoding="utf-8")
 
 
 def native_model_description(xml_text: str, c_files: list[str]) -> str:
