@@ -199,3 +199,37 @@ def test_sanitizers(tmp_path):
         tol, flips = tolerances(case[0], p_case, **options)
         problems = disagreements(type("R", (), got), expected, tol, flips)
         assert not problems, f"{options}: {problems}"
+
+
+def test_paper_table_pairs(native):
+    """Every material pair of the paper's Tables 1, 3 (S2 on Al 6061) and 4, t/d 0.05 ... 10, speeds
+    0.01 ... 10 m/s, both models, every C method."""
+    from restitution.materials import TABLE1_CASES, TABLE4_CASES
+
+    pairs = [(r.MATERIALS[s], d, r.MATERIALS[p]) for s, d, p in TABLE1_CASES.values()]
+    pairs += [(a, 6.35e-3, b) for a, b in map(r.table4_case, TABLE4_CASES)]
+    pairs.append((r.MATERIALS["s2_tool_steel"], 6.35e-3, r.MATERIALS["al_6061"]))
+    v = np.geomspace(0.01, 10.0, 7)
+    for sphere, d, plate in pairs:
+        for t_over_d in (0.05, 0.5, 2.0, 10.0):
+            params = {**r.Sphere(sphere, d).params(), **r.Plate(plate, t_over_d * d).params()}
+            for model, method in itertools.product(r.RESTITUTION_MODELS, NATIVE_METHODS):
+                assert_same_model(native, v, params, restitution_model=model, zener_method=method)
+
+
+def test_hypothesis_search_over_the_declared_domain(native):
+    """A hypothesis search (the lead's strategy of tests/test_properties.py: the declared domain, its
+    bounds, nu up to 0.5 - ulp) for a case where the C and the package disagree."""
+    from hypothesis import HealthCheck, given, settings
+
+    from test_properties import CASES
+
+    @settings(max_examples=300, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])
+    @given(CASES)
+    def search(case):
+        case = dict(case)
+        v = case.pop("v")
+        options = {k: case.pop(k) for k in ("restitution_model", "zener_method", "plasticity", "plate_waves")}
+        assert_same_model(native, v, case, **options)
+
+    search()
