@@ -30,7 +30,10 @@ from .compile import CFLAGS, prepare_sources
 HERE = Path(__file__).resolve().parent
 FRONT = HERE.parent / "cfront"
 #: Model identifier -> the backend C file of this directory that implements it.
-BACKENDS = {"SpherePlateImpact": ("rst_native_impact.h", "rst_native_impact.c")}
+BACKENDS = {"SpherePlateImpact": ("rst_native_impact.h", "rst_native_impact.c"),
+            "BouncingBall": ("rst_native_ball.h", "rst_native_ball.c")}
+#: Models whose backend calls the impact physics (rst_physics.c and the generated Zener table).
+PHYSICS_MODELS = {"SpherePlateImpact"}
 #: The FMI 2.0 headers fmpy ships (used at build time only; not copied into the FMU: FMI 2.0 hosts bring them).
 FMI2_HEADERS = ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h")
 INTERFACE_HEADER = "rst_{model}_interface.h"
@@ -69,10 +72,14 @@ def write_sources(model: str, directory: Path) -> list[str]:
     from .compile import PHYSICS_SOURCES
 
     front = front_files()
-    missing = [name for name in (*PHYSICS_SOURCES, *BACKENDS[model]) if not (HERE / name).is_file()]
+    needed = (*PHYSICS_SOURCES, *BACKENDS[model]) if model in PHYSICS_MODELS else BACKENDS[model]
+    missing = [name for name in needed if not (HERE / name).is_file()]
     if missing:  # an installed package without its C files (package-data)
         raise NativeBuildSkipped(f"C sources missing from {HERE}: {', '.join(missing)}")
-    prepare_sources(directory)
+    if model in PHYSICS_MODELS:
+        prepare_sources(directory)
+    else:
+        directory.mkdir(parents=True, exist_ok=True)
     for path in front:
         shutil.copyfile(path, directory / path.name)
     write_backend(model, directory)
