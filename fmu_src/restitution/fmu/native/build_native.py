@@ -128,6 +128,18 @@ def compile_binary(model: str, sources: Path, c_files: list[str], platform: str,
     return target
 
 
+def native_source_hash(model: str, python_hash: str) -> str:
+    """SHA-256 over the Python sources' hash (the interface and the physics the C follows) and every C
+    file and generator the native FMU is built from."""
+    import hashlib
+
+    digest = hashlib.sha256(python_hash.encode())
+    paths = front_files() + sorted(HERE.glob("*.[ch]")) + sorted(HERE.glob("*.py"))
+    for path in paths:
+        digest.update(path.name.encode() + b"\0" + path.read_bytes() + b"\0")
+    return digest.hexdigest()
+
+
 def _zip_dir(directory: Path, fmu: Path) -> None:
     with zipfile.ZipFile(fmu, "w", zipfile.ZIP_DEFLATED) as z:
         for path in sorted(directory.rglob("*")):
@@ -159,7 +171,7 @@ def build_native_one(model: str, out_dir: Path, python_fmu: Path, log=None) -> P
                 log(f"warning: native {model}.fmu: {exc}")
         if not built:
             raise NativeBuildSkipped(f"no C compiler for any platform: native {model}.fmu not built")
-        info = {"model": model, "native": True, "source_hash": source_hash(model),
+        info = {"model": model, "native": True, "source_hash": native_source_hash(model, source_hash(model)),
                 "platforms": sorted(p.parent.name for p in built)}
         (stage / BUILD_INFO).parent.mkdir(parents=True, exist_ok=True)
         (stage / BUILD_INFO).write_text(json.dumps(info, indent=1), encoding="utf-8")
