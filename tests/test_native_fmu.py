@@ -148,6 +148,7 @@ def test_rebuilt_from_sources_by_fmpy(native_fmu, tmp_path):
     unzip = tmp_path / "unzipped"
     extract(str(native_fmu), str(unzip))
     (unzip / "binaries/linux64/SpherePlateImpact.so").unlink()
+    (tmp_path / "build").mkdir()
     build_platform_binary(unzip, build_dir=tmp_path / "build")
     assert (unzip / "binaries/linux64/SpherePlateImpact.so").is_file()
     with FmuInstance(native_fmu, unzip_dir=unzip) as fmu:
