@@ -108,7 +108,7 @@ void rst_ball_initialize(const rst_ball_binding *binding, double *values, double
 void rst_ball_do_step(const rst_ball_binding *binding, double *values, double current_time, double step_size)
 {
     double g = AT(RST_BALL_G);
-    int wait = (int)AT(RST_BALL_CONTACT_MODE) == CONTACT_MODE_WAIT;
+    int wait = AT(RST_BALL_CONTACT_MODE) == CONTACT_MODE_WAIT; /* compared as a double: no cast of a bad value */
     double end = current_time + step_size;
     if (AT(RST_BALL_IN_CONTACT) != 0.0) /* the COR for the pending contact arrived at this point */
         rebound(binding, values, current_time);
@@ -117,7 +117,7 @@ void rst_ball_do_step(const rst_ball_binding *binding, double *values, double cu
         double v_start = AT(RST_BALL_V_START);
         double v_hit = sqrt(v_start * v_start + 2.0 * g * AT(RST_BALL_H_START));
         double t_hit = AT(RST_BALL_T_START) + (v_start + v_hit) / g;
-        if (t_hit > end + TIME_TOLERANCE)
+        if (!(t_hit <= end + TIME_TOLERANCE)) /* as the slave's t_hit > end + tol, and a NaN ends the loop too */
             break;
         AT(RST_BALL_IMPACTS) += 1.0;
         AT(RST_BALL_T_IMPACT) = t_hit;

@@ -23,6 +23,13 @@ static const char *const OUTPUT_NAMES[RST_IMPACT_N_OUTPUTS] = {
     "valid", "zener.in_range", "jgm.in_range", "e_negative", "effects.plasticity", "effects.plate_waves"};
 #define N_REAL_OUTPUTS 11
 
+/* An Integer code held as a double; -1 (no valid code) for NaN, fractions or values beyond int
+ * (converting those to int would be undefined behaviour). */
+static int to_code(double x)
+{
+    return (x >= -1000.0 && x <= 1000.0 && x == floor(x)) ? (int)x : -1;
+}
+
 static const rst_variable *find(const char *name)
 {
     size_t i;
@@ -90,10 +97,10 @@ int rst_impact_evaluate(const rst_impact_binding *binding, double *values, char 
     inputs.plate_Sy = values[in[8]];
     inputs.plate_rho = values[in[9]];
     inputs.plate_t = values[in[10]];
-    inputs.restitution_model = (int)values[in[11]];
-    inputs.zener_method = (int)values[in[12]];
-    inputs.plasticity = (int)values[in[13]];
-    inputs.plate_waves = (int)values[in[14]];
+    inputs.restitution_model = to_code(values[in[11]]);
+    inputs.zener_method = to_code(values[in[12]]);
+    inputs.plasticity = to_code(values[in[13]]);
+    inputs.plate_waves = to_code(values[in[14]]);
     inputs.effect_tolerance = values[in[15]];
     inputs.ode_rtol = values[in[16]];
     status = rst_impact(&inputs, &r);
