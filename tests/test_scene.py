@@ -300,7 +300,7 @@ def test_command_line_run_and_report(impact_fmu, tmp_path, capsys):
         rows = list(csv.DictReader(f))
     assert len(rows) == 22
     assert list(rows[0]) == ["ball", "plate", "drop_height_m", "impact", "time_s", "v_approach_m_s", "apex_m",
-                             "t_contact_s", "plasticity", "plate_waves"]
+                             "t_contact_s", "plasticity", "plate_waves", "valid", "jgm.in_range", "zener.in_range"]
     assert float(rows[0]["v_approach_m_s"]) == pytest.approx(math.sqrt(2 * G * 0.05), rel=1e-11)
     assert {r_["plasticity"] for r_ in rows} == {"0"} and {r_["plate_waves"] for r_ in rows} == {"1"}
     assert (tmp_path / "glass_marble_glass_plate.png").stat().st_size > 10_000

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+import tempfile
 from pathlib import Path
 
 from ..fmu.build import BuildError
@@ -26,22 +27,52 @@ def _check(args) -> int:
     return 0
 
 
+#: Exit status of an interrupted run (128 + SIGINT, as a shell reports Ctrl-C).
+EXIT_INTERRUPTED = 130
+
+
+class UsageError(Exception):
+    """A command-line value that cannot be used (one line, exit 2)."""
+
+
+def _output_dir(out: Path) -> Path:
+    """``out`` created if missing and checked writable, before the run starts."""
+    if out.exists() and not out.is_dir():
+        raise UsageError(f"--out {out}: exists and is not a directory")
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryFile(dir=out):  # a real write: permission bits lie to root
+            pass
+    except OSError as exc:
+        raise UsageError(f"--out {out}: cannot write there: {exc.strerror or exc}") from None
+    return out
+
+
 def _run(args) -> int:
-    from .runner import run_scene
+    from .runner import DropWriter, SceneInterrupted, run_scene
 
     scene = load_scene(args.file)
-    result = run_scene(scene, fmu=args.fmu, effects="all_on" if args.all_on else "scene",
-                       zener_method=args.zener_method, progress=False if args.no_progress else None,
-                       rebuild=args.rebuild)
-    out = Path(args.out) if args.out else Path("scene-results") / scene.stem
-    out.mkdir(parents=True, exist_ok=True)
+    out = _output_dir(Path(args.out) if args.out else Path("scene-results") / scene.stem)
     suffix = "_all_on" if args.all_on else ""
-    written = [result.write_csv(out / f"{scene.stem}{suffix}.csv"),
-               result.write_summary_csv(out / f"{scene.stem}{suffix}_summary.csv")]
+    table = out / f"{scene.stem}{suffix}.csv"
+    summary = out / f"{scene.stem}{suffix}_summary.csv"
+    with DropWriter(table, scene) as writer:  # each finished drop is on disk before the next starts
+        try:
+            result = run_scene(scene, fmu=args.fmu, effects="all_on" if args.all_on else "scene",
+                               zener_method=args.zener_method, progress=False if args.no_progress else None,
+                               rebuild=args.rebuild, on_drop=writer.write)
+        except SceneInterrupted as exc:
+            exc.result.write_summary_csv(summary)
+            print(f"interrupted: {len(exc.result.drops)} of {exc.n_drops} drops finished and written to {table} "
+                  f"and {summary}; {exc.n_drops - len(exc.result.drops)} drops missing", file=sys.stderr)
+            return EXIT_INTERRUPTED
+    written = [table, result.write_summary_csv(summary)]
     if not args.no_plot:
         written.append(result.plot(out / f"{scene.stem}{suffix}.png"))
     print(result.summary())
     print("wrote " + ", ".join(str(p) for p in written))
+    if result.warning():
+        print(result.warning(), file=sys.stderr)
     return 0
 
 
@@ -60,6 +91,16 @@ def _report(args) -> int:
         print(f"outside the declared tolerance: {', '.join(bad)}", file=sys.stderr)
         return 1
     return 0
+
+
+def _repeat(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not an integer") from None
+    if not 1 <= value <= 1000:
+        raise argparse.ArgumentTypeError(f"{value} is out of range: 1 <= value <= 1000")
+    return value
 
 
 def main(argv=None) -> int:
@@ -85,7 +126,7 @@ def main(argv=None) -> int:
     p.add_argument("files", nargs="+", type=Path)
     p.add_argument("--out", type=Path, default=None, help="Markdown file to write or refresh")
     p.add_argument("--fmu", type=Path, default=None)
-    p.add_argument("--repeat", type=int, default=3, help="timing repeats (best of N)")
+    p.add_argument("--repeat", type=_repeat, default=3, help="timing repeats (best of N, 1 ... 1000)")
     p.add_argument("--methods", default=None, help="Zener methods to compare (default: the scene's and ode)")
     p.add_argument("--no-progress", action="store_true")
     p.set_defaults(func=_report)
@@ -93,7 +134,7 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     try:
         return args.func(args)
-    except (SceneError, BuildError) as exc:
+    except (SceneError, BuildError, UsageError) as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
 

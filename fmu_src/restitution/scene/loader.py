@@ -61,9 +61,9 @@ from pathlib import Path
 import tomllib  # Python >= 3.11
 
 from ..materials import BRITTLE_SY, MATERIALS, TABLE4_CASES, Material, suggest_material, table4_case
-from ..model import EFFECT_MODES, RESTITUTION_MODELS
+from ..model import DOMAIN, EFFECT_MODES, RESTITUTION_MODELS
 from ..zener import ZENER_METHODS
-from .units import UnitError, parse_quantity
+from .units import QUANTITIES, UnitError, parse_quantity
 
 __all__ = ["SceneError", "Scene", "BallSpec", "PlateSpec", "ModelSpec", "SimulationSpec", "Drop",
            "OUTPUTS", "load_scene", "parse_scene", "resolve_material"]
@@ -195,7 +195,9 @@ def _check_keys(ctx: _Ctx, table: dict, where: str, allowed, required=()):
             raise ctx.error(_join(where, key), f"missing required key ({allowed[key]})")
 
 
-def _quantity(ctx, table, where, key, kind, *, positive=True, default=None):
+def _quantity(ctx, table, where, key, kind, *, positive=True, default=None, domain=None):
+    """``domain``: (low, high) [SI] the FMU accepts (:data:`restitution.model.DOMAIN`), checked here
+    so that a value the FMU would reject is a loader error naming the key."""
     full = _join(where, key)
     if key not in table:
         return default
@@ -205,6 +207,10 @@ def _quantity(ctx, table, where, key, kind, *, positive=True, default=None):
         raise SceneError(str(exc), full, ctx.source) from None
     if positive and not value > 0.0:
         raise ctx.error(full, f"{table[key]!r} must be > 0")
+    if domain is not None and not domain[0] <= value <= domain[1]:
+        unit = QUANTITIES[kind]
+        raise ctx.error(full, f"{table[key]!r} is outside the range the FMU accepts: "
+                              f"{domain[0]:g} {unit} <= value <= {domain[1]:g} {unit}")
     return value
 
 
@@ -295,13 +301,13 @@ def _material(ctx, value, where, custom) -> Material:
         required = ()
     _check_keys(ctx, value, where, _MATERIAL_KEYS, required)
     props = {}
-    props["E"] = _quantity(ctx, value, where, "E", "pressure")
+    props["E"] = _quantity(ctx, value, where, "E", "pressure", domain=DOMAIN["sphere_E"])
     props["nu"] = _number(ctx, value, where, "nu", low=0.0, high=0.5, high_open=True)
     if value.get("Sy") == "brittle":
         props["Sy"] = BRITTLE_SY
     else:
-        props["Sy"] = _quantity(ctx, value, where, "Sy", "pressure")
-    props["rho"] = _quantity(ctx, value, where, "rho", "density")
+        props["Sy"] = _quantity(ctx, value, where, "Sy", "pressure", domain=DOMAIN["sphere_Sy"])
+    props["rho"] = _quantity(ctx, value, where, "rho", "density", domain=DOMAIN["sphere_rho"])
     props = {k: v for k, v in props.items() if v is not None}
     label = _string(ctx, value, where, "name", default=None)
     source = _string(ctx, value, where, "source", default=None)
@@ -323,7 +329,9 @@ _MODEL = {"effect_tolerance": "a number >= 0", "zener_method": " | ".join(ZENER_
           "restitution_model": " | ".join(RESTITUTION_MODELS), "plasticity": " | ".join(EFFECT_MODES),
           "plate_waves": " | ".join(EFFECT_MODES)}
 _SIMULATION = {"gravity": 'an acceleration, e.g. "9.81 m/s2"', "v_min": 'a speed, e.g. "0.1 m/s"',
-               "max_bounces": "an integer >= 1"}
+               "max_bounces": "an integer, 1 ... 1000000"}
+#: Largest simulation.max_bounces: bounds the time and memory of a drop whose ball never rests.
+MAX_BOUNCES = 1_000_000
 _PLATE = {"name": "a unique name", "material": "a material name or table", "thickness": 'a length, e.g. "3.18 mm"'}
 _BALL = {"name": "a unique name", "material": "a material name or table", "diameter": 'a length, e.g. "6.35 mm"',
          "drop_heights": 'a length or a list of lengths, e.g. ["0.1 m", "0.5 m"]',
@@ -365,8 +373,9 @@ def parse_scene(data: dict, source: str = "<scene>", path: Path | None = None) -
     _check_keys(ctx, s, "simulation", _SIMULATION)
     d = SimulationSpec()
     max_bounces = s.get("max_bounces", d.max_bounces)
-    if isinstance(max_bounces, bool) or not isinstance(max_bounces, int) or max_bounces < 1:
-        raise ctx.error("simulation.max_bounces", f"{max_bounces!r}: expected an integer >= 1")
+    if isinstance(max_bounces, bool) or not isinstance(max_bounces, int) or not 1 <= max_bounces <= MAX_BOUNCES:
+        raise ctx.error("simulation.max_bounces", f"{max_bounces!r}: expected an integer, 1 <= max_bounces <= "
+                                                  f"{MAX_BOUNCES} (a ball that never rests stops there)")
     simulation = SimulationSpec(gravity=_quantity(ctx, s, "simulation", "gravity", "acceleration", default=d.gravity),
                                 v_min=_quantity(ctx, s, "simulation", "v_min", "speed", default=d.v_min),
                                 max_bounces=max_bounces)
@@ -389,7 +398,8 @@ def parse_scene(data: dict, source: str = "<scene>", path: Path | None = None) -
         _check_keys(ctx, p, where, _PLATE, ("name", "material", "thickness"))
         plates.append(PlateSpec(name=_string(ctx, p, where, "name"),
                                 material=_material(ctx, p["material"], f"{where}.material", custom),
-                                thickness=_quantity(ctx, p, where, "thickness", "length")))
+                                thickness=_quantity(ctx, p, where, "thickness", "length",
+                                                    domain=DOMAIN["plate_t"])))
     _unique(ctx, plates, "plates")
     plate_names = [p.name for p in plates]
 
@@ -401,7 +411,10 @@ def parse_scene(data: dict, source: str = "<scene>", path: Path | None = None) -
         heights = heights if isinstance(heights, list) else [heights]
         if not heights:
             raise ctx.error(f"{where}.drop_heights", "expected at least one drop height")
-        drop_heights = tuple(_quantity(ctx, {f"drop_heights[{j}]": h}, where, f"drop_heights[{j}]", "length")
+        # the first impact's speed sqrt(2 g h) must be one the FMU accepts (v_approach <= DOMAIN["v"][1])
+        highest = DOMAIN["v"][1] ** 2 / (2.0 * simulation.gravity)
+        drop_heights = tuple(_quantity(ctx, {f"drop_heights[{j}]": h}, where, f"drop_heights[{j}]", "length",
+                                       domain=(0.0, highest))
                              for j, h in enumerate(heights))
         on = _string_list(ctx, b, where, "plates") if "plates" in b else plate_names
         for plate in on:
@@ -409,7 +422,7 @@ def parse_scene(data: dict, source: str = "<scene>", path: Path | None = None) -
                 raise ctx.error(f"{where}.plates", f"no plate named {plate!r}; plates: {', '.join(plate_names)}")
         balls.append(BallSpec(name=_string(ctx, b, where, "name"),
                               material=_material(ctx, b["material"], f"{where}.material", custom),
-                              diameter=_quantity(ctx, b, where, "diameter", "length"),
+                              diameter=_quantity(ctx, b, where, "diameter", "length", domain=DOMAIN["sphere_d"]),
                               drop_heights=drop_heights, plates=tuple(on)))
     _unique(ctx, balls, "balls")
 

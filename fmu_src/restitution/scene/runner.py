@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import csv
 import math
+import os
 import sys
 import time
 from dataclasses import dataclass, field
@@ -39,10 +40,11 @@ from ..jgm import (critical_interference, critical_load, critical_pressure, crit
 from ..model import EFFECT_MODES, RESTITUTION_MODELS, ZENER_SLOPE_BOUND
 from ..zener import ZENER_METHODS, inelasticity_parameter
 from ..cosim.bouncing import impact_sequence
+from ..cosim.interrupt import DeferredInterrupt
 from .loader import Drop, Scene
 
-__all__ = ["DropResult", "SceneResult", "run_scene", "ensure_fmu", "open_instance", "COLUMNS",
-           "READ_OUTPUTS", "drop_parameters"]
+__all__ = ["DropResult", "SceneResult", "SceneInterrupted", "DropWriter", "run_scene", "ensure_fmu",
+           "open_instance", "COLUMNS", "READ_OUTPUTS", "VALIDITY", "drop_parameters"]
 
 #: requested output -> (FMU output names, result column names, units)
 READ_OUTPUTS = {
@@ -52,6 +54,19 @@ READ_OUTPUTS = {
 }
 #: column -> CSV header
 COLUMNS = {"apex": "apex_m", "e": "e", "e_ep": "e_ep", "e_ze": "e_ze", "t_contact": "t_contact_s"}
+#: Validity flags read at every impact (FMU Boolean outputs, also the CSV headers): inside
+#: JGM's V* <= 1000 and Zener's lambda <= 1.5, and both.
+VALIDITY = ("valid", "jgm.in_range", "zener.in_range")
+_FLAGS = ("effects.plasticity", "effects.plate_waves", *VALIDITY)
+
+
+class SceneInterrupted(KeyboardInterrupt):
+    """An interrupted scene run: ``result`` holds the drops that finished."""
+
+    def __init__(self, result: "SceneResult", n_drops: int):
+        super().__init__(f"scene interrupted after {len(result.drops)} of {n_drops} drops")
+        self.result = result
+        self.n_drops = n_drops
 
 
 
@@ -110,6 +125,13 @@ class DropResult:
     plate_waves: np.ndarray  #: effects.plate_waves at each impact
     stop_reason: str  #: "v_min", "e<=0" or "max_bounces"
     gravity: float = 9.80665  #: [m/s2]
+    validity: dict = field(default_factory=dict)  #: VALIDITY flag -> Boolean array, per impact
+
+    @property
+    def out_of_range(self) -> int:
+        """Impacts outside the models' validated ranges (``valid`` false)."""
+        valid = self.validity.get("valid")
+        return 0 if valid is None else int(np.count_nonzero(~valid))
 
     @property
     def n_impacts(self) -> int:
@@ -156,31 +178,39 @@ class SceneResult:
     def columns(self) -> list:
         return [c for out in self.scene.outputs for c in READ_OUTPUTS[out][1]]
 
+    @property
+    def out_of_range(self) -> int:
+        """Impacts outside the models' validated ranges (``valid`` false), over every drop."""
+        return sum(d.out_of_range for d in self.drops)
+
+    def warning(self) -> str | None:
+        """One line when any impact lies outside the validated ranges, else None."""
+        n = self.out_of_range
+        if not n:
+            return None
+        jgm = sum(int(np.count_nonzero(~d.validity["jgm.in_range"])) for d in self.drops)
+        zener = sum(int(np.count_nonzero(~d.validity["zener.in_range"])) for d in self.drops)
+        return (f"warning: {n} of {self.n_impacts} impacts lie outside the models' validated ranges "
+                f"(valid = 0: {jgm} with V* > 1000, {zener} with lambda > 1.5); their e is an extrapolation")
+
     def write_csv(self, path) -> Path:
-        """One row per impact: drop, impact instant and speed, requested outputs, effects used."""
-        path = Path(path)
-        cols = self.columns()
-        with path.open("w", newline="") as f:
-            w = csv.writer(f)
-            w.writerow(["ball", "plate", "drop_height_m", "impact", "time_s", "v_approach_m_s",
-                        *(COLUMNS[c] for c in cols), "plasticity", "plate_waves"])
+        """One row per impact: drop, impact instant and speed, requested outputs, effects used,
+        validity flags (:class:`DropWriter`)."""
+        with DropWriter(path, self.scene) as writer:
             for d in self.drops:
-                for i in range(d.n_impacts):
-                    w.writerow([d.drop.ball.name, d.drop.plate.name, f"{d.drop.drop_height:.9g}", i + 1,
-                                f"{d.time[i]:.12g}", f"{d.v_approach[i]:.12g}",
-                                *(f"{d.columns[c][i]:.12g}" for c in cols),
-                                int(d.plasticity[i]), int(d.plate_waves[i])])
-        return path
+                writer.write(d)
+        return Path(path)
 
     def write_summary_csv(self, path) -> Path:
         path = Path(path)
         with path.open("w", newline="") as f:
             w = csv.writer(f)
             w.writerow(["ball", "plate", "drop_height_m", "impacts", "rest_time_s", "stop_reason",
-                        "plasticity_impacts", "plate_wave_impacts"])
+                        "plasticity_impacts", "plate_wave_impacts", "out_of_range_impacts"])
             for d in self.drops:
                 w.writerow([d.drop.ball.name, d.drop.plate.name, f"{d.drop.drop_height:.9g}", d.n_impacts,
-                            f"{d.rest_time:.9g}", d.stop_reason, int(d.plasticity.sum()), int(d.plate_waves.sum())])
+                            f"{d.rest_time:.9g}", d.stop_reason, int(d.plasticity.sum()), int(d.plate_waves.sum()),
+                            d.out_of_range])
         return path
 
     def summary(self) -> str:
@@ -188,11 +218,11 @@ class SceneResult:
         lines = [f"{self.scene.name}: {len(self.drops)} drops, {self.n_impacts} impacts, "
                  f"{self.wall_time:.3f} s (zener_method = {self.zener_method}, plasticity = {self.plasticity_mode}, "
                  f"plate_waves = {self.plate_waves_mode})"]
-        width = max(len(d.drop.label) for d in self.drops)
-        lines.append(f"  {'drop':<{width}}  impacts  plasticity  plate waves  stop")
+        width = max([len(d.drop.label) for d in self.drops] + [4])
+        lines.append(f"  {'drop':<{width}}  impacts  plasticity  plate waves  out of range  stop")
         for d in self.drops:
             lines.append(f"  {d.drop.label:<{width}}  {d.n_impacts:7d}  {int(d.plasticity.sum()):10d}  "
-                         f"{int(d.plate_waves.sum()):11d}  {d.stop_reason}")
+                         f"{int(d.plate_waves.sum()):11d}  {d.out_of_range:12d}  {d.stop_reason}")
         lines += [f"  {line}" for line in explain(self)]
         return "\n".join(lines)
 
@@ -239,6 +269,42 @@ class SceneResult:
         fig.savefig(path, dpi=120)
         plt.close(fig)
         return path
+
+
+class DropWriter:
+    """The per-impact CSV of a scene, written drop by drop: each finished drop's rows are on
+    disk (flushed and fsynced) before the next drop starts, so an interrupt loses none."""
+
+    def __init__(self, path, scene: Scene):
+        self.path = Path(path)
+        self.cols = [c for out in scene.outputs for c in READ_OUTPUTS[out][1]]
+        self.file = self.path.open("w", newline="")
+        self.csv = csv.writer(self.file)
+        self.csv.writerow(["ball", "plate", "drop_height_m", "impact", "time_s", "v_approach_m_s",
+                           *(COLUMNS[c] for c in self.cols), "plasticity", "plate_waves", *VALIDITY])
+        self._sync()
+
+    def write(self, d: DropResult) -> None:
+        flags = [d.validity.get(name, np.ones(d.n_impacts, bool)) for name in VALIDITY]
+        for i in range(d.n_impacts):
+            self.csv.writerow([d.drop.ball.name, d.drop.plate.name, f"{d.drop.drop_height:.9g}", i + 1,
+                               f"{d.time[i]:.12g}", f"{d.v_approach[i]:.12g}",
+                               *(f"{d.columns[c][i]:.12g}" for c in self.cols),
+                               int(d.plasticity[i]), int(d.plate_waves[i]), *(int(f[i]) for f in flags)])
+        self._sync()
+
+    def _sync(self):
+        self.file.flush()
+        os.fsync(self.file.fileno())
+
+    def close(self):
+        self.file.close()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
 
 
 # --- why effects were left out ---------------------------------------------------------------
@@ -303,7 +369,8 @@ def explain(result: SceneResult) -> list[str]:
 
 # --- the master ----------------------------------------------------------------------------------
 
-def _run_drop(instance, scene: Scene, drop: Drop, params: dict, read_names, read_cols) -> DropResult:
+def _run_drop(instance, scene: Scene, drop: Drop, params: dict, read_names, read_cols,
+              interrupt: DeferredInterrupt | None = None) -> DropResult:
     sim = scene.simulation
     g, v_min = sim.gravity, sim.v_min
     slave = instance.slave
@@ -319,13 +386,15 @@ def _run_drop(instance, scene: Scene, drop: Drop, params: dict, read_names, read
     vr_in = [instance.vr("v_approach")]
     real_names = ("v_rebound", *read_names)
     vr_real = [instance.vr(n) for n in real_names]
-    vr_bool = [instance.vr("effects.plasticity"), instance.vr("effects.plate_waves")]
+    vr_bool = [instance.vr(name) for name in _FLAGS]
     get_real, get_bool, set_real, do_step = slave.getReal, slave.getBoolean, slave.setReal, slave.doStep
 
     def rebound(v):  # only the requested outputs, and the effects used
         set_real(vr_in, [v])
         out = dict(zip(real_names, get_real(vr_real)))  # floats: checked for NaN by impact_sequence
         out["flags"] = get_bool(vr_bool)
+        if interrupt is not None:
+            interrupt.check()  # here, between FMU calls, never inside one
         return out
 
     try:
@@ -338,7 +407,7 @@ def _run_drop(instance, scene: Scene, drop: Drop, params: dict, read_names, read
     rows = [[out[n] for n in real_names] for _, _, out in events]
     flags = [out["flags"] for _, _, out in events]
     data = np.array(rows, dtype=float).reshape(len(rows), 1 + len(read_names))
-    flags = np.array(flags, dtype=bool).reshape(len(rows), 2)
+    flags = np.array(flags, dtype=bool).reshape(len(rows), len(_FLAGS))
     v_reb = data[:, 0]
     columns = {}
     if "bounce_heights" in scene.outputs:
@@ -347,18 +416,21 @@ def _run_drop(instance, scene: Scene, drop: Drop, params: dict, read_names, read
         columns[col] = data[:, 1 + j]
     return DropResult(drop=drop, time=np.array(times), v_approach=np.array(speeds), v_rebound=v_reb,
                       columns=columns, plasticity=flags[:, 0], plate_waves=flags[:, 1], stop_reason=stop,
-                      gravity=g)
+                      gravity=g, validity={name: flags[:, 2 + k] for k, name in enumerate(VALIDITY)})
 
 
 def run_scene(scene: Scene, fmu=None, *, effects: str = "scene", zener_method: str | None = None,
-              instance=None, progress: bool | None = None, rebuild: bool = False) -> SceneResult:
+              instance=None, progress: bool | None = None, rebuild: bool = False, on_drop=None) -> SceneResult:
     """Simulate every drop of ``scene`` through the FMU.
 
     ``effects``: ``"scene"`` (the scene's modes, auto by default, see :meth:`Scene.effect_modes`)
     or ``"all_on"`` (plasticity = plate_waves = on, the reference). ``zener_method`` overrides
     the scene's. ``instance``: an open :class:`~restitution.cosim.FmuInstance` to reuse
     (else one is opened on ``fmu`` or the built/reused dist/ FMU, and closed afterwards).
-    ``progress``: a tqdm bar (None: shown only when the run takes more than a second).
+    ``progress``: None or True: in a terminal, a bar once the run has taken a second; always a
+    final line on stderr with the drops done; False: nothing. ``on_drop``: called with each
+    :class:`DropResult` as soon as its drop finishes (e.g. :meth:`DropWriter.write`). An
+    interrupt raises :class:`SceneInterrupted` with the finished drops.
     """
     if effects == "scene":
         plasticity, plate_waves = scene.effect_modes()
@@ -378,32 +450,54 @@ def run_scene(scene: Scene, fmu=None, *, effects: str = "scene", zener_method: s
         fmu_path = ensure_fmu(fmu, rebuild=rebuild)
         instance = open_instance(fmu_path)
     drops = scene.drops()
+    results = []
+    start = time.perf_counter()
+
+    def result():
+        return SceneResult(scene=scene, drops=results, plasticity_mode=plasticity, plate_waves_mode=plate_waves,
+                           zener_method=method, wall_time=time.perf_counter() - start, fmu_path=fmu_path)
+
+    bar = _progress(drops, scene, progress, method)
     try:
-        bar = _progress(drops, scene, progress, method)
-        results = []
-        start = time.perf_counter()
-        for drop in bar:
-            params = drop_parameters(scene, drop, plasticity, plate_waves, method)
-            result = _run_drop(instance, scene, drop, params, read_names, read_cols)
-            results.append(result)
-            if hasattr(bar, "set_postfix_str"):
-                bar.set_postfix_str(f"{sum(r.n_impacts for r in results)} impacts")
-        wall = time.perf_counter() - start
-        if hasattr(bar, "close"):
-            bar.close()
+        with DeferredInterrupt() as interrupt:
+            for drop in drops:
+                interrupt.check()
+                params = drop_parameters(scene, drop, plasticity, plate_waves, method)
+                done = _run_drop(instance, scene, drop, params, read_names, read_cols, interrupt)
+                results.append(done)
+                if on_drop is not None:
+                    on_drop(done)
+                if bar is not None:
+                    bar.set_postfix_str(f"{sum(r.n_impacts for r in results)} impacts", refresh=False)
+                    bar.update(1)
+    except KeyboardInterrupt:
+        _final_line(bar, progress, scene, method, results, len(drops), start, "interrupted")
+        raise SceneInterrupted(result(), len(drops)) from None
     finally:
         if own:
             instance.close()
-    return SceneResult(scene=scene, drops=results, plasticity_mode=plasticity, plate_waves_mode=plate_waves,
-                       zener_method=method, wall_time=wall, fmu_path=fmu_path)
+    _final_line(bar, progress, scene, method, results, len(drops), start, "done")
+    return result()
 
 
 def _progress(drops, scene, progress, method):
-    if progress is False:
-        return drops
+    """A tqdm bar in a terminal (shown after a second); None when redirected or not wanted."""
+    if progress is False or not sys.stderr.isatty():
+        return None
     try:
         from tqdm import tqdm
     except ModuleNotFoundError:  # the bar is a convenience, not a requirement
-        return drops
-    return tqdm(drops, desc=f"{scene.stem} ({method})", unit="drop", delay=0.0 if progress else 1.0,
-                leave=False, file=sys.stderr)
+        return None
+    return tqdm(total=len(drops), desc=f"{scene.stem} ({method})", unit="drop", delay=1.0, leave=False,
+                file=sys.stderr)
+
+
+def _final_line(bar, progress, scene, method, results, n_drops, start, state):
+    if bar is not None:
+        bar.close()
+    if progress is False:
+        return
+    sys.stdout.flush()
+    print(f"{scene.stem} ({method}): {len(results)}/{n_drops} drops {state}, "
+          f"{sum(r.n_impacts for r in results)} impacts, {time.perf_counter() - start:.3g} s", file=sys.stderr,
+          flush=True)

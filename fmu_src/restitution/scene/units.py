@@ -28,7 +28,8 @@ UNITS: dict[str, dict[str, float]] = {
 QUANTITIES = {"length": "m", "pressure": "Pa", "density": "kg/m3", "speed": "m/s", "acceleration": "m/s2"}
 
 _KIND_OF = {unit: kind for kind, units in UNITS.items() for unit in units}
-_NUMBER = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(\S.*?)?\s*$")
+# ASCII digits only: float() would take "٣.١٨" (Arabic-Indic digits) as 3.18.
+_NUMBER = re.compile(r"^\s*([-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][-+]?[0-9]+)?)\s*(\S.*?)?\s*$", re.ASCII)
 
 
 def _examples(kind: str) -> str:
@@ -52,7 +53,7 @@ def parse_quantity(key: str, value, kind: str) -> float:
                         f"(units: {_examples(kind)})")
     match = _NUMBER.match(value)
     if match is None:
-        raise UnitError(f"{value!r} is not '<number> <unit>', e.g. {example}")
+        raise UnitError(f"{value!r} is not '<number> <unit>' (a number in ASCII digits), e.g. {example}")
     number, unit = float(match.group(1)), match.group(2)
     if unit is None:
         raise UnitError(f"{value!r} has no unit: write the {kind} with its unit, e.g. {example} "

@@ -3,11 +3,63 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import os
 import sys
+import tempfile
 from pathlib import Path
 
 from ..materials import MATERIALS, TABLE4_CASES
-from .spec import CODES, INPUT_NAMES, INPUTS, T_OVER_D, SweepSpec, canonical_name, load_spec
+from .spec import CODES, INPUT_NAMES, INPUTS, MAX_SAMPLES, MAX_SEED, T_OVER_D, SweepSpec, canonical_name, load_spec
+
+#: Exit status of an interrupted sweep (128 + SIGINT, as a shell reports Ctrl-C).
+EXIT_INTERRUPTED = 130
+#: Largest --chunk-size and --workers.
+MAX_CHUNK = 10**9
+MAX_WORKERS = 4096
+
+
+def _int_in(low: int, high: int):
+    """argparse type: an integer in [low, high] (checked at parse time; one-line error)."""
+    def parse(text: str) -> int:
+        try:
+            value = int(text.strip())
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r} is not an integer") from None
+        if not low <= value <= high:
+            raise argparse.ArgumentTypeError(f"{value} is out of range: {low} <= value <= {high}")
+        return value
+    return parse
+
+
+def _bytes_arg(text: str) -> int:
+    """argparse type: a size in bytes, with an optional K/M/G/T(iB) suffix."""
+    units = {"": 1, "k": 2**10, "kib": 2**10, "m": 2**20, "mib": 2**20, "g": 2**30, "gib": 2**30,
+             "t": 2**40, "tib": 2**40}
+    body = text.strip()
+    digits = body.rstrip("KMGTiBkmgtib")
+    try:
+        value = float(digits) * units[body[len(digits):].lower()]
+    except (ValueError, KeyError):
+        raise argparse.ArgumentTypeError(f"{text!r} is not a size (e.g. 2GiB, 500M, 1000000)") from None
+    if not 1 <= value <= 2**60:
+        raise argparse.ArgumentTypeError(f"{text!r} is out of range: 1 byte ... 1 EiB")
+    return int(value)
+
+
+def check_output(path: Path, what: str = "--out") -> None:
+    """ValueError (one line) unless ``path`` can be written: not a directory, its parent a
+    writable directory (created if missing). Checked before the run starts."""
+    if path.is_dir():
+        raise ValueError(f"{what} {path}: is a directory; give a file name (.csv or .parquet)")
+    parent = path.parent
+    try:
+        parent.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryFile(dir=parent):  # a real write: permission bits lie to root
+            pass
+    except OSError as exc:
+        raise ValueError(f"{what} {path}: cannot write in {parent}: {exc.strerror or exc}") from None
+    if path.exists() and not os.access(path, os.W_OK):
+        raise ValueError(f"{what} {path}: not writable")
 
 EXAMPLES = """examples:
   # e over speed and t/d for two material pairs, on a local Dask cluster (one worker per core)
@@ -82,8 +134,8 @@ def main(argv=None) -> int:
                         help="random parameter: uniform:lo:hi, loguniform:lo:hi, normal:mean:sd, "
                              "normal_rel:sd, uniform_rel:h, choice:a,b (repeat)")
     parser.add_argument("--set", action="append", metavar="NAME=VALUE", help="fixed value (repeat)")
-    parser.add_argument("--samples", type=int, help="random cases per grid point")
-    parser.add_argument("--seed", type=int, help="seed of the random draws")
+    parser.add_argument("--samples", type=_int_in(1, MAX_SAMPLES), help="random cases per grid point")
+    parser.add_argument("--seed", type=_int_in(0, MAX_SEED), help="seed of the random draws (0 ... 2**63 - 1)")
     parser.add_argument("--backend", choices=("package", "fmu", "both"),
                         help="package: vectorized (default); fmu: the FMU itself; both: run both and "
                              "compare (exit 1 if any output differs by more than its conditioning allows, "
@@ -93,8 +145,14 @@ def main(argv=None) -> int:
     parser.add_argument("--scheduler", help="address of a running dask.distributed scheduler "
                                             "(tcp://host:8786), 'local' (new LocalCluster) or 'serial' "
                                             "(no Dask); default: $DASK_SCHEDULER_ADDRESS, else local")
-    parser.add_argument("--workers", type=int, help="LocalCluster worker processes (default: one per core)")
-    parser.add_argument("--chunk-size", type=int, help="cases per Dask task")
+    parser.add_argument("--workers", type=_int_in(1, MAX_WORKERS),
+                        help="LocalCluster worker processes (default: one per core)")
+    parser.add_argument("--chunk-size", type=_int_in(1, MAX_CHUNK), help="cases per Dask task")
+    parser.add_argument("--memory-budget", type=_bytes_arg, metavar="BYTES",
+                        help="largest table to gather, e.g. 2GiB (default: half the memory available); "
+                             "a bigger sweep is refused before it starts")
+    parser.add_argument("--resume", action="store_true",
+                        help="complete an interrupted sweep: evaluate only the chunks missing from <out>.parts/")
     parser.add_argument("--columns", help="keep only these comma-separated columns (plus case and pair), "
                                           "e.g. v_approach,t_over_d,e,valid for a big sweep")
     parser.add_argument("--out", help="table: .csv or .parquet (default: sweep.parquet with pyarrow, else sweep.csv)")
@@ -110,12 +168,14 @@ def main(argv=None) -> int:
         return 0
     try:
         spec, run = build_spec(args)
-    except ValueError as exc:
+        run_ints = {key: _int_in(low, high)(str(run[key])) for key, low, high in (
+            ("workers", 1, MAX_WORKERS), ("chunk_size", 1, MAX_CHUNK)) if run.get(key) is not None}
+    except (ValueError, argparse.ArgumentTypeError) as exc:
         parser.error(str(exc))
     backend = args.backend or run.get("backend", "package")
     scheduler = args.scheduler or run.get("scheduler")
-    workers = args.workers or run.get("workers")
-    chunk = args.chunk_size or run.get("chunk_size")
+    workers = args.workers if args.workers is not None else run_ints.get("workers")
+    chunk = args.chunk_size if args.chunk_size is not None else run_ints.get("chunk_size")
     fmu = args.fmu or run.get("fmu")
     out = args.out or run.get("out")
     if backend in ("fmu", "both") and fmu is None and not args.dry_run:
@@ -139,25 +199,48 @@ def main(argv=None) -> int:
     plot = None if (args.no_plot or run.get("plot") is False) else Path(
         args.plot or run.get("plot") or out.with_name(out.stem + "_cor_map.png"))
     print(f"sweep: {spec.describe()}")
-    if args.dry_run:
-        return 0
-
-    from .run import open_client, run_sweep
-
-    progress = not args.no_progress
     columns = args.columns or run.get("columns")
     if isinstance(columns, str):
         columns = [c.strip() for c in columns.split(",") if c.strip()]
+    from .run import check_memory, table_bytes
+
+    try:
+        need = check_memory(spec, columns, args.memory_budget, backends=2 if backend == "both" else 1)
+        check_output(out)
+        if plot is not None:
+            check_output(plot, "--plot")
+    except ValueError as exc:
+        if args.dry_run and "memory budget" in str(exc):
+            print(f"sweep: {exc}")
+            return 0
+        parser.error(str(exc))
+    if args.dry_run:
+        print(f"sweep: the table would take {need:,} bytes in memory ({table_bytes(1, columns)} bytes a case)")
+        return 0
+
+    from .run import SweepInterrupted, open_client, run_sweep
+
+    progress = not args.no_progress
     status = 0
-    with contextlib.ExitStack() as stack:
-        target = "serial" if scheduler == "serial" else stack.enter_context(open_client(scheduler, workers))
-        backends = ("package", "fmu") if backend == "both" else (backend,)
-        results = {}
-        for name in backends:
-            res = run_sweep(spec, name, fmu=fmu, scheduler=target, chunk_size=chunk, progress=progress,
-                            columns=columns)
-            print(res.summary())
-            results[name] = res
+    parts = out.with_name(out.name + ".parts")
+    backends = ("package", "fmu") if backend == "both" else (backend,)
+    results = {}
+    try:
+        with contextlib.ExitStack() as stack:
+            target = "serial" if scheduler == "serial" else stack.enter_context(open_client(scheduler, workers))
+            for name in backends:
+                res = run_sweep(spec, name, fmu=fmu, scheduler=target, chunk_size=chunk, progress=progress,
+                                columns=columns, parts=parts / name, resume=args.resume)
+                print(res.summary())
+                results[name] = res
+    except SweepInterrupted as exc:
+        written = exc.result.write(out)
+        print(f"\ninterrupted: wrote the {len(exc.result):,} finished cases to {written}; {exc.missing:,} of "
+              f"{spec.n_cases:,} cases are missing (finished chunks kept in {parts}); run the same command "
+              f"with --resume to complete them", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    except ValueError as exc:  # --resume on another sweep's parts
+        parser.error(str(exc))
     if backend == "both":
         from .compare import agreement_report
 
@@ -175,6 +258,12 @@ def main(argv=None) -> int:
                   "(restitution.agreement)")
     result = results[backends[0]]
     print(f"table: {result.write(out)}")
+    import shutil
+
+    shutil.rmtree(parts, ignore_errors=True)  # the table is whole: the finished chunks are not needed
+    for res in results.values():
+        if res.warning():
+            print(f"{res.backend}: {res.warning()}", file=sys.stderr)
     if plot is not None:
         try:
             print(f"COR map: {result.plot(plot)}")

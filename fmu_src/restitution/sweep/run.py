@@ -9,13 +9,22 @@
 
 The work is cut into chunks of consecutive case indices; each Dask task builds its cases
 from the spec (nothing large travels to the workers) and evaluates them with the back end.
+
+With ``parts=DIR`` every finished chunk is written to DIR as it completes (one ``.npz`` file a
+chunk, written under a temporary name and renamed, so a file there is always whole), beside a
+``manifest.json`` naming the spec, back end, chunk size and columns. An interrupt (Ctrl-C) then
+raises :class:`SweepInterrupted` carrying the table of the finished chunks, and
+``resume=True`` on the same DIR evaluates only the chunks that are missing.
 """
 from __future__ import annotations
 
 import contextlib
+import json
 import logging
 import math
 import os
+import shutil
+import sys
 import time
 import warnings
 from dataclasses import dataclass, field
@@ -23,13 +32,69 @@ from pathlib import Path
 
 import numpy as np
 
+from ..cosim.interrupt import DeferredInterrupt
 from .backends import Backend, FmuBackend, code_fingerprint, get_backend, release_fmus
-from .spec import INPUT_NAMES, INTEGER_INPUTS, OUTPUT_NAMES, T_OVER_D, SweepSpec
+from .spec import INPUT_NAMES, INTEGER_INPUTS, OUTPUT_NAMES, OUTPUTS as _OUTPUT_TYPES, T_OVER_D, SweepSpec
 
-__all__ = ["run_sweep", "SweepResult", "open_client", "machine_workers", "compare_results", "COLUMNS"]
+__all__ = ["run_sweep", "SweepResult", "SweepInterrupted", "open_client", "machine_workers", "compare_results",
+           "COLUMNS", "table_bytes", "memory_budget", "check_memory"]
 
 #: Column order of a result table.
 COLUMNS = ("case", "pair", *INPUT_NAMES, T_OVER_D, *OUTPUT_NAMES, "ok")
+
+
+class SweepInterrupted(KeyboardInterrupt):
+    """An interrupted sweep: ``result`` holds the finished chunks, ``missing`` counts the cases left."""
+
+    def __init__(self, result: "SweepResult", missing: int):
+        super().__init__(f"sweep interrupted: {missing} of {missing + len(result)} cases missing")
+        self.result = result
+        self.missing = missing
+
+
+# --- the size guard --------------------------------------------------------------------------------
+def table_bytes(n_cases: int, columns=None) -> int:
+    """Bytes the table of ``n_cases`` cases takes in memory (8 bytes a number, 1 a Boolean, a
+    pointer for the pair label), for ``columns`` (None: all of :data:`COLUMNS`). Python ints."""
+    names = COLUMNS if columns is None else [c for c in COLUMNS if c in columns]
+    booleans = {"ok", *(name for name, _, vtype in _OUTPUT_TYPES if vtype == "Boolean")}
+    per_case = sum(1 if name in booleans else 8 for name in names)
+    return int(n_cases) * per_case
+
+
+def memory_budget(fraction: float = 0.5) -> int:
+    """Default memory budget of a sweep table [bytes]: ``fraction`` of the memory available now
+    (MemAvailable on Linux, else of the physical memory)."""
+    available = None
+    with contextlib.suppress(OSError, ValueError):
+        with open("/proc/meminfo", encoding="ascii") as f:
+            for line in f:
+                if line.startswith("MemAvailable:"):
+                    available = int(line.split()[1]) * 1024
+    if available is None:
+        try:
+            available = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+        except (ValueError, OSError, AttributeError):
+            available = 4 * 2**30
+    return int(available * fraction)
+
+
+def check_memory(spec: SweepSpec, columns=None, budget: int | None = None, backends: int = 1) -> int:
+    """Bytes the table(s) will take; ValueError with the numbers when above ``budget``
+    (default :func:`memory_budget`). Called before any work."""
+    need = backends * table_bytes(spec.n_cases, columns)
+    budget = memory_budget() if budget is None else int(budget)
+    if need > budget:
+        raise ValueError(f"the table of {spec.n_cases:,} cases would take {_bytes(need)}, over the memory budget "
+                         f"of {_bytes(budget)}: sweep fewer cases, keep fewer --columns, or raise --memory-budget")
+    return need
+
+
+def _bytes(n: int) -> str:
+    for unit, size in (("TiB", 2**40), ("GiB", 2**30), ("MiB", 2**20), ("KiB", 2**10)):
+        if n >= size:
+            return f"{n / size:,.3g} {unit} ({n:,} bytes)"
+    return f"{n} bytes"
 
 
 def machine_workers() -> int:
@@ -137,7 +202,26 @@ class SweepResult:
             text += f"; {ok} evaluated, {len(self) - ok} with inputs out of range"
         if "valid" in self.columns:
             text += f"; {int(np.count_nonzero(self.columns['valid']))} inside the models' validated ranges"
+            counts = self.out_of_range()
+            text += (f" ({counts['valid']} outside: {counts['jgm.in_range']} beyond JGM's V* <= 1000, "
+                     f"{counts['zener.in_range']} beyond Zener's lambda <= 1.5)")
         return text
+
+    def out_of_range(self) -> dict:
+        """Evaluated cases (``ok``) outside the validated ranges, per flag (``valid``,
+        ``jgm.in_range``, ``zener.in_range``; flags not kept in the table count 0)."""
+        ok = np.asarray(self.columns["ok"], dtype=bool) if "ok" in self.columns else np.ones(len(self), bool)
+        return {flag: int(np.count_nonzero(ok & ~np.asarray(self.columns[flag], dtype=bool)))
+                if flag in self.columns else 0 for flag in ("valid", "jgm.in_range", "zener.in_range")}
+
+    def warning(self) -> str | None:
+        """A one-line warning when any evaluated case lies outside the validated ranges, else None."""
+        counts = self.out_of_range()
+        if not counts["valid"]:
+            return None
+        return (f"warning: {counts['valid']} of {len(self)} cases lie outside the models' validated ranges "
+                f"(valid = False: {counts['jgm.in_range']} with V* > 1000, {counts['zener.in_range']} with "
+                f"lambda > 1.5); their e is an extrapolation")
 
     # --- output ---
     def write(self, path) -> Path:
@@ -283,7 +367,7 @@ def _keep(columns):
 
 def run_sweep(spec: SweepSpec | dict, backend: str | Backend = "package", *, fmu=None, scheduler=None,
               n_workers: int | None = None, chunk_size: int | None = None, progress: bool = False,
-              columns=None, release: bool = True) -> SweepResult:
+              columns=None, release: bool = True, parts=None, resume: bool = False) -> SweepResult:
     """Evaluate every case of ``spec`` and return the table.
 
     ``backend``: "package" (vectorized :func:`restitution.impact`) or "fmu" (the FMU at ``fmu``,
@@ -292,61 +376,190 @@ def run_sweep(spec: SweepSpec | dict, backend: str | Backend = "package", *, fmu
     "local" (always a new LocalCluster), a scheduler address, a ``distributed.Client``, or
     "serial" (no Dask: one loop in this process, for reference and debugging).
     ``chunk_size``: cases per task (default: the back end's, at most a quarter of each worker's
-    share so the work spreads and progress moves). ``progress``: show Dask's progress bar.
-    ``columns``: keep only these columns (besides ``case`` and ``pair``), for sweeps whose
-    full table would be too big to gather. ``release=False`` keeps the FMU instances loaded
-    in the workers for the next sweep (free them with ``client.run(release_fmus)``).
+    share so the work spreads and progress moves). ``progress``: a progress line on stderr
+    (redrawn in a terminal; elsewhere only the final state). ``columns``: keep only these
+    columns (besides ``case`` and ``pair``), for sweeps whose full table would be too big to
+    gather. ``release=False`` keeps the FMU instances loaded in the workers for the next sweep
+    (free them with ``client.run(release_fmus)``). ``parts``: directory where each finished chunk
+    is written as it completes; ``resume=True`` keeps the chunks already there (same spec, back
+    end, chunk size and columns) and evaluates only the missing ones. An interrupt raises
+    :class:`SweepInterrupted` with the finished chunks' table.
     """
     if isinstance(spec, dict):
         spec = SweepSpec.from_dict(spec)
     backend = get_backend(backend, fmu)
     n = spec.n_cases
     keep = _keep(columns)
+    store = None if parts is None else _PartStore(Path(parts))
 
     if scheduler == "serial":
-        chunks = _chunks(n, chunk_size or backend.default_chunk)
+        chunk_size = _chunk_size(store, resume, chunk_size or backend.default_chunk)
+        chunks = _chunks(n, chunk_size)
+        done = store.open(spec, backend, chunk_size, keep, resume) if store else {}
         payload = backend.local_payload() if isinstance(backend, FmuBackend) else backend.payload()
+        bar = _Progress(len(chunks), progress, "serial")
+        bar.update(len(done))
         t0 = time.perf_counter()
+        # an FMU in this process: Ctrl-C waits for the chunk's FMU calls to return
+        deferred = DeferredInterrupt() if isinstance(backend, FmuBackend) else contextlib.nullcontext()
         try:
-            results = []
-            for k, (a, b) in enumerate(chunks):
-                results.append(_run_chunk(a, b, spec, backend, payload, keep))
-                if progress:
-                    print(f"\r[serial] {k + 1}/{len(chunks)} chunks", end="", flush=True)
-            if progress:
-                print()
+            with deferred:
+                for a, b in chunks:
+                    if a in done:
+                        continue
+                    done[a] = _run_chunk(a, b, spec, backend, payload, keep)
+                    if store:
+                        store.write(a, b, done[a])
+                    bar.update(len(done))
+                    if isinstance(deferred, DeferredInterrupt):
+                        deferred.check()
+        except KeyboardInterrupt:
+            bar.close(len(done))
+            raise _interrupted(spec, backend, done, "this process (serial)", 1, time.perf_counter() - t0,
+                               len(chunks), keep, n) from None
         finally:
             if isinstance(backend, FmuBackend) and release:
                 release_fmus()
+        bar.close(len(done))
         elapsed = time.perf_counter() - t0
-        return _result(spec, backend, results, "this process (serial)", 1, elapsed, len(chunks), keep)
+        return _result(spec, backend, _ordered(done), "this process (serial)", 1, elapsed, len(chunks), keep)
 
     with open_client(scheduler, n_workers) as client:
         workers = _count_workers(client)
         where = _describe_client(client, scheduler)
         if chunk_size is None:
             chunk_size = max(1, min(backend.default_chunk, math.ceil(n / (4 * workers))))
+        chunk_size = _chunk_size(store, resume, chunk_size)
         chunks = _chunks(n, chunk_size)
+        done = store.open(spec, backend, chunk_size, keep, resume) if store else {}
+        todo = [(a, b) for a, b in chunks if a not in done]
+        bar = _Progress(len(chunks), progress, "dask")
+        bar.update(len(done))
         t0 = time.perf_counter()
-        payload = backend.payload()
-        if payload is not None:
-            payload = client.scatter([payload], broadcast=True, hash=False)[0]
-        futures = client.map(_run_chunk, [a for a, _ in chunks], [b for _, b in chunks],
-                             spec=spec, backend=backend, payload=payload, keep=keep, pure=False)
+        futures = []
         try:
-            if progress:
-                from distributed import progress as dask_progress
+            payload = backend.payload()
+            if payload is not None and todo:
+                payload = client.scatter([payload], broadcast=True, hash=False)[0]
+            from distributed import as_completed
 
-                dask_progress(futures)
-                print()
-            results = client.gather(futures)
+            futures = client.map(_run_chunk, [a for a, _ in todo], [b for _, b in todo],
+                                 spec=spec, backend=backend, payload=payload, keep=keep, pure=False)
+            bounds = {f.key: ab for f, ab in zip(futures, todo)}
+            for future in as_completed(futures):
+                a, b = bounds[future.key]
+                done[a] = future.result()
+                if store:
+                    store.write(a, b, done[a])
+                future.release()
+                bar.update(len(done))
+        except KeyboardInterrupt:
+            bar.close(len(done))
+            with contextlib.suppress(Exception):
+                client.cancel(futures)
+            raise _interrupted(spec, backend, done, where, workers, time.perf_counter() - t0, len(chunks),
+                               keep, n) from None
         finally:
-            client.cancel(futures)
+            with contextlib.suppress(Exception):
+                client.cancel(futures)
             if isinstance(backend, FmuBackend) and release:
                 with contextlib.suppress(Exception):
                     client.run(release_fmus)
+        bar.close(len(done))
         elapsed = time.perf_counter() - t0
-        return _result(spec, backend, results, where, workers, elapsed, len(chunks), keep)
+        return _result(spec, backend, _ordered(done), where, workers, elapsed, len(chunks), keep)
+
+
+def _ordered(done: dict) -> list:
+    return [done[a] for a in sorted(done)]
+
+
+def _interrupted(spec, backend, done, where, workers, elapsed, n_chunks, keep, n) -> SweepInterrupted:
+    result = _result(spec, backend, _ordered(done), where, workers, elapsed, n_chunks, keep)
+    return SweepInterrupted(result, n - len(result))
+
+
+def _chunk_size(store, resume: bool, chunk_size: int) -> int:
+    """The chunk size: a resumed run keeps the one its parts were cut with."""
+    if store is not None and resume:
+        manifest = store.manifest()
+        if manifest is not None:
+            return int(manifest["chunk_size"])
+    return int(chunk_size)
+
+
+class _PartStore:
+    """Finished chunks of one sweep on disk: ``chunk-<start>-<stop>.npz`` and ``manifest.json``."""
+
+    def __init__(self, path: Path):
+        self.path = path
+
+    def manifest(self):
+        try:
+            return json.loads((self.path / "manifest.json").read_text(encoding="utf-8"))
+        except (OSError, ValueError):
+            return None
+
+    def open(self, spec, backend, chunk_size, keep, resume: bool) -> dict:
+        """Chunks already finished (``resume``; start -> (columns, info)), after checking that
+        they belong to this sweep; without ``resume``, an empty directory."""
+        manifest = {"spec": spec.as_dict(), "backend": backend.name, "chunk_size": int(chunk_size),
+                    "n_cases": int(spec.n_cases), "columns": None if keep is None else sorted(keep)}
+        old = self.manifest() if resume else None
+        if old is not None and old != json.loads(json.dumps(manifest)):
+            raise ValueError(f"--resume: the finished chunks in {self.path} belong to another sweep "
+                             f"(spec, back end or columns differ); run without --resume to start over")
+        if old is None and self.path.exists():
+            shutil.rmtree(self.path)
+        self.path.mkdir(parents=True, exist_ok=True)
+        if old is None:
+            self._write_text("manifest.json", json.dumps(manifest, indent=1))
+        done = {}
+        for file in sorted(self.path.glob("chunk-*.npz")):
+            a, b = (int(x) for x in file.stem.split("-")[1:3])
+            with np.load(file, allow_pickle=False) as z:
+                columns = {k[2:]: z[k] for k in z.files if k.startswith("c:")}
+                info = json.loads(str(z["info"]))
+            done[a] = (columns, info)
+        return done
+
+    def write(self, a: int, b: int, part) -> None:
+        columns, info = part
+        tmp = self.path / f".chunk-{a}-{b}.tmp.npz"
+        np.savez(tmp, info=np.array(json.dumps(info, default=str)), **{f"c:{k}": v for k, v in columns.items()})
+        os.replace(tmp, self.path / f"chunk-{a:015d}-{b:015d}.npz")
+
+    def _write_text(self, name, text):
+        tmp = self.path / f".{name}.tmp"
+        tmp.write_text(text, encoding="utf-8")
+        os.replace(tmp, self.path / name)
+
+    def remove(self) -> None:
+        shutil.rmtree(self.path, ignore_errors=True)
+
+
+class _Progress:
+    """Chunks done, on stderr: redrawn in a terminal once the run has taken a second; when
+    redirected, nothing but the final state (``close``), always on a line of its own."""
+
+    def __init__(self, total: int, enabled: bool, label: str):
+        self.total, self.enabled, self.label = total, enabled, label
+        self.tty = enabled and sys.stderr.isatty()
+        self.t0 = time.perf_counter()
+        self.drawn = False
+
+    def update(self, done: int) -> None:
+        if self.tty and time.perf_counter() - self.t0 >= 1.0:
+            print(f"\r[{self.label}] {done}/{self.total} chunks", end="", file=sys.stderr, flush=True)
+            self.drawn = True
+
+    def close(self, done: int) -> None:
+        if not self.enabled:
+            return
+        end = "\r" if self.drawn else ""
+        sys.stdout.flush()  # what was printed before stays before, when both go to one file
+        print(f"{end}[{self.label}] {done}/{self.total} chunks done in {time.perf_counter() - self.t0:.3g} s",
+              file=sys.stderr, flush=True)
 
 
 def _count_workers(client) -> int:

@@ -77,6 +77,9 @@ OUTPUT_NAMES = tuple(row[0] for row in OUTPUTS)
 T_OVER_D = "t_over_d"
 #: Material-property inputs a material pair sets.
 PAIR_INPUTS = ("sphere.E", "sphere.nu", "sphere.Sy", "sphere.rho", "plate.E", "plate.nu", "plate.Sy", "plate.rho")
+#: Largest ``samples`` and ``seed`` a spec accepts.
+MAX_SAMPLES = 10**12
+MAX_SEED = 2**63 - 1
 #: Random draws come in blocks of this many cases, each from its own seeded generator.
 RANDOM_BLOCK = 4096
 
@@ -103,46 +106,100 @@ def _code(name: str, value):
         if value.strip() in words:
             return words[value.strip()]
         try:
-            value = float(value)
+            text = value.strip()
+            value = int(text) if text.lstrip("+-").isdigit() and text.isascii() else float(text)
         except ValueError:
             raise ValueError(f"{name} = {value!r}: use one of {sorted(words)} or a code "
                              f"{sorted(words.values())}") from None
-    if float(value) != int(value):
+    try:
+        integral = float(value) == int(value)
+    except (OverflowError, ValueError):
+        integral = False
+    if not integral:
         raise ValueError(f"{name} = {value!r} is not an integer code")
-    return int(value)
+    code = int(value)
+    if code not in CODES[name].values():  # checked here: an FMU back end would wrap it to int32
+        raise ValueError(f"{name} = {value!r} is out of range: use one of {sorted(CODES[name])} or a code "
+                         f"{sorted(CODES[name].values())}")
+    return code
 
 
 def _number(name: str, value) -> float:
     if name in CODES:
         return float(_code(name, value))
-    return float(value)
+    try:
+        return float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} = {value!r} is not a number") from None
 
 
 # --- value lists and distributions -------------------------------------------------------
-def parse_values(name: str, spec) -> np.ndarray:
-    """Grid values: a number, a list, ``{"linspace": [a, b, n]}``, ``{"geomspace": [a, b, n]}``,
-    ``{"arange": [a, b, step]}``, or the CLI forms ``"a,b,c"``, ``"linspace:a:b:n"``, ``"geomspace:a:b:n"``."""
+#: Largest grid axis [values]: an axis is materialised (8 bytes a value) where the cases are built.
+MAX_AXIS_VALUES = 10**8
+
+
+def _range_form(name: str, spec):
+    """``(kind, args)`` of a linspace/geomspace/logspace/arange value range, else None."""
     if isinstance(spec, str):
-        text = spec.strip()
-        kind, _, rest = text.partition(":")
+        kind, _, rest = spec.strip().partition(":")
         if rest and kind in ("linspace", "geomspace", "logspace", "arange"):
-            spec = {kind: [float(x) for x in rest.split(":")]}
-        else:
-            spec = [x for x in text.split(",") if x.strip()]
+            try:
+                return kind, [float(x) for x in rest.split(":")]
+            except ValueError:
+                raise ValueError(f"{name} = {spec!r}: {kind} takes numbers separated by ':'") from None
+        return None
     if isinstance(spec, dict):
         if len(spec) != 1:
             raise ValueError(f"{name}: a value range has exactly one key, got {sorted(spec)}")
         (kind, args), = spec.items()
-        args = list(args)
-        if kind in ("linspace", "geomspace", "logspace"):
-            if len(args) != 3 or int(args[2]) != args[2] or args[2] < 1:
-                raise ValueError(f"{name}: {kind} needs [first, last, count]")
-            fn = {"linspace": np.linspace, "geomspace": np.geomspace, "logspace": np.logspace}[kind]
-            values = fn(float(args[0]), float(args[1]), int(args[2]))
-        elif kind == "arange":
-            values = np.arange(*map(float, args))
-        else:
+        if kind not in ("linspace", "geomspace", "logspace", "arange"):
             raise ValueError(f"{name}: unknown value range {kind!r} (linspace, geomspace, logspace, arange)")
+        try:
+            args = [float(a) for a in (args if isinstance(args, (list, tuple)) else [args])]
+        except (TypeError, ValueError):
+            raise ValueError(f"{name}: {kind} takes numbers, got {args!r}") from None
+        return kind, args
+    return None
+
+
+def axis_size(name: str, spec) -> int:
+    """Number of values :func:`parse_values` gives for ``spec``, without building them (a Python int)."""
+    form = _range_form(name, spec)
+    if form is None:
+        if isinstance(spec, str):
+            return len([x for x in spec.strip().split(",") if x.strip()])
+        return len(spec) if isinstance(spec, (list, tuple, np.ndarray)) else 1
+    kind, args = form
+    if not all(math.isfinite(a) for a in args):
+        raise ValueError(f"{name}: {kind} needs finite numbers, got {args!r}")
+    if kind == "arange":
+        if len(args) not in (1, 2, 3):
+            raise ValueError(f"{name}: arange needs [stop], [start, stop] or [start, stop, step]")
+        start, stop, step = (0.0, args[0], 1.0) if len(args) == 1 else (*args, 1.0)[:3]
+        if step == 0:
+            raise ValueError(f"{name}: arange step = 0: the step must be non-zero")
+        return max(0, math.ceil((stop - start) / step))
+    if len(args) != 3 or int(args[2]) != args[2] or args[2] < 1:
+        raise ValueError(f"{name}: {kind} needs [first, last, count] with an integer count >= 1")
+    return int(args[2])
+
+
+def parse_values(name: str, spec) -> np.ndarray:
+    """Grid values: a number, a list, ``{"linspace": [a, b, n]}``, ``{"geomspace": [a, b, n]}``,
+    ``{"arange": [a, b, step]}``, or the CLI forms ``"a,b,c"``, ``"linspace:a:b:n"``, ``"geomspace:a:b:n"``."""
+    form = _range_form(name, spec)
+    if form is not None:
+        kind, args = form
+        size = axis_size(name, spec)
+        if size > MAX_AXIS_VALUES:
+            raise ValueError(f"{name}: {kind} gives {size:,} values; at most {MAX_AXIS_VALUES:,} per axis")
+        if kind == "arange":
+            values = np.arange(*args)
+        else:
+            fn = {"linspace": np.linspace, "geomspace": np.geomspace, "logspace": np.logspace}[kind]
+            values = fn(args[0], args[1], int(args[2]))
+    elif isinstance(spec, str):
+        values = np.array([_number(name, v) for v in spec.strip().split(",") if v.strip()], dtype=float)
     elif isinstance(spec, (list, tuple, np.ndarray)):
         values = np.array([_number(name, v) for v in spec], dtype=float)
     else:
@@ -269,21 +326,35 @@ class SweepSpec:
         self.grid = {canonical_name(k): v for k, v in self.grid.items()}
         self.random = {canonical_name(k): v for k, v in self.random.items()}
         self.fixed = {canonical_name(k): v for k, v in self.fixed.items()}
-        self._axes = {k: parse_values(k, v) for k, v in self.grid.items()}
+        self._axis_sizes = {k: axis_size(k, v) for k, v in self.grid.items()}
+        self._axes_built = None  # the axes' values, built when cases are (see _axes)
+        for k, v in self.grid.items():  # value lists and codes are checked now (they are small)
+            if k in CODES or _range_form(k, v) is None:
+                if self._axis_sizes[k] > 1000:
+                    raise ValueError(f"{k}: {self._axis_sizes[k]:,} listed values; give a range "
+                                     f"(linspace, geomspace, arange) for long axes")
+                parse_values(k, v)
         self._dists = {k: parse_distribution(k, v) for k, v in self.random.items()}
         self._fixed = {k: parse_values(k, v) for k, v in self.fixed.items()}
         for k, v in self._fixed.items():
             if v.size != 1:
                 raise ValueError(f"fixed {k}: one value, got {v.size} (use the grid for several)")
+        for key in ("samples", "seed"):
+            value = getattr(self, key)
+            if isinstance(value, bool) or not isinstance(value, (int, np.integer)) and not (
+                    isinstance(value, float) and value.is_integer()):
+                raise ValueError(f"{key} = {value!r}: expected an integer")
         self.samples = int(self.samples)
         self.seed = int(self.seed)
-        if self.samples < 1:
-            raise ValueError(f"samples = {self.samples}: must be >= 1")
+        if not 1 <= self.samples <= MAX_SAMPLES:
+            raise ValueError(f"samples = {self.samples}: must be in 1 ... {MAX_SAMPLES}")
+        if not 0 <= self.seed <= MAX_SEED:
+            raise ValueError(f"seed = {self.seed}: must be in 0 ... {MAX_SEED} (2**63 - 1)")
         if self.samples > 1 and not self._dists:
             raise ValueError("samples > 1 needs at least one random parameter")
         # Each input gets its value from one place; relative draws scale whatever that is.
         sources = {}
-        for where, names in (("fixed", self._fixed), ("grid", self._axes),
+        for where, names in (("fixed", self._fixed), ("grid", self._axis_sizes),
                              ("random", {k for k, (kind, _) in self._dists.items() if not kind.endswith("_rel")})):
             for k in names:
                 if k in sources:
@@ -302,6 +373,12 @@ class SweepSpec:
 
     # --- structure ---
     @property
+    def _axes(self) -> dict:
+        if self._axes_built is None:
+            self._axes_built = {k: parse_values(k, v) for k, v in self.grid.items()}
+        return self._axes_built
+
+    @property
     def axes(self) -> dict:
         """Grid axes in iteration order (material pairs first, as indices into :attr:`pairs`)."""
         axes = {}
@@ -312,11 +389,12 @@ class SweepSpec:
 
     @property
     def shape(self) -> tuple:
-        return tuple(a.size for a in self.axes.values())
+        """Axis sizes (Python ints; the axes are not built)."""
+        return ((len(self.pairs),) if self.pairs else ()) + tuple(self._axis_sizes.values())
 
     @property
     def n_grid(self) -> int:
-        return int(np.prod(self.shape, dtype=np.int64)) if self.axes else 1
+        return math.prod(self.shape)  # Python ints: no wrap however large
 
     @property
     def n_cases(self) -> int:
@@ -416,18 +494,26 @@ class SweepSpec:
         bits = []
         if self.pairs:
             bits.append(f"{len(self.pairs)} material pair(s)")
-        bits += [f"{k} x{a.size}" for k, a in self._axes.items()]
+        bits += [f"{k} x{size:,}" for k, size in self._axis_sizes.items()]
         if self._dists:
-            bits.append(f"{self.samples} random sample(s) of {', '.join(self._dists)} per grid point")
-        return f"{self.n_cases} cases: " + (", ".join(bits) if bits else "one case at the start values")
+            bits.append(f"{self.samples:,} random sample(s) of {', '.join(self._dists)} per grid point")
+        return f"{self.n_cases:,} cases: " + (", ".join(bits) if bits else "one case at the start values")
 
 
 def load_spec(path) -> dict:
     """The dict in a TOML or JSON spec file (``.toml`` / ``.json``)."""
     path = Path(path)
-    text = path.read_text(encoding="utf-8")
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise ValueError(f"spec file {path}: {exc.strerror or exc}") from None
+    except UnicodeDecodeError:
+        raise ValueError(f"spec file {path}: not UTF-8 text") from None
     if path.suffix.lower() == ".json":
-        return json.loads(text)
+        try:
+            return json.loads(text)
+        except ValueError as exc:
+            raise ValueError(f"spec file {path}: not valid JSON: {exc}") from None
     try:
         import tomllib
     except ModuleNotFoundError:  # Python 3.10
@@ -436,4 +522,7 @@ def load_spec(path) -> dict:
         except ModuleNotFoundError:
             raise SystemExit(f"{path}: reading TOML needs Python >= 3.11 or `pip install tomli`; "
                              f"or write the spec as JSON") from None
-    return tomllib.loads(text)
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ValueError(f"spec file {path}: not valid TOML: {exc}") from None

@@ -1,0 +1,185 @@
+"""Scenes lose nothing and flag what they extrapolate (issue 13): every finished drop on disk,
+Ctrl-C (SIGINT to a child process) writes what is done and exits 130, validity columns and
+counts, values the FMU would reject refused by the loader naming the key, one-line errors,
+progress output that behaves when redirected."""
+import csv
+import os
+import signal
+import subprocess
+import sys
+import time
+import tomllib
+
+import pytest
+
+from restitution.scene import SceneError, parse_scene
+from restitution.scene.__main__ import main
+from restitution.scene.loader import MAX_BOUNCES
+
+PYTHON = sys.executable
+ENV = {**os.environ, "PYTHONUNBUFFERED": "1"}
+
+SCENE = """
+[scene]
+name = "test"
+
+[outputs]
+requested = ["bounce_heights", "cor"]
+tolerance = 1e-2
+{model}
+[simulation]
+max_bounces = {max_bounces}
+v_min = {v_min}
+
+[[plates]]
+name = "plate"
+material = "al_6061"
+thickness = {thickness}
+
+[[balls]]
+name = "ball"
+material = "s2_tool_steel"
+diameter = {diameter}
+drop_heights = {heights}
+"""
+
+
+def scene_text(thickness='"3.18 mm"', diameter='"6.35 mm"', heights='"0.1 m"', max_bounces=10000, model="",
+               v_min='"0.1 m/s"'):
+    return SCENE.format(thickness=thickness, diameter=diameter, heights=heights, max_bounces=max_bounces,
+                        model=model, v_min=v_min)
+
+
+def load(text):
+    return parse_scene(tomllib.loads(text), source="t.toml")
+
+
+# --- loader: values the FMU rejects, bounds, ASCII digits ---------------------------------
+@pytest.mark.parametrize("kwargs, key, words", [
+    (dict(diameter='"1e300 m"'), "balls[0].diameter", ["outside the range the FMU accepts", "<= 10 m"]),
+    (dict(diameter='"0.1 um"'), "balls[0].diameter", ["1e-06 m <= value"]),
+    (dict(thickness='"1000 m"'), "plates[0].thickness", ["outside the range"]),
+    (dict(heights='["0.1 m", "1e9 m"]'), "balls[0].drop_heights[1]", ["outside the range"]),
+    (dict(max_bounces=10 ** 12), "simulation.max_bounces", [f"<= {MAX_BOUNCES}"]),
+    (dict(diameter='"٣.١٨ mm"'), "balls[0].diameter", ["ASCII digits"]),
+    (dict(thickness='"3.18 mm"', diameter='"６ mm"'), "balls[0].diameter", ["ASCII digits"]),
+])
+def test_loader_refuses_what_the_fmu_would_reject(kwargs, key, words):
+    with pytest.raises(SceneError) as info:
+        load(scene_text(**kwargs))
+    message = str(info.value)
+    assert message.startswith(f"t.toml: {key}: "), message
+    for w in words:
+        assert w in message, (w, message)
+
+
+def test_material_outside_the_domain_names_the_key():
+    text = scene_text().replace('material = "al_6061"', 'material = {E = "1e20 Pa", nu = 0.3, Sy = "1 GPa", '
+                                                         'rho = "2000 kg/m3"}')
+    with pytest.raises(SceneError, match=r"plates\[0\]\.material\.E: .*outside the range the FMU accepts"):
+        load(text)
+
+
+def test_highest_bounds_still_load():
+    scene = load(scene_text(diameter='"10 m"', thickness='"100 m"', heights='"5e6 m"', max_bounces=MAX_BOUNCES))
+    assert scene.balls[0].diameter == 10.0 and scene.simulation.max_bounces == MAX_BOUNCES
+
+
+# --- the command line: errors, validity, progress ------------------------------------------
+def _run_cli(*args, cwd=None):
+    return subprocess.run([PYTHON, "-m", "restitution.scene", *map(str, args)], capture_output=True, text=True,
+                          env=ENV, cwd=cwd, timeout=300)
+
+
+def test_cli_user_mistakes_are_one_line_errors(tmp_path, impact_fmu):
+    scene = tmp_path / "s.toml"
+    scene.write_text(scene_text(diameter='"1e300 m"'))
+    a_file = tmp_path / "file"
+    a_file.write_text("x")
+    good = tmp_path / "good.toml"
+    good.write_text(scene_text())
+    for args, words in (((tmp_path / "missing.toml",), ["missing.toml", "cannot read"]),
+                        ((scene,), ["balls[0].diameter", "1e300 m"]),
+                        ((good, "--out", a_file), ["--out", "not a directory"]),
+                        ((good, "--out", a_file / "sub"), ["--out", "cannot write"])):
+        proc = _run_cli("run", *args, "--fmu", impact_fmu, "--no-plot")
+        assert proc.returncode == 2, proc.stderr
+        assert "Traceback" not in proc.stderr
+        line, = proc.stderr.strip().splitlines()
+        assert all(w in line for w in words), (words, line)
+    proc = _run_cli("report", good, "--repeat", "0")
+    assert proc.returncode == 2 and "--repeat" in proc.stderr and "Traceback" not in proc.stderr
+
+
+def test_drop_from_a_megametre_is_flagged(tmp_path, impact_fmu, capsys):
+    # v = sqrt(2 g 1e6 m) = 4.4 km/s: V* ~ 1e5, far beyond JGM's fitted V* <= 1000
+    scene = tmp_path / "high.toml"
+    scene.write_text(scene_text(heights='["0.1 m", "1e6 m"]', max_bounces=3))
+    assert main(["run", str(scene), "--fmu", str(impact_fmu), "--out", str(tmp_path), "--no-plot",
+                 "--no-progress"]) == 0
+    captured = capsys.readouterr()
+    with (tmp_path / "high.csv").open() as f:
+        rows = list(csv.DictReader(f))
+    assert {"valid", "jgm.in_range", "zener.in_range"} <= set(rows[0])
+    high = [r for r in rows if float(r["drop_height_m"]) == 1e6]
+    low = [r for r in rows if float(r["drop_height_m"]) == 0.1]
+    assert high[0]["valid"] == "0" and high[0]["jgm.in_range"] == "0"
+    assert {r["valid"] for r in low} == {"1"}
+    n_out = sum(r["valid"] == "0" for r in rows)
+    assert n_out >= 1
+    with (tmp_path / "high_summary.csv").open() as f:
+        summary = {r["drop_height_m"]: r for r in csv.DictReader(f)}
+    assert summary["1000000"]["out_of_range_impacts"] == str(sum(r["valid"] == "0" for r in high))
+    assert summary["0.1"]["out_of_range_impacts"] == "0"
+    assert f"warning: {n_out} of {len(rows)} impacts lie outside the models' validated ranges" in captured.err
+    assert "out of range" in captured.out  # the summary table's column
+
+
+def test_progress_when_redirected_is_one_final_line(tmp_path, impact_fmu):
+    scene = tmp_path / "s.toml"
+    scene.write_text(scene_text(heights='["0.1 m", "0.2 m", "0.3 m"]'))
+    proc = _run_cli("run", scene, "--fmu", impact_fmu, "--out", tmp_path, "--no-plot")
+    assert proc.returncode == 0, proc.stderr
+    assert "\r" not in proc.stderr
+    line, = proc.stderr.strip().splitlines()  # no bar line per drop: only the final state
+    assert line.startswith("s (exact): 3/3 drops done, ")
+    assert proc.stdout.startswith("test: 3 drops, ")  # the summary starts on its own line
+
+
+# --- interruption -----------------------------------------------------------------------
+@pytest.mark.slow
+def test_sigint_keeps_every_finished_drop(tmp_path, impact_fmu):
+    heights = "[" + ", ".join(f'"{0.05 + 0.005 * k:.3f} m"' for k in range(200)) + "]"
+    scene = tmp_path / "slow.toml"
+    # zener_method = ode (ms an impact) and v_min = 1 mm/s (tens of impacts a drop): 200 drops take long
+    scene.write_text(scene_text(heights=heights, model='[model]\nzener_method = "ode"\nplate_waves = "on"\n',
+                                v_min='"0.001 m/s"'))
+    out = tmp_path / "out"
+    proc = subprocess.Popen([PYTHON, "-m", "restitution.scene", "run", str(scene), "--fmu", str(impact_fmu),
+                             "--out", str(out), "--no-plot"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            text=True, env=ENV)
+    table = out / "slow.csv"
+
+    def finished_drops():
+        if not table.exists():
+            return set()
+        with table.open() as f:
+            return {r["drop_height_m"] for r in csv.DictReader(f)}
+
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline and proc.poll() is None and len(finished_drops()) < 3:
+        time.sleep(0.05)
+    assert proc.poll() is None, "the scene ended before it could be interrupted"
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=120)
+    drops = finished_drops()
+    assert 3 <= len(drops) < 200
+    with table.open() as f:
+        rows = list(csv.DictReader(f))
+    # every drop in the table is whole: it ends where the ball rests (its last rebound below v_min)
+    with (out / "slow_summary.csv").open() as f:
+        summary = {r["drop_height_m"]: int(r["impacts"]) for r in csv.DictReader(f)}
+    for h in drops:
+        assert sum(r["drop_height_m"] == h for r in rows) == summary[h]
+    assert proc.returncode == 130, err
+    assert f"{len(drops)} of 200 drops finished" in err and "Traceback" not in err
