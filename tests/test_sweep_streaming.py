@@ -233,3 +233,23 @@ def test_progress_when_redirected_is_one_final_line(tmp_path):
     assert lines == ["[serial] 1/1 chunks done in " + lines[0].split(" in ")[1]], proc.stderr
     assert "\r" not in proc.stderr
     assert any(line.startswith("3 cases with the package back end") for line in proc.stdout.splitlines())
+
+
+def test_cor_map_title_fits_a_single_pair(tmp_path):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from restitution.sweep.plot import fit_title
+
+    title = ("Apparent COR e (Green 2022), 2000 cases; red dashes: edge of the validated range "
+             "(lambda <= 1.5, V* <= 1000)")
+    fig = plt.figure(figsize=(5.4, 3.9))  # the width plot_cor_map gives one pair
+    text = fit_title(fig, title)
+    box = text.get_window_extent(fig.canvas.get_renderer())
+    assert 0 <= box.x0 and box.x1 <= fig.bbox.width  # was clipped on both sides
+    assert "\n" in text.get_text() and text.get_text().replace("\n", " ") == title
+    plt.close(fig)
+    spec = SweepSpec(pairs=["s2_tool_steel/al_6061"], grid={"v": "geomspace:0.1:100:8", "t/d": "geomspace:0.05:5:6"})
+    assert run_sweep(spec, scheduler="serial").plot(tmp_path / "map.png").stat().st_size > 10_000

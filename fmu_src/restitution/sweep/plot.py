@@ -29,6 +29,21 @@ def _edges(centres, log):
     return 10 ** e if log else e
 
 
+def fit_title(fig, title: str, fontsize: float = 10):
+    """``fig``'s suptitle, wrapped at word boundaries so that every line fits the figure's width
+    (measured as drawn; a single pair's map is narrower than the default title)."""
+    import textwrap
+
+    text = fig.suptitle(title, fontsize=fontsize)
+    renderer = fig.canvas.get_renderer()
+    limit = 0.96 * fig.bbox.width
+    width = len(title)
+    while width > 10 and text.get_window_extent(renderer).width > limit:
+        width = int(width * 0.85)
+        text.set_text(textwrap.fill(title, width=width, break_long_words=False))
+    return text
+
+
 def plot_cor_map(result, path, title: str | None = None, dpi: int = 120) -> Path:
     """Draw e over (v_approach, t/d) for each material pair of a :class:`SweepResult` into ``path``.
 
@@ -136,7 +151,7 @@ def plot_cor_map(result, path, title: str | None = None, dpi: int = 120) -> Path
             title += "; red dashes: edge of the validated range (lambda <= 1.5, V* <= 1000)"
         elif not valid_all.all():
             title += "; red marks: outside the validated range"
-    fig.suptitle(title, fontsize=10)
+    fit_title(fig, title, fontsize=10)
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=dpi)
