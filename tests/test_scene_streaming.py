@@ -183,3 +183,13 @@ def test_sigint_keeps_every_finished_drop(tmp_path, impact_fmu):
         assert sum(r["drop_height_m"] == h for r in rows) == summary[h]
     assert proc.returncode == 130, err
     assert f"{len(drops)} of 200 drops finished" in err and "Traceback" not in err
+
+
+def test_report_prints_one_final_line_per_variant_not_per_repeat(tmp_path, impact_fmu):
+    scene = tmp_path / "s.toml"
+    scene.write_text(scene_text())
+    proc = _run_cli("report", scene, "--fmu", impact_fmu, "--repeat", "5", "--methods", "exact")
+    assert proc.returncode == 0, proc.stderr
+    finals = [line for line in proc.stderr.splitlines() if "drops done" in line]
+    assert len(finals) == 2, proc.stderr  # as declared and every effect on; no bar when redirected
+    assert "\r" not in proc.stderr
