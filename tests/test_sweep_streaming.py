@@ -65,10 +65,8 @@ def test_memory_budget_refuses_with_numbers():
 
 
 def test_cli_refuses_absurd_sizes_before_any_work(tmp_path):
-    t0 = time.perf_counter()
     proc = _cli("--random", "v=uniform:1:2", "--samples", "1000000000", "--out", str(tmp_path / "s.csv"))
     _one_line_error(proc, "1,000,000,000 cases", "memory budget")
-    grid = [a for _ in range(4) for a in ("--grid", "v=linspace:0.1:1:65536")]
     grid = ["--grid", "v=linspace:0.1:1:65536", "--grid", "t/d=linspace:0.1:1:65536",
             "--grid", "sphere.E=linspace:1e9:2e9:65536", "--grid", "plate.E=linspace:1e9:2e9:65536"]
     proc = _cli(*grid, "--out", str(tmp_path / "s.csv"))
@@ -79,7 +77,6 @@ def test_cli_refuses_absurd_sizes_before_any_work(tmp_path):
     assert proc.returncode == 0 and "1,000,000,000 cases" in proc.stdout and "memory budget" in proc.stdout
     proc = _cli("--grid", "v=1,2,3", "--dry-run", "--memory-budget", "1K")
     assert proc.returncode == 0 and "3 cases" in proc.stdout, proc.stdout
-    assert time.perf_counter() - t0 < 120  # none of them did the work (generous: 4 interpreter starts)
 
 
 @pytest.mark.parametrize("args, words", [
