@@ -89,6 +89,7 @@ def test_cli_refuses_absurd_sizes_before_any_work(tmp_path):
     (["--set", "zener_method=4294967297", "--backend", "fmu"], ["zener_method = 4294967297", "out of range"]),
     (["--grid", "v=arange:0:1:0"], ["arange step = 0"]),
     (["no_such_spec.toml"], ["no_such_spec.toml", "No such file"]),
+    (["--backend", "both", "--columns", "e"], ["--columns must keep ok"]),
 ])
 def test_cli_user_mistakes_are_one_line_errors(tmp_path, args, words):
     proc = _cli(*args, "--grid" if "--grid" not in args else "--no-plot",

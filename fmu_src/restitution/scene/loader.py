@@ -329,9 +329,9 @@ _MODEL = {"effect_tolerance": "a number >= 0", "zener_method": " | ".join(ZENER_
           "restitution_model": " | ".join(RESTITUTION_MODELS), "plasticity": " | ".join(EFFECT_MODES),
           "plate_waves": " | ".join(EFFECT_MODES)}
 _SIMULATION = {"gravity": 'an acceleration, e.g. "9.81 m/s2"', "v_min": 'a speed, e.g. "0.1 m/s"',
-               "max_bounces": "an integer, 1 ... 1000000"}
+               "max_bounces": "an integer, 1 ... 100000"}
 #: Largest simulation.max_bounces: bounds the time and memory of a drop whose ball never rests.
-MAX_BOUNCES = 1_000_000
+MAX_BOUNCES = 100_000
 _PLATE = {"name": "a unique name", "material": "a material name or table", "thickness": 'a length, e.g. "3.18 mm"'}
 _BALL = {"name": "a unique name", "material": "a material name or table", "diameter": 'a length, e.g. "6.35 mm"',
          "drop_heights": 'a length or a list of lengths, e.g. ["0.1 m", "0.5 m"]',

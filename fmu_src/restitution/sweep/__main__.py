@@ -178,12 +178,13 @@ def main(argv=None) -> int:
     chunk = args.chunk_size if args.chunk_size is not None else run_ints.get("chunk_size")
     fmu = args.fmu or run.get("fmu")
     out = args.out or run.get("out")
-    if backend in ("fmu", "both") and fmu is None and not args.dry_run:
-        from ..fmu.build import BuildError, default_fmu
-        try:
-            fmu = default_fmu(log=print)
-        except BuildError as exc:
-            parser.error(str(exc))
+    columns = args.columns or run.get("columns")
+    if isinstance(columns, str):
+        columns = [c.strip() for c in columns.split(",") if c.strip()]
+    if backend == "both" and columns is not None:
+        missing = [c for c in ("ok", *INPUT_NAMES) if c not in columns]
+        if missing:  # checked before the run, not after it
+            parser.error(f"--backend both compares every case from its inputs: --columns must keep {', '.join(missing)}")
     if out is None:
         try:
             import pyarrow  # noqa: F401
@@ -199,9 +200,6 @@ def main(argv=None) -> int:
     plot = None if (args.no_plot or run.get("plot") is False) else Path(
         args.plot or run.get("plot") or out.with_name(out.stem + "_cor_map.png"))
     print(f"sweep: {spec.describe()}")
-    columns = args.columns or run.get("columns")
-    if isinstance(columns, str):
-        columns = [c.strip() for c in columns.split(",") if c.strip()]
     from .run import check_memory, table_bytes
 
     try:
@@ -217,6 +215,13 @@ def main(argv=None) -> int:
     if args.dry_run:
         print(f"sweep: the table would take {need:,} bytes in memory ({table_bytes(1, columns)} bytes a case)")
         return 0
+
+    if backend in ("fmu", "both") and fmu is None:
+        from ..fmu.build import BuildError, default_fmu
+        try:
+            fmu = default_fmu(log=print)
+        except BuildError as exc:
+            parser.error(str(exc))
 
     from .run import SweepInterrupted, open_client, run_sweep
 
@@ -245,9 +250,6 @@ def main(argv=None) -> int:
         from .compare import agreement_report
 
         a_cols, b_cols = results["fmu"].columns, results["package"].columns
-        missing = [c for c in ("case", "ok", *INPUT_NAMES) if c not in a_cols or c not in b_cols]
-        if missing:
-            parser.error(f"--backend both compares every case from its inputs: --columns must keep {', '.join(missing)}")
         compared, problems = agreement_report(a_cols, b_cols)
         if problems:
             for name, description in problems.items():
