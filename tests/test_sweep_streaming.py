@@ -251,3 +251,14 @@ def test_cor_map_title_fits_a_single_pair(tmp_path):
     plt.close(fig)
     spec = SweepSpec(pairs=["s2_tool_steel/al_6061"], grid={"v": "geomspace:0.1:100:8", "t/d": "geomspace:0.05:5:6"})
     assert run_sweep(spec, scheduler="serial").plot(tmp_path / "map.png").stat().st_size > 10_000
+
+
+def test_fmu_back_end_refuses_codes_that_would_wrap(impact_fmu):
+    """A case table built elsewhere, with zener_method = 2**32 + 1: ctypes' int32 made it 1."""
+    from restitution.sweep.backends import get_backend
+
+    cases = SweepSpec(grid={"v": "1,2"}).cases()
+    cases["zener_method"] = np.array([1.0, 2.0 ** 32 + 1])
+    backend = get_backend("fmu", impact_fmu)
+    with pytest.raises(ValueError, match=r"zener_method = 4294967297.0 is out of range"):
+        backend.evaluate(cases, backend.local_payload())

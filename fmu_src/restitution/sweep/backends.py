@@ -196,6 +196,10 @@ class _LoadedFmu:
         self.reset()
         reals = [name for name, _kw, t, _s in INPUTS if t == "Real"]
         columns = {name: np.asarray(cases[name], dtype=float) for name, _kw, _t, _s in INPUTS}
+        for name in INTEGER_INPUTS:  # fmi2Integer is 32 bits: a code beyond would wrap, not fail
+            bad = columns[name][~np.isin(columns[name], list(CODES[name].values()))]
+            if bad.size:
+                raise ValueError(f"{name} = {float(bad[0])!r} is out of range: codes {sorted(CODES[name].values())}")
         varying = {name for name, col in columns.items() if n and not np.all(col == col[0])}
         s = self.slave
         if n:
