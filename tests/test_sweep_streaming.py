@@ -171,8 +171,13 @@ def _interrupt_after_chunks(args, parts: Path, n_chunks: int, cwd):
             break
         time.sleep(0.05)
     assert proc.poll() is None, "the sweep ended before it could be interrupted"
+    import psutil
+
+    children = psutil.Process(proc.pid).children(recursive=True)  # Dask's workers, if any
     proc.send_signal(signal.SIGINT)
     out, err = proc.communicate(timeout=120)
+    gone, alive = psutil.wait_procs(children, timeout=30)
+    assert not alive, f"orphan processes after the interrupt: {alive}"
     return proc.returncode, out, err
 
 
