@@ -64,7 +64,7 @@ def fmi2_include_dir() -> Path:
 def front_files() -> list[Path]:
     """The generic C FMI front's sources (issue 11's cfront/); NativeBuildSkipped while it is missing."""
     if not (FRONT / "rst_front.h").is_file():
-        raise NativeBuildSkipped(f"the C FMI front is not there yet ({FRONT / 'rst_front.h'} missing)")
+        raise NativeBuildSkipped(f"the C FMI front is missing ({FRONT / 'rst_front.h'})")
     return sorted(p for p in FRONT.iterdir() if p.suffix in (".c", ".h"))
 
 
@@ -168,6 +168,7 @@ def build_native_one(model: str, out_dir: Path, python_fmu: Path, log=None) -> P
     from ..build import BUILD_INFO, source_hash
 
     log = log or (lambda message: print(message, file=sys.stderr))
+    front_files()  # before anything is written: no empty native/ where the front is missing
     target_dir = Path(out_dir) / "native"
     target_dir.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(prefix=f".{model}-native-", dir=target_dir) as tmp:
@@ -214,5 +215,5 @@ def build_native(out_dir: Path, log=None) -> list[Path]:
         try:
             built.append(build_native_one(model, out_dir, Path(out_dir) / f"{model}.fmu", log=log))
         except NativeBuildSkipped as exc:
-            log(f"warning: {exc}")
+            log(f"warning: native {model}.fmu not built: {exc}")
     return built
