@@ -1,0 +1,1421 @@
+/* The FMI 2.0 co-simulation front: see rst_front.h.
+ *
+ * Which call is allowed in which mode follows the FMI 2.0 standard's co-simulation state table
+ * (section 4.2.4). A call that is not allowed, or whose arguments are wrong, returns fmi2Error with a
+ * log message and changes nothing: the instance stays in its mode and keeps its values (more
+ * forgiving than the standard, which lets a master give up on an instance after any fmi2Error).
+ * A backend that reports fmi2Error puts the instance into the error mode (fmi2Reset, fmi2SetFMUstate
+ * or fmi2FreeInstance leave it); fmi2Fatal latches it for good.
+ */
+#if defined(RST_FRONT_PTHREAD) && !defined(_POSIX_C_SOURCE)
+#define _POSIX_C_SOURCE 200809L
+#endif
+
+#include "rst_front.h"
+
+#include <float.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#ifdef RST_FRONT_PTHREAD
+#include <pthread.h>
+#endif
+
+#define RST_INSTANCE_MAGIC 0x52535446u /* "RSTF": a pointer that is not one of our instances */
+#define RST_STATE_MAGIC 0x52535453u    /* "RSTS" */
+#define RST_STATE_FORMAT 1u            /* serialized layout version (see serialize_state) */
+#define MESSAGE_SIZE 2048
+
+/* Relative tolerance of the doStep time check: a master's t differs from the previous t + h by a
+ * rounding or two; a skipped or repeated step differs by about h. */
+#define TIME_RTOL 1e-9
+
+enum { CAT_WARNING = 1, CAT_DISCARD = 2, CAT_ERROR = 4, CAT_FATAL = 8, CAT_ALL = 16 };
+static const char *const CATEGORY_NAMES[] = {"logStatusWarning", "logStatusDiscard", "logStatusError",
+                                             "logStatusFatal", "logAll"};
+#define N_CATEGORIES 5
+
+#define ANY_LIVE_MODE (RST_INSTANTIATED | RST_INITIALIZATION | RST_STEP_COMPLETE | RST_STEP_FAILED | \
+                       RST_TERMINATED | RST_ERROR)
+#define GET_MODES (RST_INITIALIZATION | RST_STEP_COMPLETE | RST_STEP_FAILED | RST_TERMINATED | RST_ERROR)
+#define SET_MODES (RST_INSTANTIATED | RST_INITIALIZATION | RST_STEP_COMPLETE)
+
+typedef struct rst_state {
+    unsigned int magic;
+    struct rst_state *next;
+    rst_mode mode;
+    int has_start, has_time;
+    double start_time, next_time, last_time;
+    double values[1]; /* one per state variable of the table (allocated to size) */
+} rst_state;
+
+struct rst_instance {
+    unsigned int magic;
+    const rst_model *model;
+    char *name;
+    fmi2CallbackLogger logger;
+    fmi2CallbackAllocateMemory allocate;
+    fmi2CallbackFreeMemory release;
+    fmi2ComponentEnvironment environment;
+    int logging_on;
+    unsigned int categories;
+    rst_mode mode;
+    int has_start;      /* fmi2SetupExperiment gave the start time */
+    double start_time;
+    int has_time;       /* next_time is known: the t the next doStep must have */
+    double next_time;
+    double last_time;   /* end of the last successful step (fmi2LastSuccessfulTime) */
+    fmi2Status last_step_status;
+    size_t n_state;     /* state variables of the table */
+    rst_state *states;  /* FMU states made by this instance, to tell ours from any other pointer */
+    double *store;
+    void *backend;
+#ifdef RST_FRONT_PTHREAD
+    pthread_mutex_t lock; /* FMI 2.0 does not ask one instance to be thread-safe; this one is */
+#endif
+};
+
+/* ------------------------------------------------------------------------------------------------ */
+/* Accessors for backends                                                                           */
+/* ------------------------------------------------------------------------------------------------ */
+double *rst_store(rst_instance *inst) { return inst->store; }
+void *rst_backend(rst_instance *inst) { return inst->backend; }
+const char *rst_instance_name(const rst_instance *inst) { return inst->name; }
+rst_mode rst_mode_of(const rst_instance *inst) { return inst->mode; }
+double rst_start_time(const rst_instance *inst) { return inst->has_start ? inst->start_time : 0.0; }
+
+/* ------------------------------------------------------------------------------------------------ */
+/* Messages                                                                                         */
+/* ------------------------------------------------------------------------------------------------ */
+void rst_format_double(double x, char *out, size_t size)
+{
+    char buf[40], digits[24];
+    int precision, exponent = 0, n_digits = 0, i;
+    const char *p;
+    if (isnan(x)) {
+        snprintf(out, size, "nan");
+        return;
+    }
+    if (isinf(x)) {
+        snprintf(out, size, x > 0 ? "inf" : "-inf");
+        return;
+    }
+    if (x == 0.0) {
+        snprintf(out, size, signbit(x) ? "-0.0" : "0.0");
+        return;
+    }
+    /* the shortest digit string that reads back as x (what repr() uses) */
+    for (precision = 1; precision <= 17; precision++) {
+        snprintf(buf, sizeof buf, "%.*e", precision - 1, x);
+        if (strtod(buf, NULL) == x)
+            break;
+    }
+    /* buf: [-]d[<decimal point>ddd]e(+|-)XX, whatever the locale's decimal point */
+    for (p = buf; *p && *p != 'e'; p++)
+        if (*p >= '0' && *p <= '9' && n_digits < (int)sizeof digits - 1)
+            digits[n_digits++] = *p;
+    digits[n_digits] = '\0';
+    if (*p == 'e')
+        exponent = atoi(p + 1);
+    while (n_digits > 1 && digits[n_digits - 1] == '0')
+        digits[--n_digits] = '\0';
+    {
+        char text[64];
+        size_t k = 0;
+        if (x < 0)
+            text[k++] = '-';
+        if (exponent >= -4 && exponent < 16) { /* positional, always with a fractional part */
+            if (exponent < 0) {
+                text[k++] = '0';
+                text[k++] = '.';
+                for (i = 0; i < -exponent - 1; i++)
+                    text[k++] = '0';
+                for (i = 0; i < n_digits; i++)
+                    text[k++] = digits[i];
+            } else {
+                for (i = 0; i <= exponent; i++)
+                    text[k++] = i < n_digits ? digits[i] : '0';
+                text[k++] = '.';
+                if (n_digits > exponent + 1)
+                    for (i = exponent + 1; i < n_digits; i++)
+                        text[k++] = digits[i];
+                else
+                    text[k++] = '0';
+            }
+            text[k] = '\0';
+        } else { /* d[.ddd]e+XX with at least two exponent digits */
+            text[k++] = digits[0];
+            if (n_digits > 1) {
+                text[k++] = '.';
+                for (i = 1; i < n_digits; i++)
+                    text[k++] = digits[i];
+            }
+            snprintf(text + k, sizeof text - k, "e%c%02d", exponent < 0 ? '-' : '+', exponent < 0 ? -exponent : exponent);
+        }
+        snprintf(out, size, "%s", text);
+    }
+}
+
+static unsigned int category_of(fmi2Status status)
+{
+    switch (status) {
+    case fmi2Warning: return CAT_WARNING;
+    case fmi2Discard: return CAT_DISCARD;
+    case fmi2Error: return CAT_ERROR;
+    case fmi2Fatal: return CAT_FATAL;
+    default: return CAT_ALL;
+    }
+}
+
+static const char *category_name(unsigned int bit)
+{
+    int i;
+    for (i = 0; i < N_CATEGORIES; i++)
+        if (bit == (1u << i))
+            return CATEGORY_NAMES[i];
+    return "logAll";
+}
+
+/* The host's logger treats the message as a printf format: every '%' of the text is doubled. */
+static void deliver(rst_instance *inst, fmi2Status status, const char *category, const char *text)
+{
+    char escaped[2 * MESSAGE_SIZE];
+    size_t k = 0;
+    const char *p;
+    if (inst->logger == NULL)
+        return;
+    if (status == fmi2OK || status == fmi2Pending) {
+        unsigned int bit = CAT_ALL;
+        int i;
+        for (i = 0; category && i < N_CATEGORIES; i++)
+            if (strcmp(category, CATEGORY_NAMES[i]) == 0)
+                bit = 1u << i;
+        if (!inst->logging_on || !(inst->categories & bit))
+            return;
+    }
+    for (p = text; *p && k + 2 < sizeof escaped; p++) {
+        if (*p == '%')
+            escaped[k++] = '%';
+        escaped[k++] = *p;
+    }
+    escaped[k] = '\0';
+    inst->logger(inst->environment, inst->name, status, category, escaped);
+}
+
+void rst_log_text(rst_instance *inst, fmi2Status status, const char *category, const char *text)
+{
+    deliver(inst, status, category ? category : category_name(category_of(status)), text ? text : "");
+}
+
+void rst_log(rst_instance *inst, fmi2Status status, const char *format, ...)
+{
+    char message[MESSAGE_SIZE];
+    va_list args;
+    va_start(args, format);
+    vsnprintf(message, sizeof message, format, args);
+    va_end(args);
+    deliver(inst, status, category_name(category_of(status)), message);
+}
+
+static const char *mode_name(rst_mode mode)
+{
+    switch (mode) {
+    case RST_INSTANTIATED: return "instantiated";
+    case RST_INITIALIZATION: return "initialization mode";
+    case RST_STEP_COMPLETE: return "step mode";
+    case RST_STEP_FAILED: return "step failed (after fmi2DoStep returned fmi2Discard)";
+    case RST_TERMINATED: return "terminated";
+    case RST_ERROR: return "error";
+    default: return "fatal error";
+    }
+}
+
+static const char *type_name(rst_type type)
+{
+    return type == RST_REAL ? "Real" : type == RST_INTEGER ? "Integer" : "Boolean";
+}
+
+static const char *causality_name(rst_causality causality)
+{
+    switch (causality) {
+    case RST_PARAMETER: return "parameter";
+    case RST_INPUT: return "input";
+    case RST_OUTPUT: return "output";
+    default: return "local";
+    }
+}
+
+/* ------------------------------------------------------------------------------------------------ */
+/* Entering and leaving a call                                                                      */
+/* ------------------------------------------------------------------------------------------------ */
+static rst_instance *as_instance(fmi2Component c)
+{
+    rst_instance *inst = (rst_instance *)c;
+    return (inst != NULL && inst->magic == RST_INSTANCE_MAGIC) ? inst : NULL;
+}
+
+static void lock(rst_instance *inst)
+{
+#ifdef RST_FRONT_PTHREAD
+    pthread_mutex_lock(&inst->lock);
+#else
+    (void)inst;
+#endif
+}
+
+static void unlock(rst_instance *inst)
+{
+#ifdef RST_FRONT_PTHREAD
+    pthread_mutex_unlock(&inst->lock);
+#else
+    (void)inst;
+#endif
+}
+
+/* Is `function` allowed in the instance's mode? Logs why not. */
+static int allowed(rst_instance *inst, const char *function, unsigned int modes)
+{
+    if (inst->mode == RST_FATAL) {
+        rst_log(inst, fmi2Error, "%s: this instance reported fmi2Fatal earlier and cannot be used any more; "
+                "free it (fmi2FreeInstance)", function);
+        return 0;
+    }
+    if (!(modes & (unsigned int)inst->mode)) {
+        rst_log(inst, fmi2Error, "%s is not allowed in %s (FMI 2.0 co-simulation state machine)", function,
+                mode_name(inst->mode));
+        return 0;
+    }
+    return 1;
+}
+
+/* A backend's answer: fmi2Error puts the instance into the error mode, fmi2Fatal latches it. */
+static fmi2Status backend_status(rst_instance *inst, fmi2Status status)
+{
+    if (status == fmi2Fatal)
+        inst->mode = RST_FATAL;
+    else if (status == fmi2Error)
+        inst->mode = RST_ERROR;
+    return status;
+}
+
+#define ENTER(function, modes)                          \
+    rst_instance *inst = as_instance(c);                \
+    fmi2Status status_ = fmi2OK;                        \
+    if (inst == NULL)                                   \
+        return fmi2Error;                               \
+    lock(inst);                                         \
+    if (!allowed(inst, function, modes)) {              \
+        unlock(inst);                                   \
+        return fmi2Error;                               \
+    }
+
+#define LEAVE(status)    \
+    do {                 \
+        status_ = status; \
+        unlock(inst);    \
+        return status_;  \
+    } while (0)
+
+/* ------------------------------------------------------------------------------------------------ */
+/* Values                                                                                           */
+/* ------------------------------------------------------------------------------------------------ */
+static void reset_store(rst_instance *inst)
+{
+    size_t i;
+    for (i = 0; i < inst->model->n_variables; i++)
+        inst->store[i] = inst->model->variables[i].start;
+}
+
+static void describe_value(rst_type type, double value, char *out, size_t size)
+{
+    if (type == RST_REAL)
+        rst_format_double(value, out, size);
+    else if (type == RST_BOOLEAN)
+        snprintf(out, size, "%s", value != 0.0 ? "True" : "False");
+    else
+        snprintf(out, size, "%.0f", value);
+}
+
+/* Is `value` inside the variable's declared range? (Reals: finite too.) */
+static int in_range(const rst_variable *var, double value)
+{
+    if (var->type == RST_BOOLEAN)
+        return value == 0.0 || value == 1.0;
+    if (!isfinite(value))
+        return 0;
+    if (var->low_open ? !(value > var->low) : !(value >= var->low))
+        return 0;
+    if (var->high_open ? !(value < var->high) : !(value <= var->high))
+        return 0;
+    return 1;
+}
+
+/* May the host set `var` in the current mode? (FMI 2.0: inputs and parameters in instantiated and
+ * initialization mode; in step mode inputs and tunable parameters only.) */
+static int settable(const rst_instance *inst, const rst_variable *var)
+{
+    if (var->causality != RST_INPUT && var->causality != RST_PARAMETER)
+        return 0;
+    if (inst->mode == RST_STEP_COMPLETE)
+        return var->causality == RST_INPUT || var->variability == RST_TUNABLE;
+    return 1;
+}
+
+/* Checks one value the host wants to set; logs and returns 0 if it is refused. */
+static int check_set(rst_instance *inst, const char *function, fmi2ValueReference vr, rst_type type, double value)
+{
+    const rst_variable *var;
+    char text[40];
+    if (vr >= inst->model->n_variables) {
+        rst_log(inst, fmi2Error, "%s: unknown value reference %u (this FMU has %u variables)", function, vr,
+                (unsigned int)inst->model->n_variables);
+        return 0;
+    }
+    var = &inst->model->variables[vr];
+    describe_value(type, value, text, sizeof text);
+    if (var->type != type) {
+        rst_log(inst, fmi2Error, "%s: %s (value reference %u) is a %s variable, not %s", function, var->name, vr,
+                type_name(var->type), type_name(type));
+        return 0;
+    }
+    if (!settable(inst, var)) {
+        if (var->causality == RST_OUTPUT || var->causality == RST_LOCAL)
+            rst_log(inst, fmi2Error, "%s: %s is an %s and cannot be set", function, var->name,
+                    causality_name(var->causality));
+        else
+            rst_log(inst, fmi2Error, "%s: %s is a fixed parameter and cannot be set in %s (only before "
+                    "fmi2ExitInitializationMode)", function, var->name, mode_name(inst->mode));
+        return 0;
+    }
+    if (!in_range(var, value)) {
+        rst_log(inst, fmi2Error, "%s = %s is outside the allowed range: %s", var->name, text,
+                var->range_text ? var->range_text : "finite");
+        return 0;
+    }
+    if (inst->model->accept != NULL && inst->model->accept(inst, var, value) != fmi2OK)
+        return 0;
+    return 1;
+}
+
+static fmi2Status set_values(fmi2Component c, const char *function, rst_type type, const fmi2ValueReference vr[],
+                             size_t n, const double *values)
+{
+    size_t i;
+    fmi2Status status = fmi2OK;
+    ENTER(function, SET_MODES)
+    for (i = 0; i < n; i++)
+        if (!check_set(inst, function, vr[i], type, values[i]))
+            LEAVE(fmi2Error); /* all or nothing: a rejected value leaves every variable as it was */
+    for (i = 0; i < n; i++)
+        inst->store[vr[i]] = values[i];
+    if (inst->model->set != NULL)
+        status = backend_status(inst, inst->model->set(inst, type, vr, n, values));
+    LEAVE(status);
+}
+
+static int check_get(rst_instance *inst, const char *function, fmi2ValueReference vr, rst_type type)
+{
+    if (vr >= inst->model->n_variables) {
+        rst_log(inst, fmi2Error, "%s: unknown value reference %u (this FMU has %u variables)", function, vr,
+                (unsigned int)inst->model->n_variables);
+        return 0;
+    }
+    if (inst->model->variables[vr].type != type) {
+        rst_log(inst, fmi2Error, "%s: %s (value reference %u) is a %s variable, not %s", function,
+                inst->model->variables[vr].name, vr, type_name(inst->model->variables[vr].type),
+                type_name(type));
+        return 0;
+    }
+    return 1;
+}
+
+/* Reads `n` (at most 64) variables of `type` into `out`: inputs, parameters and locals from the
+ * store, outputs from the backend in one call. */
+static fmi2Status get_values(rst_instance *inst, const char *function, rst_type type, const fmi2ValueReference vr[],
+                             size_t n, double *out)
+{
+    fmi2ValueReference outputs[64];
+    double output_values[64];
+    size_t position[64];
+    size_t i, n_outputs = 0;
+    fmi2Status status;
+    for (i = 0; i < n; i++) {
+        if (!check_get(inst, function, vr[i], type))
+            return fmi2Error;
+        out[i] = inst->store[vr[i]];
+        if (inst->model->variables[vr[i]].causality == RST_OUTPUT) {
+            position[n_outputs] = i;
+            outputs[n_outputs++] = vr[i];
+        }
+    }
+    if (n_outputs == 0 || inst->model->get_outputs == NULL)
+        return fmi2OK;
+    status = backend_status(inst, inst->model->get_outputs(inst, type, outputs, n_outputs, output_values));
+    if (status < fmi2Error)
+        for (i = 0; i < n_outputs; i++)
+            out[position[i]] = output_values[i];
+    return status;
+}
+
+/* `out` may hold a non-double type: read into doubles first, in chunks. */
+#define GET_TYPED(function, rst_type_, c_type, convert)                                               \
+    size_t i0;                                                                                        \
+    double buffer[64];                                                                                \
+    fmi2Status status = fmi2OK;                                                                       \
+    ENTER(function, GET_MODES)                                                                        \
+    if (n > 0 && (vr == NULL || value == NULL)) {                                                     \
+        rst_log(inst, fmi2Error, "%s: NULL value reference or value array for %u variables", function, \
+                (unsigned int)n);                                                                     \
+        LEAVE(fmi2Error);                                                                             \
+    }                                                                                                 \
+    for (i0 = 0; i0 < n; i0 += 64) {                                                                  \
+        size_t m = n - i0 < 64 ? n - i0 : 64, j;                                                      \
+        fmi2Status s = get_values(inst, function, rst_type_, vr + i0, m, buffer);                     \
+        if (s > status)                                                                               \
+            status = s;                                                                               \
+        if (s >= fmi2Error)                                                                           \
+            LEAVE(status);                                                                            \
+        for (j = 0; j < m; j++)                                                                       \
+            value[i0 + j] = (c_type)convert(buffer[j]);                                               \
+    }                                                                                                 \
+    LEAVE(status);
+
+static double same(double x) { return x; }
+/* an Integer or Boolean held as a double, converted without undefined behaviour for any double */
+static fmi2Integer to_integer(double x)
+{
+    if (!(x >= -2147483648.0 && x <= 2147483647.0))
+        return 0;
+    return (fmi2Integer)x;
+}
+static fmi2Boolean to_boolean(double x) { return x != 0.0 && !isnan(x) ? fmi2True : fmi2False; }
+
+fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2Real value[])
+{
+    GET_TYPED("fmi2GetReal", RST_REAL, fmi2Real, same)
+}
+
+fmi2Status fmi2GetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2Integer value[])
+{
+    GET_TYPED("fmi2GetInteger", RST_INTEGER, fmi2Integer, to_integer)
+}
+
+fmi2Status fmi2GetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2Boolean value[])
+{
+    GET_TYPED("fmi2GetBoolean", RST_BOOLEAN, fmi2Boolean, to_boolean)
+}
+
+fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2String value[])
+{
+    size_t i;
+    ENTER("fmi2GetString", GET_MODES)
+    (void)value;
+    for (i = 0; i < n; i++) {
+        if (vr == NULL || vr[i] >= inst->model->n_variables)
+            rst_log(inst, fmi2Error, "fmi2GetString: unknown value reference %u (this FMU has no String variables)",
+                    vr ? vr[i] : 0u);
+        else
+            rst_log(inst, fmi2Error, "fmi2GetString: %s is a %s variable, not String", inst->model->variables[vr[i]].name,
+                    type_name(inst->model->variables[vr[i]].type));
+        LEAVE(fmi2Error);
+    }
+    LEAVE(fmi2OK);
+}
+
+#define SET_TYPED(function, rst_type_, convert)                                                       \
+    size_t i0;                                                                                        \
+    double buffer[64];                                                                                \
+    rst_instance *checked = as_instance(c);                                                           \
+    if (checked == NULL)                                                                              \
+        return fmi2Error;                                                                             \
+    if (n > 0 && (vr == NULL || value == NULL)) {                                                     \
+        lock(checked);                                                                                \
+        rst_log(checked, fmi2Error, "%s: NULL value reference or value array for %u variables", function, \
+                (unsigned int)n);                                                                     \
+        unlock(checked);                                                                              \
+        return fmi2Error;                                                                             \
+    }                                                                                                 \
+    if (n <= 64) {                                                                                    \
+        for (i0 = 0; i0 < n; i0++)                                                                    \
+            buffer[i0] = convert(value[i0]);                                                          \
+        return set_values(c, function, rst_type_, vr, n, buffer);                                     \
+    } else { /* more than 64: all-or-nothing needs them in one piece */                              \
+        double *all = (double *)checked->allocate(n, sizeof(double));                                 \
+        fmi2Status status;                                                                            \
+        if (all == NULL) {                                                                            \
+            lock(checked);                                                                            \
+            rst_log(checked, fmi2Error, "%s: out of memory for %u values", function, (unsigned int)n); \
+            unlock(checked);                                                                          \
+            return fmi2Error;                                                                         \
+        }                                                                                             \
+        for (i0 = 0; i0 < n; i0++)                                                                    \
+            all[i0] = convert(value[i0]);                                                             \
+        status = set_values(c, function, rst_type_, vr, n, all);                                      \
+        checked->release(all);                                                                        \
+        return status;                                                                                \
+    }
+
+static double from_boolean(fmi2Boolean b) { return (double)b; }
+static double from_integer(fmi2Integer i) { return (double)i; }
+
+fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2Real value[])
+{
+    SET_TYPED("fmi2SetReal", RST_REAL, same)
+}
+
+fmi2Status fmi2SetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2Integer value[])
+{
+    SET_TYPED("fmi2SetInteger", RST_INTEGER, from_integer)
+}
+
+fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2Boolean value[])
+{
+    SET_TYPED("fmi2SetBoolean", RST_BOOLEAN, from_boolean)
+}
+
+fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2String value[])
+{
+    size_t i;
+    ENTER("fmi2SetString", SET_MODES)
+    (void)value;
+    for (i = 0; i < n; i++) {
+        rst_log(inst, fmi2Error, "fmi2SetString: value reference %u is not a String variable (this FMU has none)",
+                vr ? vr[i] : 0u);
+        LEAVE(fmi2Error);
+    }
+    LEAVE(fmi2OK);
+}
+
+/* ------------------------------------------------------------------------------------------------ */
+/* Life cycle                                                                                       */
+/* ------------------------------------------------------------------------------------------------ */
+const char *fmi2GetTypesPlatform(void) { return fmi2TypesPlatform; }
+const char *fmi2GetVersion(void) { return fmi2Version; }
+
+static int hex_value(char ch)
+{
+    if (ch >= '0' && ch <= '9') return ch - '0';
+    if (ch >= 'a' && ch <= 'f') return ch - 'a' + 10;
+    if (ch >= 'A' && ch <= 'F') return ch - 'A' + 10;
+    return -1;
+}
+
+/* fmuResourceLocation (file:///p, file:/p, file://localhost/p, percent-encoded) -> the path p in
+ * `path` (room for strlen(uri) + 1 bytes). Returns NULL, or why it is not a file URI one can decode.
+ * Windows drive paths (file:///C:/x) lose their leading slash. */
+static const char *decode_resource_location(const char *uri, char *path)
+{
+    const char *p = uri;
+    size_t n = 0;
+    if (strncmp(p, "file://localhost/", 17) == 0)
+        p += 16;
+    else if (strncmp(p, "file:///", 8) == 0)
+        p += 7;
+    else if (strncmp(p, "file:/", 6) == 0)
+        p += 5;
+    else
+        return "it is not a file: URI";
+    if (((p[1] >= 'A' && p[1] <= 'Z') || (p[1] >= 'a' && p[1] <= 'z')) && p[2] == ':')
+        p++; /* /C:/... */
+    for (; *p; p++) {
+        if (*p == '%') {
+            int hi = hex_value(p[1]), lo = hi < 0 ? -1 : hex_value(p[2]);
+            if (hi < 0 || lo < 0 || (hi == 0 && lo == 0))
+                return "it has an invalid percent escape";
+            path[n++] = (char)(hi * 16 + lo);
+            p += 2;
+        } else {
+            path[n++] = *p;
+        }
+    }
+    while (n > 1 && (path[n - 1] == '/' || path[n - 1] == '\\'))
+        n--;
+    path[n] = '\0';
+    return NULL;
+}
+
+static void stderr_message(const char *name, const char *message)
+{
+    fprintf(stderr, "%s [%s]: %s\n", RST_MODEL.identifier, name ? name : "?", message);
+}
+
+static void free_states(rst_instance *inst)
+{
+    while (inst->states != NULL) {
+        rst_state *next = inst->states->next;
+        inst->states->magic = 0;
+        inst->release(inst->states);
+        inst->states = next;
+    }
+}
+
+static void free_memory(rst_instance *inst)
+{
+    fmi2CallbackFreeMemory release = inst->release;
+    free_states(inst);
+#ifdef RST_FRONT_PTHREAD
+    pthread_mutex_destroy(&inst->lock);
+#endif
+    inst->magic = 0;
+    release(inst->backend);
+    release(inst->store);
+    release(inst->name);
+    release(inst);
+}
+
+fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2String fmuGUID,
+                              fmi2String fmuResourceLocation, const fmi2CallbackFunctions *functions,
+                              fmi2Boolean visible, fmi2Boolean loggingOn)
+{
+    const rst_model *model = &RST_MODEL;
+    rst_instance *inst;
+    char *resource_dir = NULL;
+    const char *why = NULL;
+    size_t i;
+    fmi2Status status;
+    if (functions == NULL || functions->logger == NULL) {
+        stderr_message(instanceName, "fmi2Instantiate: no logger in the callback functions (NULL); not instantiated");
+        return NULL;
+    }
+    if (functions->allocateMemory == NULL || functions->freeMemory == NULL) {
+        functions->logger(functions->componentEnvironment, instanceName ? instanceName : "", fmi2Error,
+                          "logStatusError", "fmi2Instantiate: allocateMemory or freeMemory is NULL; not instantiated");
+        return NULL;
+    }
+    if (instanceName == NULL || instanceName[0] == '\0') {
+        functions->logger(functions->componentEnvironment, "", fmi2Error, "logStatusError",
+                          "fmi2Instantiate: the instance name is NULL or empty; not instantiated");
+        return NULL;
+    }
+    inst = (rst_instance *)functions->allocateMemory(1, sizeof *inst);
+    if (inst == NULL)
+        return NULL;
+    inst->model = model;
+    inst->logger = functions->logger;
+    inst->allocate = functions->allocateMemory;
+    inst->release = functions->freeMemory;
+    inst->environment = functions->componentEnvironment;
+    inst->logging_on = loggingOn != fmi2False;
+    inst->categories = CAT_WARNING | CAT_DISCARD | CAT_ERROR | CAT_FATAL | CAT_ALL;
+    inst->mode = RST_INSTANTIATED;
+    inst->last_step_status = fmi2OK;
+    inst->name = (char *)inst->allocate(strlen(instanceName) + 1, 1);
+    inst->store = (double *)inst->allocate(model->n_variables ? model->n_variables : 1, sizeof(double));
+    inst->backend = inst->allocate(model->backend_size ? model->backend_size : 1, 1);
+    if (inst->name == NULL || inst->store == NULL || inst->backend == NULL) {
+        functions->logger(functions->componentEnvironment, instanceName, fmi2Error, "logStatusError",
+                          "fmi2Instantiate: out of memory");
+        if (inst->name) inst->release(inst->name);
+        if (inst->store) inst->release(inst->store);
+        if (inst->backend) inst->release(inst->backend);
+        inst->release(inst);
+        return NULL;
+    }
+    strcpy(inst->name, instanceName);
+    memset(inst->backend, 0, model->backend_size ? model->backend_size : 1);
+    for (i = 0; i < model->n_variables; i++)
+        inst->n_state += model->variables[i].state != 0;
+#ifdef RST_FRONT_PTHREAD
+    pthread_mutex_init(&inst->lock, NULL);
+#endif
+    inst->magic = RST_INSTANCE_MAGIC;
+    reset_store(inst);
+
+    if (fmuType != fmi2CoSimulation) {
+        rst_log(inst, fmi2Error, "fmi2Instantiate: %s is a co-simulation FMU; model exchange is not provided",
+                model->identifier);
+        free_memory(inst);
+        return NULL;
+    }
+    if (fmuGUID == NULL || strcmp(fmuGUID, model->guid) != 0) {
+        rst_log(inst, fmi2Error, "fmi2Instantiate: GUID %s does not match this FMU's %s (modelDescription.xml "
+                "of another FMU or another build?)", fmuGUID ? fmuGUID : "(NULL)", model->guid);
+        free_memory(inst);
+        return NULL;
+    }
+    if (fmuResourceLocation != NULL && fmuResourceLocation[0] != '\0') {
+        resource_dir = (char *)inst->allocate(strlen(fmuResourceLocation) + 1, 1);
+        why = resource_dir == NULL ? "out of memory" : decode_resource_location(fmuResourceLocation, resource_dir);
+        if (why != NULL) {
+            rst_log(inst, fmi2Error, "fmi2Instantiate: cannot use the resource location %s: %s", fmuResourceLocation,
+                    why);
+            if (resource_dir != NULL)
+                inst->release(resource_dir);
+            free_memory(inst);
+            return NULL;
+        }
+    }
+    status = model->instantiate ? model->instantiate(inst, resource_dir, visible) : fmi2OK;
+    if (resource_dir != NULL)
+        inst->release(resource_dir);
+    if (status != fmi2OK) {
+        free_memory(inst);
+        return NULL;
+    }
+    return inst;
+}
+
+void fmi2FreeInstance(fmi2Component c)
+{
+    rst_instance *inst = as_instance(c);
+    if (inst == NULL)
+        return;
+    lock(inst);
+    if (inst->model->free_instance != NULL)
+        inst->model->free_instance(inst);
+    unlock(inst);
+    free_memory(inst);
+}
+
+fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn, size_t nCategories,
+                               const fmi2String categories[])
+{
+    size_t i;
+    unsigned int bits = 0;
+    int k;
+    ENTER("fmi2SetDebugLogging", ANY_LIVE_MODE)
+    if (nCategories > 0 && categories == NULL) {
+        rst_log(inst, fmi2Error, "fmi2SetDebugLogging: %u categories but a NULL array", (unsigned int)nCategories);
+        LEAVE(fmi2Error);
+    }
+    for (i = 0; i < nCategories; i++) {
+        int found = 0;
+        for (k = 0; categories[i] != NULL && k < N_CATEGORIES; k++)
+            if (strcmp(categories[i], CATEGORY_NAMES[k]) == 0) {
+                bits |= 1u << k;
+                found = 1;
+            }
+        if (!found) {
+            rst_log(inst, fmi2Error, "fmi2SetDebugLogging: unknown log category %s (this FMU has logStatusWarning, "
+                    "logStatusDiscard, logStatusError, logStatusFatal and logAll)",
+                    categories[i] ? categories[i] : "(NULL)");
+            LEAVE(fmi2Error);
+        }
+    }
+    inst->logging_on = loggingOn != fmi2False;
+    inst->categories = nCategories > 0 ? bits : (CAT_WARNING | CAT_DISCARD | CAT_ERROR | CAT_FATAL | CAT_ALL);
+    LEAVE(fmi2OK);
+}
+
+fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined, fmi2Real tolerance,
+                               fmi2Real startTime, fmi2Boolean stopTimeDefined, fmi2Real stopTime)
+{
+    ENTER("fmi2SetupExperiment", RST_INSTANTIATED)
+    if (!isfinite(startTime) || (stopTimeDefined && !(stopTime >= startTime && stopTime <= DBL_MAX)) ||
+        (toleranceDefined && !(tolerance > 0.0 && tolerance <= DBL_MAX))) {
+        char t0[40], t1[40], tol[40];
+        rst_format_double(startTime, t0, sizeof t0);
+        rst_format_double(stopTime, t1, sizeof t1);
+        rst_format_double(tolerance, tol, sizeof tol);
+        rst_log(inst, fmi2Error, "fmi2SetupExperiment: startTime = %s%s%s%s%s: the start time must be finite, a "
+                "defined stop time finite and >= the start time, a defined tolerance finite and > 0", t0,
+                stopTimeDefined ? ", stopTime = " : "", stopTimeDefined ? t1 : "",
+                toleranceDefined ? ", tolerance = " : "", toleranceDefined ? tol : "");
+        LEAVE(fmi2Error);
+    }
+    if (inst->model->setup_experiment != NULL) {
+        fmi2Status s = backend_status(inst, inst->model->setup_experiment(inst, toleranceDefined, tolerance,
+                                                                            startTime, stopTimeDefined, stopTime));
+        if (s >= fmi2Error)
+            LEAVE(s);
+        status_ = s;
+    }
+    inst->has_start = 1;
+    inst->start_time = startTime;
+    LEAVE(status_);
+}
+
+fmi2Status fmi2EnterInitializationMode(fmi2Component c)
+{
+    fmi2Status status = fmi2OK;
+    ENTER("fmi2EnterInitializationMode", RST_INSTANTIATED)
+    if (inst->model->enter_initialization != NULL)
+        status = backend_status(inst, inst->model->enter_initialization(inst));
+    if (status < fmi2Error)
+        inst->mode = RST_INITIALIZATION;
+    LEAVE(status);
+}
+
+fmi2Status fmi2ExitInitializationMode(fmi2Component c)
+{
+    fmi2Status status = fmi2OK;
+    ENTER("fmi2ExitInitializationMode", RST_INITIALIZATION)
+    if (inst->model->exit_initialization != NULL)
+        status = backend_status(inst, inst->model->exit_initialization(inst));
+    if (status < fmi2Error) {
+        inst->mode = RST_STEP_COMPLETE;
+        inst->has_time = inst->has_start;
+        inst->next_time = inst->start_time;
+        inst->last_time = inst->start_time;
+    }
+    LEAVE(status);
+}
+
+fmi2Status fmi2Terminate(fmi2Component c)
+{
+    fmi2Status status = fmi2OK;
+    ENTER("fmi2Terminate", RST_STEP_COMPLETE | RST_STEP_FAILED)
+    if (inst->model->terminate != NULL)
+        status = backend_status(inst, inst->model->terminate(inst));
+    if (status < fmi2Error)
+        inst->mode = RST_TERMINATED;
+    LEAVE(status);
+}
+
+fmi2Status fmi2Reset(fmi2Component c)
+{
+    fmi2Status status = fmi2OK;
+    ENTER("fmi2Reset", ANY_LIVE_MODE)
+    reset_store(inst);
+    inst->mode = RST_INSTANTIATED;
+    inst->has_start = inst->has_time = 0;
+    inst->start_time = inst->next_time = inst->last_time = 0.0;
+    inst->last_step_status = fmi2OK;
+    if (inst->model->reset != NULL)
+        status = backend_status(inst, inst->model->reset(inst));
+    LEAVE(status);
+}
+
+/* ------------------------------------------------------------------------------------------------ */
+/* Stepping                                                                                         */
+/* ------------------------------------------------------------------------------------------------ */
+fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint, fmi2Real communicationStepSize,
+                      fmi2Boolean noSetFMUStatePriorToCurrentPoint)
+{
+    double t = currentCommunicationPoint, h = communicationStepSize;
+    fmi2Status status = fmi2OK;
+    char t_text[40], h_text[40], want[40];
+    ENTER("fmi2DoStep", RST_STEP_COMPLETE)
+    (void)noSetFMUStatePriorToCurrentPoint;
+    rst_format_double(t, t_text, sizeof t_text);
+    rst_format_double(h, h_text, sizeof h_text);
+    if (!isfinite(t) || !isfinite(h) || !(h > 0.0) || !isfinite(t + h)) {
+        rst_log(inst, fmi2Error, "fmi2DoStep: currentCommunicationPoint = %s, communicationStepSize = %s: the step "
+                "size must be finite and > 0, the time finite", t_text, h_text);
+        LEAVE(fmi2Error);
+    }
+    if (inst->has_time) {
+        double scale = fabs(inst->next_time) > fabs(h) ? fabs(inst->next_time) : fabs(h);
+        if (fabs(t - inst->next_time) > TIME_RTOL * scale) {
+            rst_format_double(inst->next_time, want, sizeof want);
+            rst_log(inst, fmi2Error, "fmi2DoStep: currentCommunicationPoint = %s does not continue the previous "
+                    "step, which ended at %s (a step cannot be skipped or repeated without fmi2SetFMUstate)",
+                    t_text, want);
+            LEAVE(fmi2Error);
+        }
+    }
+    if (inst->model->do_step != NULL)
+        status = backend_status(inst, inst->model->do_step(inst, t, h));
+    inst->last_step_status = status;
+    if (status <= fmi2Warning) {
+        inst->has_time = 1;
+        inst->next_time = t + h;
+        inst->last_time = t + h;
+    } else if (status == fmi2Discard) {
+        inst->mode = RST_STEP_FAILED;
+        inst->last_time = t;
+    }
+    LEAVE(status);
+}
+
+fmi2Status fmi2CancelStep(fmi2Component c)
+{
+    ENTER("fmi2CancelStep", 0)
+    LEAVE(fmi2Error); /* no step is ever in progress: fmi2DoStep is synchronous */
+}
+
+fmi2Status fmi2GetStatus(fmi2Component c, const fmi2StatusKind s, fmi2Status *value)
+{
+    ENTER("fmi2GetStatus", RST_STEP_COMPLETE | RST_STEP_FAILED | RST_TERMINATED)
+    if (value == NULL || s != fmi2DoStepStatus) {
+        rst_log(inst, fmi2Error, "fmi2GetStatus: only fmi2DoStepStatus is provided, with a non-NULL value");
+        LEAVE(fmi2Error);
+    }
+    *value = inst->last_step_status;
+    LEAVE(fmi2OK);
+}
+
+fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind s, fmi2Real *value)
+{
+    ENTER("fmi2GetRealStatus", RST_STEP_COMPLETE | RST_STEP_FAILED | RST_TERMINATED)
+    if (value == NULL || s != fmi2LastSuccessfulTime) {
+        rst_log(inst, fmi2Error, "fmi2GetRealStatus: only fmi2LastSuccessfulTime is provided, with a non-NULL value");
+        LEAVE(fmi2Error);
+    }
+    *value = inst->last_time;
+    LEAVE(fmi2OK);
+}
+
+fmi2Status fmi2GetIntegerStatus(fmi2Component c, const fmi2StatusKind s, fmi2Integer *value)
+{
+    ENTER("fmi2GetIntegerStatus", RST_STEP_COMPLETE | RST_STEP_FAILED | RST_TERMINATED)
+    (void)s;
+    (void)value;
+    rst_log(inst, fmi2Error, "fmi2GetIntegerStatus: no integer status is defined by FMI 2.0");
+    LEAVE(fmi2Error);
+}
+
+fmi2Status fmi2GetBooleanStatus(fmi2Component c, const fmi2StatusKind s, fmi2Boolean *value)
+{
+    ENTER("fmi2GetBooleanStatus", RST_STEP_COMPLETE | RST_STEP_FAILED | RST_TERMINATED)
+    if (value == NULL || s != fmi2Terminated) {
+        rst_log(inst, fmi2Error, "fmi2GetBooleanStatus: only fmi2Terminated is provided, with a non-NULL value");
+        LEAVE(fmi2Error);
+    }
+    *value = fmi2False; /* the slave never asks to end the simulation */
+    LEAVE(fmi2OK);
+}
+
+fmi2Status fmi2GetStringStatus(fmi2Component c, const fmi2StatusKind s, fmi2String *value)
+{
+    ENTER("fmi2GetStringStatus", RST_STEP_COMPLETE | RST_STEP_FAILED | RST_TERMINATED)
+    (void)s;
+    (void)value;
+    rst_log(inst, fmi2Error, "fmi2GetStringStatus: fmi2PendingStatus does not exist here (no asynchronous steps)");
+    LEAVE(fmi2Error);
+}
+
+/* ------------------------------------------------------------------------------------------------ */
+/* Not provided (canGetDirectionalDerivatives, canInterpolateInputs, maxOutputDerivativeOrder = 0)   */
+/* ------------------------------------------------------------------------------------------------ */
+fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference vUnknown_ref[], size_t nUnknown,
+                                        const fmi2ValueReference vKnown_ref[], size_t nKnown,
+                                        const fmi2Real dvKnown[], fmi2Real dvUnknown[])
+{
+    ENTER("fmi2GetDirectionalDerivative", GET_MODES)
+    (void)vUnknown_ref, (void)nUnknown, (void)vKnown_ref, (void)nKnown, (void)dvKnown, (void)dvUnknown;
+    rst_log(inst, fmi2Error, "fmi2GetDirectionalDerivative is not provided (providesDirectionalDerivative = false)");
+    LEAVE(fmi2Error);
+}
+
+fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
+                                       const fmi2Integer order[], const fmi2Real value[])
+{
+    ENTER("fmi2SetRealInputDerivatives", SET_MODES)
+    (void)vr, (void)nvr, (void)order, (void)value;
+    rst_log(inst, fmi2Error, "fmi2SetRealInputDerivatives is not provided (canInterpolateInputs = false)");
+    LEAVE(fmi2Error);
+}
+
+fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
+                                        const fmi2Integer order[], fmi2Real value[])
+{
+    ENTER("fmi2GetRealOutputDerivatives", RST_STEP_COMPLETE | RST_STEP_FAILED | RST_TERMINATED | RST_ERROR)
+    (void)vr, (void)nvr, (void)order, (void)value;
+    rst_log(inst, fmi2Error, "fmi2GetRealOutputDerivatives is not provided (maxOutputDerivativeOrder = 0)");
+    LEAVE(fmi2Error);
+}
+
+/* ------------------------------------------------------------------------------------------------ */
+/* FMU states                                                                                       */
+/* ------------------------------------------------------------------------------------------------ */
+static rst_state *find_state(rst_instance *inst, const void *pointer)
+{
+    rst_state *s;
+    for (s = inst->states; s != NULL; s = s->next)
+        if ((const void *)s == pointer)
+            return s;
+    return NULL;
+}
+
+static rst_state *new_state(rst_instance *inst)
+{
+    rst_state *s = (rst_state *)inst->allocate(1, sizeof(rst_state) + (inst->n_state ? inst->n_state - 1 : 0) *
+                                                                     sizeof(double));
+    if (s == NULL)
+        return NULL;
+    s->magic = RST_STATE_MAGIC;
+    s->next = inst->states;
+    inst->states = s;
+    return s;
+}
+
+static void unlink_state(rst_instance *inst, rst_state *state)
+{
+    rst_state **link;
+    for (link = &inst->states; *link != NULL; link = &(*link)->next)
+        if (*link == state) {
+            *link = state->next;
+            state->magic = 0;
+            inst->release(state);
+            return;
+        }
+}
+
+/* `*pointer`: NULL (a new state) or one of ours (overwritten). Logs and returns NULL otherwise. */
+static rst_state *target_state(rst_instance *inst, const char *function, fmi2FMUstate *pointer)
+{
+    rst_state *s;
+    if (pointer == NULL) {
+        rst_log(inst, fmi2Error, "%s: the FMUstate pointer is NULL", function);
+        return NULL;
+    }
+    if (*pointer == NULL) {
+        s = new_state(inst);
+        if (s == NULL)
+            rst_log(inst, fmi2Error, "%s: out of memory", function);
+        return s;
+    }
+    s = find_state(inst, *pointer);
+    if (s == NULL)
+        rst_log(inst, fmi2Error, "%s: *FMUstate is neither NULL nor a state of this instance", function);
+    return s;
+}
+
+fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *FMUstate)
+{
+    rst_state *s;
+    size_t i, k = 0;
+    fmi2Status status = fmi2OK;
+    ENTER("fmi2GetFMUstate", ANY_LIVE_MODE)
+    if (inst->model->save_state != NULL) {
+        status = backend_status(inst, inst->model->save_state(inst));
+        if (status >= fmi2Error)
+            LEAVE(status);
+    }
+    s = target_state(inst, "fmi2GetFMUstate", FMUstate);
+    if (s == NULL)
+        LEAVE(fmi2Error);
+    s->mode = inst->mode;
+    s->has_start = inst->has_start;
+    s->has_time = inst->has_time;
+    s->start_time = inst->start_time;
+    s->next_time = inst->next_time;
+    s->last_time = inst->last_time;
+    for (i = 0; i < inst->model->n_variables; i++)
+        if (inst->model->variables[i].state)
+            s->values[k++] = inst->store[i];
+    *FMUstate = s;
+    LEAVE(status);
+}
+
+/* Is every value of a snapshot one this instance could hold? (A deserialized state passes here
+ * before it becomes a state; checks as fmi2SetXXX would, plus the types of the other variables.) */
+static int check_snapshot(rst_instance *inst, const char *function, const rst_state *s)
+{
+    size_t i, k = 0;
+    char text[40];
+    if (!(s->mode & (ANY_LIVE_MODE)) || !isfinite(s->start_time) || !isfinite(s->next_time) ||
+        !isfinite(s->last_time)) {
+        rst_log(inst, fmi2Error, "%s: the state's mode or times are invalid", function);
+        return 0;
+    }
+    for (i = 0; i < inst->model->n_variables; i++) {
+        const rst_variable *var = &inst->model->variables[i];
+        double value;
+        if (!var->state)
+            continue;
+        value = s->values[k++];
+        describe_value(var->type, value, text, sizeof text);
+        if (var->causality == RST_INPUT || var->causality == RST_PARAMETER) {
+            if (!in_range(var, value) ||
+                (var->type == RST_INTEGER && value != floor(value))) {
+                rst_log(inst, fmi2Error, "%s: the state has %s = %s, outside the allowed range: %s", function,
+                        var->name, text, var->range_text ? var->range_text : "finite");
+                return 0;
+            }
+            if (inst->model->accept != NULL && inst->model->accept(inst, var, value) != fmi2OK)
+                return 0;
+        } else if ((var->type == RST_BOOLEAN && value != 0.0 && value != 1.0) ||
+                   (var->type == RST_INTEGER &&
+                    !(value == floor(value) && value >= -2147483648.0 && value <= 2147483647.0))) {
+            rst_log(inst, fmi2Error, "%s: the state has %s = %s, not a valid %s", function, var->name, text,
+                    type_name(var->type));
+            return 0;
+        }
+    }
+    return 1;
+}
+
+fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate FMUstate)
+{
+    rst_state *s;
+    size_t i, k = 0;
+    fmi2Status status = fmi2OK;
+    ENTER("fmi2SetFMUstate", ANY_LIVE_MODE)
+    s = find_state(inst, FMUstate);
+    if (s == NULL) {
+        rst_log(inst, fmi2Error, "fmi2SetFMUstate: the FMUstate is not a state of this instance (states are made by "
+                "fmi2GetFMUstate or fmi2DeSerializeFMUstate of the same instance)");
+        LEAVE(fmi2Error);
+    }
+    for (i = 0; i < inst->model->n_variables; i++)
+        if (inst->model->variables[i].state)
+            inst->store[i] = s->values[k++];
+    inst->mode = s->mode;
+    inst->has_start = s->has_start;
+    inst->has_time = s->has_time;
+    inst->start_time = s->start_time;
+    inst->next_time = s->next_time;
+    inst->last_time = s->last_time;
+    inst->last_step_status = fmi2OK;
+    if (inst->model->restore_state != NULL)
+        status = backend_status(inst, inst->model->restore_state(inst));
+    LEAVE(status);
+}
+
+fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate *FMUstate)
+{
+    rst_state *s;
+    ENTER("fmi2FreeFMUstate", ANY_LIVE_MODE)
+    if (FMUstate == NULL || *FMUstate == NULL)
+        LEAVE(fmi2OK); /* nothing to free */
+    s = find_state(inst, *FMUstate);
+    if (s == NULL) {
+        rst_log(inst, fmi2Error, "fmi2FreeFMUstate: the FMUstate is not a state of this instance");
+        LEAVE(fmi2Error);
+    }
+    unlink_state(inst, s);
+    *FMUstate = NULL;
+    LEAVE(fmi2OK);
+}
+
+/* Serialized layout (little-endian whatever the platform):
+ *   "RSTFMUST" | u32 format | u32 len + model identifier | u32 len + GUID | u32 number of state variables
+ *   | u32 mode | u32 has_start | u32 has_time | f64 start_time | f64 next_time | f64 last_time
+ *   | per state variable: u32 value reference, u32 type, f64 value | u64 FNV-1a of everything before. */
+#define SERIAL_MAGIC "RSTFMUST"
+
+static size_t serialized_size(const rst_instance *inst)
+{
+    return 8 + 4 + 4 + strlen(inst->model->identifier) + 4 + strlen(inst->model->guid) + 4 + 3 * 4 + 3 * 8 +
+           inst->n_state * (4 + 4 + 8) + 8;
+}
+
+static void put_u32(unsigned char **p, uint32_t x)
+{
+    int i;
+    for (i = 0; i < 4; i++)
+        *(*p)++ = (unsigned char)(x >> (8 * i));
+}
+
+static void put_u64(unsigned char **p, uint64_t x)
+{
+    int i;
+    for (i = 0; i < 8; i++)
+        *(*p)++ = (unsigned char)(x >> (8 * i));
+}
+
+static void put_f64(unsigned char **p, double x)
+{
+    uint64_t bits;
+    memcpy(&bits, &x, sizeof bits);
+    put_u64(p, bits);
+}
+
+static void put_text(unsigned char **p, const char *text)
+{
+    size_t n = strlen(text);
+    put_u32(p, (uint32_t)n);
+    memcpy(*p, text, n);
+    *p += n;
+}
+
+static uint64_t fnv1a(const unsigned char *bytes, size_t n)
+{
+    uint64_t hash = 14695981039346656037ull;
+    size_t i;
+    for (i = 0; i < n; i++) {
+        hash ^= bytes[i];
+        hash *= 1099511628211ull;
+    }
+    return hash;
+}
+
+fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate FMUstate, size_t *size)
+{
+    ENTER("fmi2SerializedFMUstateSize", ANY_LIVE_MODE)
+    if (size == NULL || find_state(inst, FMUstate) == NULL) {
+        rst_log(inst, fmi2Error, "fmi2SerializedFMUstateSize: %s", size == NULL ? "size is NULL"
+                : "the FMUstate is not a state of this instance");
+        LEAVE(fmi2Error);
+    }
+    *size = serialized_size(inst);
+    LEAVE(fmi2OK);
+}
+
+fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate FMUstate, fmi2Byte serializedState[], size_t size)
+{
+    rst_state *s;
+    unsigned char *p;
+    size_t i, k = 0;
+    ENTER("fmi2SerializeFMUstate", ANY_LIVE_MODE)
+    s = find_state(inst, FMUstate);
+    if (s == NULL || serializedState == NULL || size < serialized_size(inst)) {
+        rst_log(inst, fmi2Error, "fmi2SerializeFMUstate: %s",
+                s == NULL ? "the FMUstate is not a state of this instance"
+                : serializedState == NULL ? "the byte array is NULL"
+                : "the byte array is smaller than fmi2SerializedFMUstateSize says");
+        LEAVE(fmi2Error);
+    }
+    p = (unsigned char *)serializedState;
+    memcpy(p, SERIAL_MAGIC, 8);
+    p += 8;
+    put_u32(&p, RST_STATE_FORMAT);
+    put_text(&p, inst->model->identifier);
+    put_text(&p, inst->model->guid);
+    put_u32(&p, (uint32_t)inst->n_state);
+    put_u32(&p, (uint32_t)s->mode);
+    put_u32(&p, (uint32_t)s->has_start);
+    put_u32(&p, (uint32_t)s->has_time);
+    put_f64(&p, s->start_time);
+    put_f64(&p, s->next_time);
+    put_f64(&p, s->last_time);
+    for (i = 0; i < inst->model->n_variables; i++)
+        if (inst->model->variables[i].state) {
+            put_u32(&p, (uint32_t)i);
+            put_u32(&p, (uint32_t)inst->model->variables[i].type);
+            put_f64(&p, s->values[k++]);
+        }
+    put_u64(&p, fnv1a((const unsigned char *)serializedState, (size_t)(p - (unsigned char *)serializedState)));
+    LEAVE(fmi2OK);
+}
+
+/* A reader that never goes past the end of the bytes. */
+typedef struct {
+    const unsigned char *p, *end;
+    int ok;
+} reader;
+
+static uint64_t get_uint(reader *r, int n_bytes)
+{
+    uint64_t x = 0;
+    int i;
+    if (!r->ok || r->end - r->p < n_bytes) {
+        r->ok = 0;
+        return 0;
+    }
+    for (i = 0; i < n_bytes; i++)
+        x |= (uint64_t)(*r->p++) << (8 * i);
+    return x;
+}
+
+static double get_f64(reader *r)
+{
+    uint64_t bits = get_uint(r, 8);
+    double x;
+    memcpy(&x, &bits, sizeof x);
+    return x;
+}
+
+static int get_text_equal(reader *r, const char *expected)
+{
+    uint64_t n = get_uint(r, 4);
+    size_t m = strlen(expected);
+    int equal;
+    if (!r->ok || n > (uint64_t)(r->end - r->p)) {
+        r->ok = 0;
+        return 0;
+    }
+    equal = n == m && memcmp(r->p, expected, m) == 0;
+    r->p += n;
+    return equal;
+}
+
+fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte serializedState[], size_t size,
+                                   fmi2FMUstate *FMUstate)
+{
+    reader r;
+    rst_state *s, *target;
+    size_t i, k = 0;
+    double *values;
+    rst_state head;
+    uint32_t format, mode;
+    const char *problem = NULL;
+    ENTER("fmi2DeSerializeFMUstate", ANY_LIVE_MODE)
+    if (serializedState == NULL || FMUstate == NULL) {
+        rst_log(inst, fmi2Error, "fmi2DeSerializeFMUstate: NULL %s", serializedState == NULL ? "bytes" : "FMUstate pointer");
+        LEAVE(fmi2Error);
+    }
+    if (*FMUstate != NULL && find_state(inst, *FMUstate) == NULL) {
+        rst_log(inst, fmi2Error, "fmi2DeSerializeFMUstate: *FMUstate is neither NULL nor a state of this instance");
+        LEAVE(fmi2Error);
+    }
+    values = (double *)inst->allocate(inst->n_state ? inst->n_state : 1, sizeof(double));
+    if (values == NULL) {
+        rst_log(inst, fmi2Error, "fmi2DeSerializeFMUstate: out of memory");
+        LEAVE(fmi2Error);
+    }
+    r.p = (const unsigned char *)serializedState;
+    r.end = r.p + size;
+    r.ok = 1;
+    memset(&head, 0, sizeof head);
+    if (size < 8 + 8 || memcmp(r.p, SERIAL_MAGIC, 8) != 0)
+        problem = "these bytes are not a serialized state of this FMU (no RSTFMUST header)";
+    else {
+        uint64_t expected = fnv1a(r.p, size - 8);
+        r.p += size - 8;
+        if (get_uint(&r, 8) != expected)
+            problem = "the checksum does not match (truncated or corrupted bytes)";
+    }
+    if (problem == NULL) {
+        r.p = (const unsigned char *)serializedState + 8;
+        r.end = (const unsigned char *)serializedState + size - 8;
+        format = (uint32_t)get_uint(&r, 4);
+        if (r.ok && format != RST_STATE_FORMAT)
+            problem = "the state was written in another format version";
+        else if (!get_text_equal(&r, inst->model->identifier) && r.ok)
+            problem = "the state belongs to another model";
+        else if (!get_text_equal(&r, inst->model->guid) && r.ok)
+            problem = "the state belongs to another build of this model (GUID differs)";
+        else if (get_uint(&r, 4) != inst->n_state && r.ok)
+            problem = "the state has another number of variables";
+        else {
+            mode = (uint32_t)get_uint(&r, 4);
+            head.mode = (rst_mode)mode;
+            head.has_start = get_uint(&r, 4) != 0;
+            head.has_time = get_uint(&r, 4) != 0;
+            head.start_time = get_f64(&r);
+            head.next_time = get_f64(&r);
+            head.last_time = get_f64(&r);
+            for (i = 0; r.ok && problem == NULL && i < inst->model->n_variables; i++) {
+                if (!inst->model->variables[i].state)
+                    continue;
+                if (get_uint(&r, 4) != i || get_uint(&r, 4) != (uint64_t)inst->model->variables[i].type)
+                    problem = "the state's variable list differs from this FMU's";
+                values[k++] = get_f64(&r);
+            }
+            if (r.ok && problem == NULL && r.p != r.end)
+                problem = "the state has trailing bytes";
+        }
+        if (!r.ok && problem == NULL)
+            problem = "the state is truncated";
+    }
+    if (problem != NULL) {
+        rst_log(inst, fmi2Error, "fmi2DeSerializeFMUstate: %s; nothing was changed", problem);
+        inst->release(values);
+        LEAVE(fmi2Error);
+    }
+    /* the values as a snapshot, checked like fmi2SetXXX before it may become a state */
+    s = (rst_state *)inst->allocate(1, sizeof(rst_state) + (inst->n_state ? inst->n_state - 1 : 0) * sizeof(double));
+    if (s == NULL) {
+        inst->release(values);
+        rst_log(inst, fmi2Error, "fmi2DeSerializeFMUstate: out of memory");
+        LEAVE(fmi2Error);
+    }
+    *s = head;
+    memcpy(s->values, values, inst->n_state * sizeof(double));
+    inst->release(values);
+    if (!check_snapshot(inst, "fmi2DeSerializeFMUstate", s)) {
+        inst->release(s);
+        LEAVE(fmi2Error);
+    }
+    target = target_state(inst, "fmi2DeSerializeFMUstate", FMUstate);
+    if (target == NULL) {
+        inst->release(s);
+        LEAVE(fmi2Error);
+    }
+    {
+        rst_state *next = target->next;
+        memcpy(target, s, sizeof(rst_state) + (inst->n_state ? inst->n_state - 1 : 0) * sizeof(double));
+        target->magic = RST_STATE_MAGIC;
+        target->next = next;
+    }
+    inst->release(s);
+    *FMUstate = target;
+    LEAVE(fmi2OK);
+}
