@@ -91,7 +91,7 @@ static void update_outputs(const rst_ball_binding *binding, double *values, doub
     AT(RST_BALL_V_APPROACH) = -AT(RST_BALL_V) >= 0.0 ? -AT(RST_BALL_V) : 0.0;
 }
 
-void rst_ball_initialize(const rst_ball_binding *binding, double *values, double start_time)
+void rst_ball_clear(const rst_ball_binding *binding, double *values)
 {
     AT(RST_BALL_H) = AT(RST_BALL_V) = AT(RST_BALL_V_APPROACH) = 0.0;
     AT(RST_BALL_IMPACTS) = 0.0;
@@ -101,6 +101,12 @@ void rst_ball_initialize(const rst_ball_binding *binding, double *values, double
     AT(RST_BALL_V_REBOUND) = 0.0;
     AT(RST_BALL_E_APPLIED) = NAN;
     AT(RST_BALL_IN_CONTACT) = AT(RST_BALL_AT_REST) = 0.0;
+    start_flight(binding, values, 0.0, 0.0, 0.0);
+}
+
+void rst_ball_initialize(const rst_ball_binding *binding, double *values, double start_time)
+{
+    rst_ball_clear(binding, values);
     start_flight(binding, values, start_time, AT(RST_BALL_H0), 0.0);
     update_outputs(binding, values, start_time);
 }

@@ -25,6 +25,9 @@ typedef struct {
 /* Bind against the generated BouncingBall interface table; 0 on success, else `message` says why. */
 int rst_ball_bind(rst_ball_binding *binding, char *message, size_t size);
 
+/* The state before fmi2ExitInitializationMode (the slave's _INITIAL_STATE: at the plate, no contact yet). */
+void rst_ball_clear(const rst_ball_binding *binding, double *values);
+
 /* fmi2ExitInitializationMode: the initial state (released from rest at h0 at `start_time` [s]). */
 void rst_ball_initialize(const rst_ball_binding *binding, double *values, double start_time);
 

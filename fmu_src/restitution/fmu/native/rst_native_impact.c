@@ -78,13 +78,46 @@ int rst_impact_bind(rst_impact_binding *binding, char *message, size_t size)
     return 0;
 }
 
+static const char ODE_REFUSED[] =
+    "zener_method = 4 (ode) is not available in the native SpherePlateImpact.fmu: use the Python FMU "
+    "(SpherePlateImpact.fmu built with pythonfmu), which integrates Eq. (10); 1 = exact gives the same solution "
+    "to 1e-8";
+
+int rst_impact_accept(const rst_impact_binding *binding, unsigned int vr, double value, char *message, size_t size)
+{
+    if (vr == binding->input_vr[12] && value == RST_ZENER_ODE) {
+        snprintf(message, size, "%s", ODE_REFUSED);
+        return 1;
+    }
+    return 0;
+}
+
+/* The slave's _undocumented_nonfinite: the first Real output that is not finite although the
+ * interface does not say it may be (m_eff = +inf for e_ze = 1; tau0 and t_contact = +inf for the
+ * linear method at lambda >= 2), or -1. */
+static int undocumented_nonfinite(const rst_impact_inputs *in, const double outputs[])
+{
+    int i;
+    for (i = 0; i < N_REAL_OUTPUTS; i++) {
+        double x = outputs[i];
+        if (isfinite(x))
+            continue;
+        if (x == INFINITY && i == 9 && outputs[5] == 1.0) /* plate.m_eff, zener.e */
+            continue;
+        if (x == INFINITY && (i == 7 || i == 8) && in->zener_method == RST_ZENER_LINEAR && outputs[6] >= 2.0)
+            continue;
+        return i;
+    }
+    return -1;
+}
+
 int rst_impact_evaluate(const rst_impact_binding *binding, double *values, char *message, size_t size)
 {
     const unsigned int *in = binding->input_vr;
     rst_impact_inputs inputs;
     rst_impact_result r;
     double outputs[RST_IMPACT_N_OUTPUTS];
-    int status;
+    int status, k;
     size_t i;
     inputs.v = values[in[0]];
     inputs.sphere_E = values[in[1]];
@@ -105,9 +138,7 @@ int rst_impact_evaluate(const rst_impact_binding *binding, double *values, char 
     inputs.ode_rtol = values[in[16]];
     status = rst_impact(&inputs, &r);
     if (status == RST_PHYSICS_UNSUPPORTED)
-        snprintf(message, size, "zener_method = 4 (ode) is not available in the native SpherePlateImpact.fmu: "
-                 "use the Python FMU (SpherePlateImpact.fmu built with pythonfmu), which integrates Eq. (10); "
-                 "1 = exact gives the same solution to 1e-8");
+        snprintf(message, size, "%s", ODE_REFUSED);
     else if (status != RST_PHYSICS_OK)
         snprintf(message, size, "invalid code: restitution_model = %d, zener_method = %d, plasticity = %d, "
                  "plate_waves = %d", inputs.restitution_model, inputs.zener_method, inputs.plasticity,
@@ -129,6 +160,13 @@ int rst_impact_evaluate(const rst_impact_binding *binding, double *values, char 
     outputs[14] = r.e_negative;
     outputs[15] = r.plasticity_used;
     outputs[16] = r.plate_waves_used;
+    if (status == RST_PHYSICS_OK && (k = undocumented_nonfinite(&inputs, outputs)) >= 0) {
+        snprintf(message, size, "non-finite output %s = %s", OUTPUT_NAMES[k],
+                 isnan(outputs[k]) ? "nan" : outputs[k] > 0 ? "inf" : "-inf");
+        status = RST_IMPACT_NONFINITE;
+        for (i = 0; i < RST_IMPACT_N_OUTPUTS; i++)
+            outputs[i] = i < N_REAL_OUTPUTS ? NAN : 0.0;
+    }
     for (i = 0; i < RST_IMPACT_N_OUTPUTS; i++)
         values[binding->output_vr[i]] = outputs[i];
     return status;

@@ -24,6 +24,14 @@ typedef struct {
  * `message` names the variable that is missing or has an unexpected type. */
 int rst_impact_bind(rst_impact_binding *binding, char *message, size_t size);
 
+/* Return code of rst_impact_evaluate besides rst_physics.h's: an output is NaN or infinite where the
+ * interface does not document it (an evaluation failure: every output NaN/false). */
+#define RST_IMPACT_NONFINITE 100
+
+/* A value the interface table allows but this backend refuses: zener_method = 4 (ode), which only
+ * the Python FMU integrates. Nonzero with `message` saying so; 0 otherwise. */
+int rst_impact_accept(const rst_impact_binding *binding, unsigned int vr, double value, char *message, size_t size);
+
 /* Evaluate the model on `values` (every variable by value reference; Integer codes and Boolean 0/1
  * as doubles): reads the inputs and parameters, writes every output. 0 (RST_PHYSICS_OK) on success;
  * otherwise the physics' error code, every Real output NaN, every Boolean 0, and `message` says why

@@ -1,0 +1,44 @@
+/* The native BouncingBall FMU: the C front (cfront/rst_front.h) bound to the native ball
+ * (rst_native_ball.h). The ball's whole state lives in the front's value store, so the front's
+ * FMU-state snapshot of the store is the ball's state and nothing needs saving or restoring here. */
+#include "rst_front.h"
+
+#include "rst_BouncingBall_interface.h" /* generated: restitution.fmu.interface.c_header */
+#include "rst_model_info.h"             /* generated: identifier and GUID of modelDescription.xml */
+#include "rst_native_ball.h"
+
+static fmi2Status instantiate(rst_instance *inst, const char *resource_dir, fmi2Boolean visible)
+{
+    rst_ball_binding *b = (rst_ball_binding *)rst_backend(inst);
+    char message[256];
+    (void)resource_dir, (void)visible;
+    if (rst_ball_bind(b, message, sizeof message) != 0) {
+        rst_log(inst, fmi2Error, "fmi2Instantiate: %s", message);
+        return fmi2Error;
+    }
+    rst_ball_clear(b, rst_store(inst));
+    return fmi2OK;
+}
+
+static fmi2Status reset(rst_instance *inst)
+{
+    rst_ball_clear((rst_ball_binding *)rst_backend(inst), rst_store(inst));
+    return fmi2OK;
+}
+
+static fmi2Status exit_initialization(rst_instance *inst)
+{
+    rst_ball_initialize((rst_ball_binding *)rst_backend(inst), rst_store(inst), rst_start_time(inst));
+    return fmi2OK;
+}
+
+static fmi2Status do_step(rst_instance *inst, double t, double h)
+{
+    rst_ball_do_step((rst_ball_binding *)rst_backend(inst), rst_store(inst), t, h);
+    return fmi2OK;
+}
+
+const rst_model RST_MODEL = {
+    .identifier = RST_MODEL_IDENTIFIER, .guid = RST_MODEL_GUID,
+    .variables = RST_MODEL_VARIABLES, .n_variables = RST_MODEL_N_VARIABLES, .backend_size = sizeof(rst_ball_binding),
+    .instantiate = instantiate, .exit_initialization = exit_initialization, .do_step = do_step, .reset = reset};

@@ -1,0 +1,124 @@
+/* The native SpherePlateImpact FMU: the C front (cfront/rst_front.h) bound to the native backend
+ * (rst_native_impact.h). The front checks every call and value; this file only decides when to
+ * evaluate: lazily, when an output is read or a step taken after an input or parameter changed. */
+#include "rst_front.h"
+
+#include <stdio.h>
+
+#include "rst_SpherePlateImpact_interface.h" /* generated: restitution.fmu.interface.c_header */
+#include "rst_model_info.h"                  /* generated: identifier and GUID of modelDescription.xml */
+#include "rst_native_impact.h"
+
+typedef struct {
+    rst_impact_binding binding;
+    int stale;  /* an input or parameter changed since the last evaluation */
+    int failed; /* the last evaluation failed: outputs are NaN/false */
+} impact_backend;
+
+static fmi2Status instantiate(rst_instance *inst, const char *resource_dir, fmi2Boolean visible)
+{
+    impact_backend *b = (impact_backend *)rst_backend(inst);
+    char message[256];
+    (void)resource_dir, (void)visible; /* no resources, no user interface */
+    if (rst_impact_bind(&b->binding, message, sizeof message) != 0) {
+        rst_log(inst, fmi2Error, "fmi2Instantiate: %s", message);
+        return fmi2Error;
+    }
+    b->stale = 1;
+    return fmi2OK;
+}
+
+/* The inputs as the failure message shows them (the Python slave's _describe_inputs). */
+static void describe_inputs(rst_instance *inst, char *out, size_t size)
+{
+    size_t i, k = 0;
+    out[0] = '\0';
+    for (i = 0; i < RST_MODEL_N_VARIABLES && k + 1 < size; i++) {
+        const rst_variable *var = &RST_MODEL_VARIABLES[i];
+        char value[40];
+        int n;
+        if (var->causality != RST_INPUT && var->causality != RST_PARAMETER)
+            continue;
+        if (var->type == RST_REAL)
+            rst_format_double(rst_store(inst)[i], value, sizeof value);
+        else
+            snprintf(value, sizeof value, "%.0f", rst_store(inst)[i]);
+        n = snprintf(out + k, size - k, "%s%s = %s", k ? ", " : "", var->name, value);
+        if (n < 0)
+            break;
+        k += (size_t)n;
+    }
+}
+
+static void evaluate(rst_instance *inst)
+{
+    impact_backend *b = (impact_backend *)rst_backend(inst);
+    char message[256], inputs[1024];
+    if (!b->stale)
+        return;
+    b->stale = 0;
+    b->failed = rst_impact_evaluate(&b->binding, rst_store(inst), message, sizeof message) != 0;
+    if (b->failed) {
+        describe_inputs(inst, inputs, sizeof inputs);
+        rst_log(inst, fmi2Error, "evaluation failed for %s: %s", inputs, message);
+    }
+}
+
+static fmi2Status accept(rst_instance *inst, const rst_variable *var, double value)
+{
+    impact_backend *b = (impact_backend *)rst_backend(inst);
+    char message[256];
+    if (rst_impact_accept(&b->binding, var->vr, value, message, sizeof message) != 0) {
+        rst_log(inst, fmi2Error, "%s", message);
+        return fmi2Error;
+    }
+    return fmi2OK;
+}
+
+static fmi2Status changed(rst_instance *inst)
+{
+    ((impact_backend *)rst_backend(inst))->stale = 1;
+    return fmi2OK;
+}
+
+static fmi2Status set(rst_instance *inst, rst_type type, const fmi2ValueReference vr[], size_t n,
+                      const double values[])
+{
+    (void)type, (void)vr, (void)n, (void)values;
+    return changed(inst);
+}
+
+static fmi2Status exit_initialization(rst_instance *inst)
+{
+    evaluate(inst);
+    return fmi2OK;
+}
+
+static fmi2Status get_outputs(rst_instance *inst, rst_type type, const fmi2ValueReference vr[], size_t n,
+                              double values[])
+{
+    size_t i;
+    (void)type;
+    evaluate(inst);
+    for (i = 0; i < n; i++)
+        values[i] = rst_store(inst)[vr[i]];
+    return fmi2OK;
+}
+
+static fmi2Status do_step(rst_instance *inst, double t, double h)
+{
+    (void)t, (void)h;
+    evaluate(inst);
+    if (((impact_backend *)rst_backend(inst))->failed) {
+        rst_log(inst, fmi2Discard, "fmi2DoStep discarded: the model could not be evaluated for the current inputs "
+                "(see the error above)");
+        return fmi2Discard;
+    }
+    return fmi2OK;
+}
+
+const rst_model RST_MODEL = {
+    .identifier = RST_MODEL_IDENTIFIER, .guid = RST_MODEL_GUID,
+    .variables = RST_MODEL_VARIABLES, .n_variables = RST_MODEL_N_VARIABLES, .backend_size = sizeof(impact_backend),
+    .instantiate = instantiate, .exit_initialization = exit_initialization, .accept = accept, .set = set,
+    .get_outputs = get_outputs, .do_step = do_step, .reset = changed, .restore_state = changed};
