@@ -12,8 +12,10 @@ the installed ``restitution`` package (the same source ``pip install`` installs)
   never reads the XML;
 * records a hash of the sources it was built from (``resources/build_info.json``), which
   :func:`default_fmu` compares to decide whether an FMU is stale;
-* makes the Linux binary loadable by plain C hosts (``native_host.make_standalone``; needs gcc,
-  without it the FMU is built for Python hosts only and the build says so);
+* puts the guard in front of pythonfmu's Linux binary (``native_host.make_standalone``: the C FMI
+  front checks every call against the FMI 2.0 state machine and the interface table generated
+  from the slave's VARIABLES, and the binary also loads in plain C hosts; needs gcc, without it
+  the FMU is built for Python hosts only, unguarded, and the build says so);
 * checks the result with fmpy's validation.
 
 Everything is built in a temporary directory beside the output and moved into place
@@ -160,8 +162,9 @@ def _physics_only(directory, names):
 
 def source_files(model: str) -> list[Path]:
     """Every file ``<model>.fmu`` is built from: the slave, the bundled physics modules and data,
-    this build module and the native-host loader."""
-    files = [FMUS[model], Path(__file__).resolve()]
+    this build module, the interface table's generator and the guard (C front and native-host loader)."""
+    files = [FMUS[model], Path(__file__).resolve(), HERE / "interface.py"]
+    files += sorted((HERE / "cfront").glob("*.[ch]"))
     files += sorted((HERE / "native_host").glob("*.[ch]")) + sorted((HERE / "native_host").glob("*.py"))
     files += sorted(PACKAGE.glob("*.py"))
     for sub in sorted(BUNDLED_SUBDIRS):
@@ -241,11 +244,12 @@ def build_one(model: str, out_dir: Path, standalone: bool = True, log=None) -> P
             xml, slave_module.VARIABLES, slave_module.allowed_range, getattr(slave_module, "FEEDTHROUGH", None)),
             member="modelDescription.xml", extra={BUILD_INFO: info})
         if standalone and shutil.which("gcc") is None:
-            log(f"warning: gcc not found: {model}.fmu is built for Python hosts only (fmpy, libcosimpy); "
-                "install gcc for the plain-C-host loader")
+            log(f"warning: gcc not found: {model}.fmu is built for Python hosts only (fmpy, libcosimpy), "
+                "without the C guard that checks every FMI call; install gcc")
         elif standalone:
+            from .interface import c_header
             from .native_host.make_standalone import make_standalone
-            make_standalone(fmu)
+            make_standalone(fmu, interface_header=c_header(model))
         problems = validate_fmu(str(fmu))
         if problems:
             raise BuildError(f"{model}.fmu failed fmpy validation: " + "; ".join(problems))

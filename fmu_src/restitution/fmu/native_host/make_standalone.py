@@ -5,12 +5,12 @@ pythonfmu's Linux binary does not link libpython, so outside a Python process
 post-processes a built FMU, in place:
 
 * ``binaries/linux64/<id>.so`` (pythonfmu) is renamed ``<id>_pythonfmu.so``;
-* a small C shim compiled from ``fmi2_shim.c`` takes its place. It exports all
-  FMI 2.0 co-simulation functions. In a process without Python it loads the
-  libpython recorded below (RTLD_GLOBAL), starts the interpreter on the build
-  environment (venv), checks the required modules and then forwards every call
-  to the pythonfmu binary. In a Python host (fmpy, libcosimpy) it forwards
-  without touching the running interpreter;
+* the guard takes its place: the project's C FMI front (``cfront/``: state machine, argument and
+  range checks from the interface table, FMU states, logging) with ``pythonfmu_backend.c``, which
+  forwards the checked calls to the pythonfmu binary, and ``python_host.c``. In a process without
+  Python the latter loads the libpython recorded below (RTLD_GLOBAL), starts the interpreter on the
+  build environment (venv) and checks the required modules; in a Python host (fmpy, libcosimpy) it
+  uses the running interpreter;
 * ``resources/python_env.txt`` records the interpreter: libpython, executable,
   home (base prefix), site-packages directories and required modules.
 
@@ -42,8 +42,10 @@ from typing import Iterable, Optional, Sequence
 from xml.etree import ElementTree
 
 HERE = Path(__file__).resolve().parent
-SHIM_SOURCE = HERE / "fmi2_shim.c"
-CONFIG_NAME = "python_env.txt"  # must match SHIM_CONFIG_NAME in fmi2_shim.c
+FRONT = HERE.parent / "cfront"
+#: The guard's C sources: the front, then this directory's backend and Python loader.
+GUARD_SOURCES = (FRONT / "rst_front.c", HERE / "pythonfmu_backend.c", HERE / "python_host.c")
+CONFIG_NAME = "python_env.txt"  # must match PYHOST_CONFIG_NAME in python_host.c
 REAL_SUFFIX = "_pythonfmu"
 
 __all__ = ["make_standalone", "StandaloneError", "describe_interpreter"]
@@ -168,7 +170,7 @@ def _config_text(info: dict, requires: Sequence[str]) -> str:
 
 
 #: pythonfmu's ``(anonymous namespace)::pyState`` (a std::shared_ptr, two words): see
-#: arm_pystate_exit_fix in fmi2_shim.c, which empties it before pythonfmu's exit-time double release.
+#: arm_pystate_exit_fix in python_host.c, which empties it before pythonfmu's exit-time double release.
 PYSTATE_SYMBOL = b"_ZN12_GLOBAL__N_17pyStateE"
 
 
@@ -195,26 +197,53 @@ def _pystate_offset(binary: bytes) -> Optional[int]:
     return None
 
 
-def _compile_shim(output: Path, real_name: str, include_dir: str, compiler: str,
-                  real_binary: Optional[bytes] = None) -> None:
-    cmd = [
-        compiler,
-        "-shared",
-        "-fPIC",
-        "-O2",
-        "-fvisibility=hidden",
-        f'-DSHIM_REAL_BINARY="{real_name}"',
-        f'-DSHIM_CONFIG_NAME="{CONFIG_NAME}"',
-    ]
+#: The guard is C99 with the GNU extensions its Linux-only loader needs (dladdr, dlinfo, __thread).
+GUARD_CFLAGS = ("-std=gnu99", "-O2", "-Wall", "-Wextra", "-Werror", "-shared", "-fPIC", "-fvisibility=hidden",
+                "-DRST_FRONT_PTHREAD")
+
+
+def _fmi2_headers() -> Path:
+    from ..native.build_native import NativeBuildSkipped, fmi2_include_dir
+
+    try:
+        return fmi2_include_dir()
+    except NativeBuildSkipped as exc:
+        raise StandaloneError(f"the FMU guard cannot be compiled: {exc}") from None
+
+
+def guard_command(output: Path, generated: Path, real_name: str, compiler: str = "gcc", include_dir: str = "",
+                  real_binary: Optional[bytes] = None, extra_flags: Sequence[str] = ()) -> list[str]:
+    """The compiler command for the guard; ``generated`` holds rst_interface.h and rst_model_info.h."""
+    cmd = [compiler, *GUARD_CFLAGS, *extra_flags, f'-DPYHOST_REAL_BINARY="{real_name}"',
+           f'-DPYHOST_CONFIG_NAME="{CONFIG_NAME}"', f"-I{generated}", f"-I{FRONT}", f"-I{HERE}", f"-I{_fmi2_headers()}"]
     offset = _pystate_offset(real_binary) if real_binary else None
     if offset is not None:
-        cmd += [f"-DSHIM_PYSTATE_OFFSET={offset:#x}", f"-DSHIM_REAL_SIZE={len(real_binary)}"]
+        cmd += [f"-DPYHOST_PYSTATE_OFFSET={offset:#x}", f"-DPYHOST_REAL_SIZE={len(real_binary)}"]
     if include_dir and (Path(include_dir) / "Python.h").is_file():
-        cmd += ["-DSHIM_HAVE_PYTHON_H", f"-I{include_dir}"]
-    cmd += [str(SHIM_SOURCE), "-o", str(output), "-ldl", "-lpthread"]
-    proc = subprocess.run(cmd, capture_output=True, text=True)
+        cmd += ["-DPYHOST_HAVE_PYTHON_H", f"-I{include_dir}"]
+    return cmd + [str(p) for p in GUARD_SOURCES] + ["-o", str(output), "-ldl", "-lpthread"]
+
+
+def write_guard_headers(directory: Path, model_description: str, interface_header: Optional[str] = None) -> None:
+    """rst_interface.h (``interface_header``, or one made from the modelDescription for an FMU without a
+    VARIABLES table) and rst_model_info.h into ``directory``."""
+    from ..interface import c_header, model_info, model_info_header, variables_from_model_description
+
+    if interface_header is None:
+        identifier = model_info(model_description)[0]
+        interface_header = c_header(identifier, variables_from_model_description(model_description))
+    (directory / "rst_interface.h").write_text(interface_header, encoding="utf-8")
+    (directory / "rst_model_info.h").write_text(model_info_header(model_description), encoding="ascii")
+
+
+def _compile_guard(output: Path, real_name: str, include_dir: str, compiler: str, real_binary: bytes,
+                   model_description: str, interface_header: Optional[str]) -> None:
+    with tempfile.TemporaryDirectory(prefix="fmi2guard_") as tmp:
+        write_guard_headers(Path(tmp), model_description, interface_header)
+        cmd = guard_command(output, Path(tmp), real_name, compiler, include_dir, real_binary)
+        proc = subprocess.run(cmd, capture_output=True, text=True)
     if proc.returncode != 0:
-        raise StandaloneError(f"compiling the FMI shim failed:\n{' '.join(cmd)}\n{proc.stderr}")
+        raise StandaloneError(f"compiling the FMU guard failed:\n{' '.join(cmd)}\n{proc.stderr}")
 
 
 def make_standalone(
@@ -223,6 +252,7 @@ def make_standalone(
     *,
     required_modules: Optional[Sequence[str]] = None,
     compiler: str = "gcc",
+    interface_header: Optional[str] = None,
 ) -> None:
     """Rewrite the FMU zip at ``fmu_path`` in place so that its Linux binary
     also runs in hosts without Python (see the module docstring).
@@ -232,14 +262,17 @@ def make_standalone(
     recorded. ``required_modules`` are checked at instantiation for a clear
     error message; by default they are the non-stdlib top-level modules
     imported by the FMU's Python files that are importable at build time.
+    ``interface_header`` is the guard's variable table (:func:`restitution.fmu.interface.c_header`
+    of the slave's VARIABLES); without it the table is made from the FMU's modelDescription.xml.
     """
     fmu_path = Path(fmu_path)
     if not sys.platform.startswith("linux"):
         raise StandaloneError("make_standalone builds a Linux x86_64 shim and must run on Linux")
     if shutil.which(compiler) is None:
         raise StandaloneError(f"C compiler '{compiler}' not found (install gcc)")
-    if not SHIM_SOURCE.is_file():
-        raise StandaloneError(f"shim source missing: {SHIM_SOURCE}")
+    missing = [str(p) for p in GUARD_SOURCES if not p.is_file()]
+    if missing:
+        raise StandaloneError(f"guard sources missing: {', '.join(missing)}")
 
     with zipfile.ZipFile(fmu_path) as zin:
         infos = zin.infolist()
@@ -281,7 +314,8 @@ def make_standalone(
 
     with tempfile.TemporaryDirectory(prefix="fmi2shim_") as tmp:
         shim_so = Path(tmp) / f"{model_id}.so"
-        _compile_shim(shim_so, f"{model_id}{REAL_SUFFIX}.so", info["include"], compiler, real_binary)
+        _compile_guard(shim_so, f"{model_id}{REAL_SUFFIX}.so", info["include"], compiler, real_binary,
+                       entries["modelDescription.xml"].decode("utf-8"), interface_header)
         shim_binary = shim_so.read_bytes()
 
     new_entries: dict[str, bytes] = {}

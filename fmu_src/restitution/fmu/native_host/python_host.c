@@ -1,42 +1,29 @@
 /*
- * fmi2_shim.c - makes a pythonfmu FMU loadable by plain C/C++ FMI 2.0 hosts.
+ * python_host.c - makes Python available to pythonfmu's binary in any host, and loads that binary.
  *
- * pythonfmu's binary (renamed to <modelIdentifier>_pythonfmu.so by
- * make_standalone.py) does not link libpython: it expects to be loaded into a
- * process that already contains a Python interpreter (fmpy, libcosimpy).  In
- * a C host, dlopen fails with "undefined symbol: _Py_NoneStruct".
+ * Part of the guard in front of pythonfmu (pythonfmu_backend.c, on the C front of cfront/). pythonfmu's
+ * binary (renamed to <modelIdentifier>_pythonfmu.so by make_standalone.py) does not link libpython: it
+ * expects a process that already contains a Python interpreter (fmpy, libcosimpy). In a C host,
+ * dlopen fails with "undefined symbol: _Py_NoneStruct". On the first fmi2Instantiate:
  *
- * This shim takes the place of binaries/linux64/<modelIdentifier>.so and
- * exports every FMI 2.0 co-simulation function.  On the first fmi2Instantiate:
+ *   1. If a Python interpreter is already initialized in the process (Python host such as fmpy or
+ *      libcosimpy), nothing is changed: the real binary is loaded and uses that interpreter.
+ *   2. Otherwise resources/python_env.txt (written at build time) names the interpreter: its
+ *      libpython is loaded with RTLD_GLOBAL (so the pythonfmu binary and extension modules such as
+ *      numpy resolve their Python symbols), the interpreter is started on the build environment's
+ *      site-packages, the required modules are checked, the GIL is released (pythonfmu takes it with
+ *      PyGILState_Ensure on every call and skips its own Py_Initialize when Python is running), and
+ *      the real binary is loaded.
  *
- *   1. If a Python interpreter is already initialized in the process (Python
- *      host such as fmpy or libcosimpy), nothing is changed: the real binary
- *      is loaded and uses that interpreter, exactly as without the shim.
- *   2. Otherwise the shim reads resources/python_env.txt (written at build
- *      time), loads the recorded libpython with RTLD_GLOBAL (so the pythonfmu
- *      binary and extension modules such as numpy resolve their Python
- *      symbols), initializes the interpreter so that the build environment's
- *      site-packages are on sys.path, checks that the required modules import,
- *      releases the GIL (pythonfmu takes it with PyGILState_Ensure on every
- *      call, and skips its own Py_Initialize when Python is already running)
- *      and then loads the real binary.
+ * Every failure is logged through the instance's logger; pyhost_ensure_ready then returns 0.
+ * The state here is process-wide by nature (one interpreter, one pythonfmu binary per process),
+ * guarded by a mutex.
  *
- * Every failure is reported through the fmi2CallbackLogger passed to
- * fmi2Instantiate, which then returns NULL.  All other fmi2 functions forward
- * to the real binary unchanged (the fmi2Component is the real one).
- *
- * Build (done by make_standalone.py):
- *   gcc -shared -fPIC -O2 -fvisibility=hidden \
- *       -DSHIM_REAL_BINARY='"<id>_pythonfmu.so"' \
- *       [-DSHIM_HAVE_PYTHON_H -I<python include dir>] \
- *       fmi2_shim.c -o <id>.so -ldl -lpthread
- *
- * With SHIM_HAVE_PYTHON_H the interpreter is configured with PyConfig (clean
- * error reporting, no change to the host's locale or signal handlers) when
- * the loaded libpython has the same major.minor version as the headers;
- * otherwise the legacy Py_SetProgramName/Py_InitializeEx(0) path is used.
+ * With PYHOST_HAVE_PYTHON_H the interpreter is configured with PyConfig (clean error reporting, no
+ * change to the host's locale or signal handlers) when the loaded libpython has the same major.minor
+ * version as the headers; otherwise the legacy Py_SetProgramName/Py_InitializeEx(0) path is used.
  */
-#ifdef SHIM_HAVE_PYTHON_H
+#ifdef PYHOST_HAVE_PYTHON_H
 #define PY_SSIZE_T_CLEAN
 #include <Python.h> /* must come first; only types and macros are used */
 #endif
@@ -44,6 +31,8 @@
 #ifndef _GNU_SOURCE
 #define _GNU_SOURCE
 #endif
+#include "python_host.h"
+
 #include <dlfcn.h>
 #include <errno.h>
 #include <limits.h>
@@ -58,107 +47,14 @@
 #include <sys/stat.h>
 #include <wchar.h>
 
-#ifndef SHIM_REAL_BINARY
-#error "define SHIM_REAL_BINARY, e.g. -DSHIM_REAL_BINARY='\"Model_pythonfmu.so\"'"
+#ifndef PYHOST_REAL_BINARY
+#error "define PYHOST_REAL_BINARY, e.g. -DPYHOST_REAL_BINARY='\"Model_pythonfmu.so\"'"
 #endif
-#ifndef SHIM_CONFIG_NAME
-#define SHIM_CONFIG_NAME "python_env.txt"
+#ifndef PYHOST_CONFIG_NAME
+#define PYHOST_CONFIG_NAME "python_env.txt"
 #endif
 
-#define EXPORT __attribute__((visibility("default")))
-
-/* ------------------------------------------------------------------------ */
-/* FMI 2.0 types (from fmi2TypesPlatform.h / fmi2FunctionTypes.h)           */
-/* ------------------------------------------------------------------------ */
-typedef void *fmi2Component;
-typedef void *fmi2ComponentEnvironment;
-typedef void *fmi2FMUstate;
-typedef unsigned int fmi2ValueReference;
-typedef double fmi2Real;
-typedef int fmi2Integer;
-typedef int fmi2Boolean;
-typedef char fmi2Char;
-typedef const fmi2Char *fmi2String;
-typedef char fmi2Byte;
-typedef enum { fmi2OK, fmi2Warning, fmi2Discard, fmi2Error, fmi2Fatal, fmi2Pending } fmi2Status;
-typedef enum { fmi2ModelExchange, fmi2CoSimulation } fmi2Type;
-typedef enum { fmi2DoStepStatus, fmi2PendingStatus, fmi2LastSuccessfulTime, fmi2Terminated } fmi2StatusKind;
-
-typedef void (*fmi2CallbackLogger)(fmi2ComponentEnvironment, fmi2String, fmi2Status, fmi2String, fmi2String, ...);
-typedef void *(*fmi2CallbackAllocateMemory)(size_t, size_t);
-typedef void (*fmi2CallbackFreeMemory)(void *);
-typedef void (*fmi2StepFinished)(fmi2ComponentEnvironment, fmi2Status);
-typedef struct {
-    const fmi2CallbackLogger logger;
-    const fmi2CallbackAllocateMemory allocateMemory;
-    const fmi2CallbackFreeMemory freeMemory;
-    const fmi2StepFinished stepFinished;
-    const fmi2ComponentEnvironment componentEnvironment;
-} fmi2CallbackFunctions;
-
-/* Real (pythonfmu) entry points. X(name, return type, parameter list, argument list) */
-#define SHIM_FORWARDED_FUNCTIONS(X)                                                                                  \
-    X(fmi2SetDebugLogging, fmi2Status, (fmi2Component c, fmi2Boolean on, size_t n, const fmi2String cat[]),         \
-      (c, on, n, cat))                                                                                              \
-    X(fmi2SetupExperiment, fmi2Status,                                                                              \
-      (fmi2Component c, fmi2Boolean tolDef, fmi2Real tol, fmi2Real t0, fmi2Boolean stopDef, fmi2Real tStop),       \
-      (c, tolDef, tol, t0, stopDef, tStop))                                                                         \
-    X(fmi2EnterInitializationMode, fmi2Status, (fmi2Component c), (c))                                              \
-    X(fmi2ExitInitializationMode, fmi2Status, (fmi2Component c), (c))                                               \
-    X(fmi2Terminate, fmi2Status, (fmi2Component c), (c))                                                            \
-    X(fmi2Reset, fmi2Status, (fmi2Component c), (c))                                                                \
-    X(fmi2GetReal, fmi2Status, (fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2Real v[]),            \
-      (c, vr, n, v))                                                                                                \
-    X(fmi2GetInteger, fmi2Status, (fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2Integer v[]),      \
-      (c, vr, n, v))                                                                                                \
-    X(fmi2GetBoolean, fmi2Status, (fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2Boolean v[]),      \
-      (c, vr, n, v))                                                                                                \
-    X(fmi2GetString, fmi2Status, (fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2String v[]),        \
-      (c, vr, n, v))                                                                                                \
-    X(fmi2SetReal, fmi2Status, (fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2Real v[]),      \
-      (c, vr, n, v))                                                                                                \
-    X(fmi2SetInteger, fmi2Status,                                                                                   \
-      (fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2Integer v[]), (c, vr, n, v))             \
-    X(fmi2SetBoolean, fmi2Status,                                                                                   \
-      (fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2Boolean v[]), (c, vr, n, v))             \
-    X(fmi2SetString, fmi2Status, (fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2String v[]),  \
-      (c, vr, n, v))                                                                                                \
-    X(fmi2GetFMUstate, fmi2Status, (fmi2Component c, fmi2FMUstate * s), (c, s))                                    \
-    X(fmi2SetFMUstate, fmi2Status, (fmi2Component c, fmi2FMUstate s), (c, s))                                       \
-    X(fmi2FreeFMUstate, fmi2Status, (fmi2Component c, fmi2FMUstate * s), (c, s))                                   \
-    X(fmi2SerializedFMUstateSize, fmi2Status, (fmi2Component c, fmi2FMUstate s, size_t * n), (c, s, n))             \
-    X(fmi2SerializeFMUstate, fmi2Status, (fmi2Component c, fmi2FMUstate s, fmi2Byte b[], size_t n), (c, s, b, n))   \
-    X(fmi2DeSerializeFMUstate, fmi2Status, (fmi2Component c, const fmi2Byte b[], size_t n, fmi2FMUstate * s),       \
-      (c, b, n, s))                                                                                                 \
-    X(fmi2GetDirectionalDerivative, fmi2Status,                                                                     \
-      (fmi2Component c, const fmi2ValueReference u[], size_t nu, const fmi2ValueReference z[], size_t nz,           \
-       const fmi2Real dz[], fmi2Real du[]),                                                                         \
-      (c, u, nu, z, nz, dz, du))                                                                                    \
-    X(fmi2SetRealInputDerivatives, fmi2Status,                                                                      \
-      (fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2Integer order[], const fmi2Real v[]),    \
-      (c, vr, n, order, v))                                                                                         \
-    X(fmi2GetRealOutputDerivatives, fmi2Status,                                                                     \
-      (fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2Integer order[], fmi2Real v[]),          \
-      (c, vr, n, order, v))                                                                                         \
-    X(fmi2DoStep, fmi2Status, (fmi2Component c, fmi2Real t, fmi2Real h, fmi2Boolean noSetPrior), (c, t, h, noSetPrior)) \
-    X(fmi2CancelStep, fmi2Status, (fmi2Component c), (c))                                                           \
-    X(fmi2GetStatus, fmi2Status, (fmi2Component c, const fmi2StatusKind k, fmi2Status * v), (c, k, v))              \
-    X(fmi2GetRealStatus, fmi2Status, (fmi2Component c, const fmi2StatusKind k, fmi2Real * v), (c, k, v))            \
-    X(fmi2GetIntegerStatus, fmi2Status, (fmi2Component c, const fmi2StatusKind k, fmi2Integer * v), (c, k, v))      \
-    X(fmi2GetBooleanStatus, fmi2Status, (fmi2Component c, const fmi2StatusKind k, fmi2Boolean * v), (c, k, v))      \
-    X(fmi2GetStringStatus, fmi2Status, (fmi2Component c, const fmi2StatusKind k, fmi2String * v), (c, k, v))
-
-typedef fmi2Component (*fmi2InstantiateFn)(fmi2String, fmi2Type, fmi2String, fmi2String,
-                                           const fmi2CallbackFunctions *, fmi2Boolean, fmi2Boolean);
-typedef void (*fmi2FreeInstanceFn)(fmi2Component);
-
-static struct {
-    fmi2InstantiateFn fmi2Instantiate;
-    fmi2FreeInstanceFn fmi2FreeInstance;
-#define SHIM_DECLARE_PTR(name, ret, params, args) ret(*name) params;
-    SHIM_FORWARDED_FUNCTIONS(SHIM_DECLARE_PTR)
-#undef SHIM_DECLARE_PTR
-} real;
+static pythonfmu_api real;
 
 /* ------------------------------------------------------------------------ */
 /* Python C API, resolved with dlsym (the shim never links libpython)       */
@@ -252,24 +148,7 @@ typedef struct {
 /* ------------------------------------------------------------------------ */
 /* Helpers                                                                  */
 /* ------------------------------------------------------------------------ */
-static void shim_log(const fmi2CallbackFunctions *cb, fmi2String instance, fmi2Status status,
-                     const char *category, const char *fmt, ...) __attribute__((format(printf, 5, 6)));
-
-static void shim_log(const fmi2CallbackFunctions *cb, fmi2String instance, fmi2Status status,
-                     const char *category, const char *fmt, ...)
-{
-    char msg[16384];
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(msg, sizeof msg, fmt, ap);
-    va_end(ap);
-    if (cb && cb->logger)
-        cb->logger(cb->componentEnvironment, instance ? instance : "", status, category, "%s", msg);
-    else
-        fprintf(stderr, "[%s] %s: %s\n", instance ? instance : "FMU", category, msg);
-}
-
-#define LOG_ERROR(...) shim_log(cb, instanceName, fmi2Error, "logStatusError", __VA_ARGS__)
+#define LOG_ERROR(...) rst_log(inst, fmi2Error, __VA_ARGS__)
 
 static int file_exists(const char *path)
 {
@@ -288,41 +167,6 @@ static int shim_directory(char *out, size_t size)
     if (!slash) return 0;
     *slash = '\0';
     snprintf(out, size, "%s", resolved);
-    return 1;
-}
-
-static int hexval(int c)
-{
-    if (c >= '0' && c <= '9') return c - '0';
-    if (c >= 'a' && c <= 'f') return c - 'a' + 10;
-    if (c >= 'A' && c <= 'F') return c - 'A' + 10;
-    return -1;
-}
-
-/* fmuResourceLocation URI (file:///p, file:/p, file://localhost/p) -> path */
-static int uri_to_path(const char *uri, char *out, size_t size)
-{
-    if (!uri) return 0;
-    const char *p = uri;
-    if (strncmp(p, "file://localhost/", 17) == 0)
-        p += 16;
-    else if (strncmp(p, "file:///", 8) == 0)
-        p += 7;
-    else if (strncmp(p, "file:/", 6) == 0)
-        p += 5;
-    else if (p[0] != '/')
-        return 0;
-    size_t n = 0;
-    for (; *p && n + 1 < size; p++) {
-        if (p[0] == '%' && hexval(p[1]) >= 0 && hexval(p[2]) >= 0) {
-            out[n++] = (char)(hexval(p[1]) * 16 + hexval(p[2]));
-            p += 2;
-        } else {
-            out[n++] = *p;
-        }
-    }
-    out[n] = '\0';
-    while (n > 1 && out[n - 1] == '/') out[--n] = '\0';
     return 1;
 }
 
@@ -562,7 +406,7 @@ __attribute__((destructor)) static void shim_unload(void)
  * stack mapping per load/free cycle), and the next instance made a new one. So the shim
  * pins itself (RTLD_NODELETE) before registering the handler: it stays loaded like the
  * pythonfmu binary, the handler runs once at process exit, and a reload reuses the state. */
-#if defined(SHIM_PYSTATE_OFFSET) && defined(SHIM_REAL_SIZE)
+#if defined(PYHOST_PYSTATE_OFFSET) && defined(PYHOST_REAL_SIZE)
 static void *g_pystate_slot = NULL;
 
 static void disarm_pythonfmu_pystate(void)
@@ -575,9 +419,9 @@ static void arm_pystate_exit_fix(const char *real_path)
 {
     struct stat st;
     struct link_map *map = NULL;
-    if (stat(real_path, &st) != 0 || st.st_size != (off_t)SHIM_REAL_SIZE) return;
+    if (stat(real_path, &st) != 0 || st.st_size != (off_t)PYHOST_REAL_SIZE) return;
     if (dlinfo(g_real, RTLD_DI_LINKMAP, &map) != 0 || !map) return;
-    g_pystate_slot = (void *)(map->l_addr + (uintptr_t)SHIM_PYSTATE_OFFSET);
+    g_pystate_slot = (void *)(map->l_addr + (uintptr_t)PYHOST_PYSTATE_OFFSET);
     Dl_info self;
     if (dladdr((void *)&disarm_pythonfmu_pystate, &self) && self.dli_fname)
         dlopen(self.dli_fname, RTLD_LAZY | RTLD_NOLOAD | RTLD_NODELETE); /* never unloaded from now on */
@@ -596,6 +440,15 @@ static int same_major_minor(const char *a, const char *b)
     return sscanf(a, "%d.%d", &a1, &a2) == 2 && sscanf(b, "%d.%d", &b1, &b2) == 2 && a1 == b1 && a2 == b2;
 }
 
+/* Stay loaded once ready, like the pythonfmu binary (which glibc never unloads): pythonfmu keeps
+ * pointers into this library (the guard's logger and callback structs) for the process's lifetime. */
+static void pin_self(void)
+{
+    Dl_info self;
+    if (dladdr((void *)&pin_self, &self) && self.dli_fname)
+        dlopen(self.dli_fname, RTLD_LAZY | RTLD_NOLOAD | RTLD_NODELETE);
+}
+
 /* <home>/bin/python3.X (or python3) of the base installation, if it exists */
 static int base_executable(const shim_config *cfg, char *out, size_t size)
 {
@@ -608,8 +461,8 @@ static int base_executable(const shim_config *cfg, char *out, size_t size)
     return file_exists(out);
 }
 
-#ifdef SHIM_HAVE_PYTHON_H
-static int init_with_pyconfig(const shim_config *cfg, const fmi2CallbackFunctions *cb, fmi2String instanceName)
+#ifdef PYHOST_HAVE_PYTHON_H
+static int init_with_pyconfig(const shim_config *cfg, rst_instance *inst)
 {
     typedef void (*PreInitFn)(PyPreConfig *);
     typedef PyStatus (*PreInitializeFn)(const PyPreConfig *);
@@ -653,8 +506,7 @@ static int init_with_pyconfig(const shim_config *cfg, const fmi2CallbackFunction
         if (st._type == 0) st = setBytes(&config, &config.executable, cfg->executable);
     } else if (cfg->home[0]) {
         char base_exe[PATH_MAX + 32];
-        shim_log(cb, instanceName, fmi2Warning, "logStatusWarning",
-                 "Python executable %s (recorded in %s) does not exist; starting the interpreter with home=%s",
+        rst_log(inst, fmi2Warning, "Python executable %s (recorded in %s) does not exist; starting the interpreter with home=%s",
                  cfg->executable, cfg->file, cfg->home);
         st = setBytes(&config, &config.home, cfg->home);
         if (st._type == 0 && base_executable(cfg, base_exe, sizeof base_exe)) {
@@ -675,7 +527,7 @@ static int init_with_pyconfig(const shim_config *cfg, const fmi2CallbackFunction
 }
 #endif
 
-static int init_legacy(const shim_config *cfg, const fmi2CallbackFunctions *cb, fmi2String instanceName)
+static int init_legacy(const shim_config *cfg, rst_instance *inst)
 {
     if (!py.Py_DecodeLocale || !py.Py_SetProgramName || !py.Py_InitializeEx) {
         LOG_ERROR("%s lacks Py_SetProgramName/Py_InitializeEx; rebuild the FMU with Python headers available",
@@ -689,8 +541,7 @@ static int init_legacy(const shim_config *cfg, const fmi2CallbackFunctions *cb, 
     } else if (cfg->home[0] && file_exists(cfg->home) && py.Py_SetPythonHome) {
         static wchar_t *home, *program;
         char base_exe[PATH_MAX + 32];
-        shim_log(cb, instanceName, fmi2Warning, "logStatusWarning",
-                 "Python executable %s (recorded in %s) does not exist; starting the interpreter with home=%s",
+        rst_log(inst, fmi2Warning, "Python executable %s (recorded in %s) does not exist; starting the interpreter with home=%s",
                  cfg->executable, cfg->file, cfg->home);
         home = py.Py_DecodeLocale(cfg->home, NULL);
         if (home) py.Py_SetPythonHome(home);
@@ -710,11 +561,10 @@ static int init_legacy(const shim_config *cfg, const fmi2CallbackFunctions *cb, 
 /* ------------------------------------------------------------------------ */
 /* Setup on first fmi2Instantiate (called with g_lock held)                 */
 /* ------------------------------------------------------------------------ */
-static int ensure_ready(fmi2String instanceName, fmi2String resourceLocation, const fmi2CallbackFunctions *cb,
-                        fmi2Boolean loggingOn)
+static int ensure_ready(rst_instance *inst, const char *resource_dir)
 {
     char bindir[PATH_MAX] = "", cfg_a[PATH_MAX + 64] = "", cfg_b[PATH_MAX + 64] = "";
-    char res_dir[PATH_MAX] = "", uri_path[PATH_MAX];
+    char res_dir[PATH_MAX] = "";
     shim_config cfg;
     int have_cfg = 0;
 
@@ -724,15 +574,15 @@ static int ensure_ready(fmi2String instanceName, fmi2String resourceLocation, co
         return 0;
     }
     /* 1. resources next to the unpacked binary, 2. fmuResourceLocation */
-    snprintf(cfg_a, sizeof cfg_a, "%s/../../resources/" SHIM_CONFIG_NAME, bindir);
+    snprintf(cfg_a, sizeof cfg_a, "%s/../../resources/" PYHOST_CONFIG_NAME, bindir);
     if (read_config(cfg_a, &cfg)) {
         have_cfg = 1;
         snprintf(res_dir, sizeof res_dir, "%s/../../resources", bindir);
-    } else if (uri_to_path(resourceLocation, uri_path, sizeof uri_path)) {
-        snprintf(cfg_b, sizeof cfg_b, "%s/" SHIM_CONFIG_NAME, uri_path);
+    } else if (resource_dir != NULL) {
+        snprintf(cfg_b, sizeof cfg_b, "%s/" PYHOST_CONFIG_NAME, resource_dir);
         if (read_config(cfg_b, &cfg)) {
             have_cfg = 1;
-            snprintf(res_dir, sizeof res_dir, "%s", uri_path);
+            snprintf(res_dir, sizeof res_dir, "%s", resource_dir);
         }
     }
     char resolved[PATH_MAX];
@@ -753,8 +603,7 @@ static int ensure_ready(fmi2String instanceName, fmi2String resourceLocation, co
             return 0;
         }
         g_shim_managed = interpreter_is_shim_managed();
-        if (loggingOn)
-            shim_log(cb, instanceName, fmi2OK, "logAll", "native-host shim: using the Python %s already running "
+        rst_log(inst, fmi2OK, "native-host shim: using the Python %s already running "
                      "in this process%s", py.Py_GetVersion(), g_shim_managed ? " (started by another FMU)" : "");
     } else {
         if (!have_cfg) {
@@ -783,19 +632,18 @@ static int ensure_ready(fmi2String instanceName, fmi2String resourceLocation, co
         }
         const char *loaded = py.Py_GetVersion();
         if (cfg.version[0] && !same_major_minor(loaded, cfg.version))
-            shim_log(cb, instanceName, fmi2Warning, "logStatusWarning",
-                     "%s is Python %.10s but the FMU was built with Python %s", cfg.libpython, loaded, cfg.version);
+            rst_log(inst, fmi2Warning,     "%s is Python %.10s but the FMU was built with Python %s", cfg.libpython, loaded, cfg.version);
         if (py.Py_IsInitialized()) {
             g_shim_managed = interpreter_is_shim_managed();
         } else {
             int ok = 0;
-#ifdef SHIM_HAVE_PYTHON_H
+#ifdef PYHOST_HAVE_PYTHON_H
             if (same_major_minor(loaded, PY_VERSION))
-                ok = init_with_pyconfig(&cfg, cb, instanceName);
+                ok = init_with_pyconfig(&cfg, inst);
             else
-                ok = init_legacy(&cfg, cb, instanceName);
+                ok = init_legacy(&cfg, inst);
 #else
-            ok = init_legacy(&cfg, cb, instanceName);
+            ok = init_legacy(&cfg, inst);
 #endif
             if (!ok) {
                 g_python_failed = 1;
@@ -804,14 +652,12 @@ static int ensure_ready(fmi2String instanceName, fmi2String resourceLocation, co
             py.PyEval_SaveThread(); /* release the GIL; pythonfmu uses PyGILState_Ensure */
             t_attached = 1;         /* this thread keeps the main thread state */
             g_shim_managed = 1;
-            if (loggingOn)
-                shim_log(cb, instanceName, fmi2OK, "logAll",
-                         "native-host shim: started embedded Python %s from %s (config %s)",
+            rst_log(inst, fmi2OK, "native-host shim: started embedded Python %s from %s (config %s)",
                          py.Py_GetVersion(), cfg.libpython, cfg.file);
         }
     }
 
-#ifndef SHIM_NO_TSTATE_CACHE
+#ifndef PYHOST_NO_TSTATE_CACHE
     if (g_shim_managed && !g_tstate_key_ok && py.PyEval_RestoreThread && py.PyThreadState_Clear &&
         py.PyThreadState_DeleteCurrent && py.PyGILState_GetThisThreadState) {
         if (pthread_key_create(&g_tstate_key, release_thread_state) == 0) {
@@ -831,26 +677,35 @@ static int ensure_ready(fmi2String instanceName, fmi2String resourceLocation, co
             LOG_ERROR("%s", msg + 2);
             return 0;
         }
-        if (msg[0] == 'W') shim_log(cb, instanceName, fmi2Warning, "logStatusWarning", "%s", msg + 2);
+        if (msg[0] == 'W') rst_log(inst, fmi2Warning, "%s", msg + 2);
     }
 
     if (!g_real) {
         char path[PATH_MAX + 64];
-        snprintf(path, sizeof path, "%s/" SHIM_REAL_BINARY, bindir);
+        snprintf(path, sizeof path, "%s/" PYHOST_REAL_BINARY, bindir);
         g_real = dlopen(path, RTLD_NOW | RTLD_LOCAL);
         if (!g_real) {
             LOG_ERROR("cannot load the pythonfmu binary %s: %s", path, dlerror());
             return 0;
         }
         const char *missing = NULL;
-#define SHIM_LOAD(name)                                                  \
-    if (!(*(void **)(&real.name) = dlsym(g_real, #name)) && !missing) missing = #name;
-        SHIM_LOAD(fmi2Instantiate)
-        SHIM_LOAD(fmi2FreeInstance)
-#define SHIM_LOAD_X(name, ret, params, args) SHIM_LOAD(name)
-        SHIM_FORWARDED_FUNCTIONS(SHIM_LOAD_X)
-#undef SHIM_LOAD_X
-#undef SHIM_LOAD
+#define PYHOST_LOAD(field, name)                                                 \
+    if (!(*(void **)(&real.field) = dlsym(g_real, #name)) && !missing) missing = #name;
+        PYHOST_LOAD(Instantiate, fmi2Instantiate)
+        PYHOST_LOAD(FreeInstance, fmi2FreeInstance)
+        PYHOST_LOAD(SetupExperiment, fmi2SetupExperiment)
+        PYHOST_LOAD(EnterInitializationMode, fmi2EnterInitializationMode)
+        PYHOST_LOAD(ExitInitializationMode, fmi2ExitInitializationMode)
+        PYHOST_LOAD(Terminate, fmi2Terminate)
+        PYHOST_LOAD(Reset, fmi2Reset)
+        PYHOST_LOAD(GetReal, fmi2GetReal)
+        PYHOST_LOAD(GetInteger, fmi2GetInteger)
+        PYHOST_LOAD(GetBoolean, fmi2GetBoolean)
+        PYHOST_LOAD(SetReal, fmi2SetReal)
+        PYHOST_LOAD(SetInteger, fmi2SetInteger)
+        PYHOST_LOAD(SetBoolean, fmi2SetBoolean)
+        PYHOST_LOAD(DoStep, fmi2DoStep)
+#undef PYHOST_LOAD
         if (missing) {
             LOG_ERROR("%s does not export %s", path, missing);
             dlclose(g_real);
@@ -859,48 +714,26 @@ static int ensure_ready(fmi2String instanceName, fmi2String resourceLocation, co
         }
         arm_pystate_exit_fix(path);
     }
+    pin_self();
     g_ready = 1;
     return 1;
 }
 
 /* ------------------------------------------------------------------------ */
-/* Exported FMI 2.0 functions                                               */
+/* Public                                                                   */
 /* ------------------------------------------------------------------------ */
-EXPORT const char *fmi2GetTypesPlatform(void) { return "default"; }
-EXPORT const char *fmi2GetVersion(void) { return "2.0"; }
-
-EXPORT fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2String fmuGUID,
-                                     fmi2String fmuResourceLocation, const fmi2CallbackFunctions *functions,
-                                     fmi2Boolean visible, fmi2Boolean loggingOn)
+const pythonfmu_api *pyhost_ensure_ready(rst_instance *inst, const char *resource_dir)
 {
-    const fmi2CallbackFunctions *cb = functions;
+    int ok;
     pthread_mutex_lock(&g_lock);
-    int ok = ensure_ready(instanceName, fmuResourceLocation, functions, loggingOn);
+    ok = ensure_ready(inst, resource_dir);
     pthread_mutex_unlock(&g_lock);
-    if (!ok) return NULL;
-    attach_thread();
-    if (fmuType != fmi2CoSimulation) {
-        LOG_ERROR("this FMU supports co-simulation only");
+    if (!ok)
         return NULL;
-    }
-    return real.fmi2Instantiate(instanceName, fmuType, fmuGUID, fmuResourceLocation, functions, visible, loggingOn);
-}
-
-EXPORT void fmi2FreeInstance(fmi2Component c)
-{
-    if (!c || !g_ready) return;
     attach_thread();
-    real.fmi2FreeInstance(c);
+    return &real;
 }
 
-/* A component can only exist after a successful fmi2Instantiate, so g_ready
- * is set and the real function pointers are valid. */
-#define SHIM_DEFINE_FORWARD(name, ret, params, args)  \
-    EXPORT ret name params                            \
-    {                                                 \
-        if (!g_ready || !c) return fmi2Error;         \
-        attach_thread();                              \
-        return real.name args;                        \
-    }
-SHIM_FORWARDED_FUNCTIONS(SHIM_DEFINE_FORWARD)
-#undef SHIM_DEFINE_FORWARD
+void pyhost_attach_thread(void) { attach_thread(); }
+
+int pyhost_interpreter_is_hosts(void) { return !g_shim_managed; }

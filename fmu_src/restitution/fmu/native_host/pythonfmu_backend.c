@@ -1,0 +1,409 @@
+/*
+ * pythonfmu_backend.c - the guard's backend: the C front (cfront/) in front of pythonfmu's binary.
+ *
+ * The front has checked every call and value before anything reaches here, so pythonfmu only ever
+ * sees legal calls with values inside their declared ranges. What pythonfmu 0.7's binary does wrong
+ * (FMI-NOTES.md) is worked around here, never copied:
+ *
+ * - Resources: pythonfmu decodes only "%20" in the resource URI and crashes when it cannot open the
+ *   slave script. It is handed "file://" + the decoded path, after checking that the slave script
+ *   named by resources/slavemodule.txt exists. A path that contains "%20" itself (which pythonfmu
+ *   would turn into a space) is handed as /proc/self/fd/N of an open descriptor of the directory.
+ * - Leaks: every fmi2Instantiate of pythonfmu re-executes the slave module (a new class object that
+ *   is never freed) and prepends resources/ to sys.path. Its instances are therefore kept in a
+ *   process-wide pool and reused: fmi2FreeInstance resets one (pythonfmu's fmi2Reset makes a fresh
+ *   slave object) and the next fmi2Instantiate with the same resources takes it. Instantiate/free
+ *   cycles then cost nothing; the pool holds as many instances as were alive at once.
+ * - Logging: pythonfmu keeps the host's callback struct pointer and passes messages as printf
+ *   formats. It is given a callback struct of the pool slot instead, whose logger hands each message,
+ *   as text, to whichever instance currently owns the slot (NULL loggers and '%' are then harmless).
+ * - fmi2Fatal: pythonfmu answers any Python exception with fmi2Fatal after dropping its references
+ *   to the slave, so the instance must never be called or freed again. The front latches such an
+ *   instance; its pool slot is poisoned: never reset, reused or freed.
+ * - Ctrl-C in a Python host: the interpreter would raise KeyboardInterrupt inside the slave's code,
+ *   which pythonfmu turns into fmi2Fatal. While a call is inside pythonfmu, SIGINT is held back and
+ *   raised again as soon as the call returns, so the host's own handler sees it between two FMI
+ *   calls (fmpy: KeyboardInterrupt in the host's code). A single long call is not interrupted.
+ * - FMU states: the front keeps them (the store's state variables, validated on restore), so
+ *   pythonfmu's state functions, which leak and accept anything, are never called.
+ */
+#ifndef _GNU_SOURCE
+#define _GNU_SOURCE
+#endif
+#include <dirent.h>
+#include <fcntl.h>
+#include <pthread.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "python_host.h"
+#include "rst_front.h"
+#include "rst_interface.h"  /* generated: restitution.fmu.interface.c_header */
+#include "rst_model_info.h" /* generated: identifier and GUID of modelDescription.xml */
+
+/* One pythonfmu instance, kept for the process's lifetime. */
+typedef struct slot {
+    struct slot *next;
+    fmi2Component real;
+    fmi2CallbackFunctions callbacks; /* what pythonfmu keeps a pointer to */
+    rst_instance *owner;             /* the guard instance using it, or NULL */
+    int poisoned;                    /* pythonfmu reported fmi2Fatal: never touch it again */
+    char resource_dir[1];            /* the pool key (allocated to size) */
+} slot;
+
+/* Process-wide because pythonfmu's instances must outlive ours (see the top of this file). */
+static pthread_mutex_t pool_lock = PTHREAD_MUTEX_INITIALIZER;
+static slot *pool = NULL;
+
+typedef struct {
+    const pythonfmu_api *api;
+    slot *slot;
+} guard;
+
+#define API(inst) (((guard *)rst_backend(inst))->api)
+#define REAL(inst) (((guard *)rst_backend(inst))->slot->real)
+
+/* ------------------------------------------------------------------------------------------------ */
+/* SIGINT held back during calls into Python (Python hosts only)                                     */
+/* ------------------------------------------------------------------------------------------------ */
+static pthread_mutex_t signal_lock = PTHREAD_MUTEX_INITIALIZER;
+static int calls_inside = 0;
+static struct sigaction host_action;
+static volatile sig_atomic_t interrupted = 0;
+
+static void hold_interrupt(int signum)
+{
+    (void)signum;
+    interrupted = 1;
+}
+
+static void begin_call(void)
+{
+    pyhost_attach_thread();
+    if (!pyhost_interpreter_is_hosts())
+        return;
+    pthread_mutex_lock(&signal_lock);
+    if (calls_inside++ == 0) {
+        struct sigaction hold;
+        memset(&hold, 0, sizeof hold);
+        hold.sa_handler = hold_interrupt;
+        sigemptyset(&hold.sa_mask);
+        sigaction(SIGINT, &hold, &host_action);
+    }
+    pthread_mutex_unlock(&signal_lock);
+}
+
+static void end_call(void)
+{
+    if (!pyhost_interpreter_is_hosts())
+        return;
+    pthread_mutex_lock(&signal_lock);
+    if (--calls_inside == 0) {
+        sigaction(SIGINT, &host_action, NULL);
+        if (interrupted) {
+            interrupted = 0;
+            raise(SIGINT); /* now the host's handler: Python sets its flag and raises KeyboardInterrupt later */
+        }
+    }
+    pthread_mutex_unlock(&signal_lock);
+}
+
+/* ------------------------------------------------------------------------------------------------ */
+/* The pool                                                                                         */
+/* ------------------------------------------------------------------------------------------------ */
+static void slot_logger(fmi2ComponentEnvironment environment, fmi2String instance_name, fmi2Status status,
+                        fmi2String category, fmi2String message, ...)
+{
+    slot *s = (slot *)environment;
+    (void)instance_name;
+    if (s != NULL && s->owner != NULL)
+        rst_log_text(s->owner, status, category, message); /* pythonfmu passes no format arguments */
+}
+
+static void *slot_allocate(size_t n, size_t size) { return calloc(n, size); }
+
+/* A free slot of the pool for `resource_dir`, now owned by `inst`; NULL if there is none. */
+static slot *take_slot(rst_instance *inst, const char *resource_dir)
+{
+    slot *s;
+    pthread_mutex_lock(&pool_lock);
+    for (s = pool; s != NULL; s = s->next)
+        if (s->owner == NULL && !s->poisoned && strcmp(s->resource_dir, resource_dir) == 0) {
+            s->owner = inst;
+            break;
+        }
+    pthread_mutex_unlock(&pool_lock);
+    return s;
+}
+
+/* What pythonfmu can read as fmuResourceLocation for `dir` (it strips "file://" and turns "%20" into
+ * a space, nothing else), written to `uri`. */
+static int pythonfmu_uri(rst_instance *inst, const char *dir, char *uri, size_t size)
+{
+    if (strstr(dir, "%20") == NULL) {
+        snprintf(uri, size, "file://%s", dir);
+        return 1;
+    }
+    {
+        int fd = open(dir, O_RDONLY | O_DIRECTORY | O_CLOEXEC); /* kept open: the slot lives as long */
+        if (fd < 0) {
+            rst_log(inst, fmi2Error, "fmi2Instantiate: cannot open the resources directory %s", dir);
+            return 0;
+        }
+        snprintf(uri, size, "file:///proc/self/fd/%d", fd);
+        return 1;
+    }
+}
+
+static slot *new_slot(rst_instance *inst, const pythonfmu_api *api, const char *resource_dir, fmi2Boolean visible)
+{
+    char uri[4200];
+    slot *s = (slot *)calloc(1, sizeof(slot) + strlen(resource_dir));
+    if (s == NULL) {
+        rst_log(inst, fmi2Error, "fmi2Instantiate: out of memory");
+        return NULL;
+    }
+    {
+        fmi2CallbackFunctions callbacks = {slot_logger, slot_allocate, free, NULL, s};
+        memcpy((void *)&s->callbacks, &callbacks, sizeof callbacks); /* its members are const */
+    }
+    strcpy(s->resource_dir, resource_dir);
+    s->owner = inst;
+    if (!pythonfmu_uri(inst, resource_dir, uri, sizeof uri)) {
+        free(s);
+        return NULL;
+    }
+    begin_call();
+    s->real = api->Instantiate(rst_instance_name(inst), fmi2CoSimulation, RST_MODEL_GUID, uri, &s->callbacks,
+                               visible, fmi2True);
+    end_call();
+    if (s->real == NULL) {
+        rst_log(inst, fmi2Error, "fmi2Instantiate: pythonfmu could not instantiate the slave from %s (see the "
+                "message above)", resource_dir);
+        free(s); /* pythonfmu keeps nothing of a failed instance */
+        return NULL;
+    }
+    pthread_mutex_lock(&pool_lock);
+    s->next = pool;
+    pool = s;
+    pthread_mutex_unlock(&pool_lock);
+    return s;
+}
+
+/* ------------------------------------------------------------------------------------------------ */
+/* Hooks                                                                                            */
+/* ------------------------------------------------------------------------------------------------ */
+/* The slave script pythonfmu will load: resources/<first line of slavemodule.txt>.py. */
+static int check_resources(rst_instance *inst, const char *dir)
+{
+    char path[4200], module[256] = "";
+    struct stat st;
+    FILE *f;
+    size_t n;
+    if (stat(dir, &st) != 0 || !S_ISDIR(st.st_mode)) {
+        rst_log(inst, fmi2Error, "fmi2Instantiate: the resource location %s is not a directory", dir);
+        return 0;
+    }
+    snprintf(path, sizeof path, "%s/slavemodule.txt", dir);
+    f = fopen(path, "r");
+    if (f == NULL || fgets(module, sizeof module, f) == NULL) {
+        rst_log(inst, fmi2Error, "fmi2Instantiate: cannot read %s (it names the Python slave module)", path);
+        if (f)
+            fclose(f);
+        return 0;
+    }
+    fclose(f);
+    n = strcspn(module, "\r\n");
+    module[n] = '\0';
+    snprintf(path, sizeof path, "%s/%s.py", dir, module);
+    if (n == 0 || stat(path, &st) != 0 || !S_ISREG(st.st_mode)) {
+        rst_log(inst, fmi2Error, "fmi2Instantiate: the Python slave script %s does not exist", path);
+        return 0;
+    }
+    return 1;
+}
+
+static fmi2Status instantiate(rst_instance *inst, const char *resource_dir, fmi2Boolean visible)
+{
+    guard *g = (guard *)rst_backend(inst);
+    if (resource_dir == NULL) {
+        rst_log(inst, fmi2Error, "fmi2Instantiate: no fmuResourceLocation: this FMU runs the Python code in its "
+                "resources directory");
+        return fmi2Error;
+    }
+    if (!check_resources(inst, resource_dir))
+        return fmi2Error;
+    g->api = pyhost_ensure_ready(inst, resource_dir);
+    if (g->api == NULL)
+        return fmi2Error;
+    g->slot = take_slot(inst, resource_dir);
+    if (g->slot == NULL)
+        g->slot = new_slot(inst, g->api, resource_dir, visible);
+    return g->slot != NULL ? fmi2OK : fmi2Error;
+}
+
+static void free_instance(rst_instance *inst)
+{
+    guard *g = (guard *)rst_backend(inst);
+    slot *s = g->slot;
+    fmi2Status status = fmi2Fatal;
+    if (s == NULL)
+        return;
+    if (rst_mode_of(inst) != RST_FATAL && !s->poisoned) {
+        begin_call();
+        status = g->api->Reset(s->real); /* a fresh slave object for the next owner */
+        end_call();
+    }
+    pthread_mutex_lock(&pool_lock);
+    if (status > fmi2Warning)
+        s->poisoned = 1;
+    s->owner = NULL;
+    pthread_mutex_unlock(&pool_lock);
+}
+
+static fmi2Status setup_experiment(rst_instance *inst, fmi2Boolean tolerance_defined, double tolerance,
+                                   double start_time, fmi2Boolean stop_time_defined, double stop_time)
+{
+    fmi2Status status;
+    begin_call();
+    status = API(inst)->SetupExperiment(REAL(inst), tolerance_defined, tolerance, start_time, stop_time_defined,
+                                        stop_time);
+    end_call();
+    return status;
+}
+
+#define FORWARD(name)                                         \
+    static fmi2Status forward_##name(rst_instance *inst)      \
+    {                                                         \
+        fmi2Status status;                                    \
+        begin_call();                                         \
+        status = API(inst)->name(REAL(inst));                 \
+        end_call();                                           \
+        return status;                                        \
+    }
+FORWARD(EnterInitializationMode)
+FORWARD(ExitInitializationMode)
+FORWARD(Terminate)
+FORWARD(Reset)
+
+static fmi2Status set_values(rst_instance *inst, rst_type type, const fmi2ValueReference vr[], size_t n,
+                             const double values[])
+{
+    fmi2Integer integers[64];
+    fmi2Boolean booleans[64];
+    fmi2Status status = fmi2OK;
+    size_t i0, i;
+    begin_call();
+    for (i0 = 0; i0 < n && status <= fmi2Warning; i0 += 64) {
+        size_t m = n - i0 < 64 ? n - i0 : 64;
+        if (type == RST_REAL)
+            status = API(inst)->SetReal(REAL(inst), vr + i0, m, values + i0);
+        else if (type == RST_INTEGER) {
+            for (i = 0; i < m; i++)
+                integers[i] = (fmi2Integer)values[i0 + i]; /* checked integral and in range by the front */
+            status = API(inst)->SetInteger(REAL(inst), vr + i0, m, integers);
+        } else {
+            for (i = 0; i < m; i++)
+                booleans[i] = values[i0 + i] != 0.0;
+            status = API(inst)->SetBoolean(REAL(inst), vr + i0, m, booleans);
+        }
+    }
+    end_call();
+    return status;
+}
+
+static fmi2Status get_values(rst_instance *inst, rst_type type, const fmi2ValueReference vr[], size_t n,
+                             double values[])
+{
+    fmi2Integer integers[64];
+    fmi2Boolean booleans[64];
+    fmi2Status status = fmi2OK;
+    size_t i0, i;
+    begin_call();
+    for (i0 = 0; i0 < n && status <= fmi2Warning; i0 += 64) {
+        size_t m = n - i0 < 64 ? n - i0 : 64;
+        if (type == RST_REAL)
+            status = API(inst)->GetReal(REAL(inst), vr + i0, m, values + i0);
+        else if (type == RST_INTEGER) {
+            status = API(inst)->GetInteger(REAL(inst), vr + i0, m, integers);
+            for (i = 0; i < m; i++)
+                values[i0 + i] = integers[i];
+        } else {
+            status = API(inst)->GetBoolean(REAL(inst), vr + i0, m, booleans);
+            for (i = 0; i < m; i++)
+                values[i0 + i] = booleans[i] != fmi2False;
+        }
+    }
+    end_call();
+    return status;
+}
+
+static fmi2Status do_step(rst_instance *inst, double t, double h)
+{
+    fmi2Status status;
+    begin_call();
+    status = API(inst)->DoStep(REAL(inst), t, h, fmi2True);
+    end_call();
+    return status;
+}
+
+/* The state variables that are not inputs or parameters, by type (those the slave evolves). */
+static size_t evolving(rst_type type, fmi2ValueReference vr[], size_t size)
+{
+    size_t i, n = 0;
+    for (i = 0; i < RST_MODEL_N_VARIABLES && n < size; i++) {
+        const rst_variable *v = &RST_MODEL_VARIABLES[i];
+        if (v->state && v->type == type && v->causality != RST_INPUT && v->causality != RST_PARAMETER)
+            vr[n++] = v->vr;
+    }
+    return n;
+}
+
+static fmi2Status save_state(rst_instance *inst)
+{
+    fmi2ValueReference vr[RST_MODEL_N_VARIABLES];
+    double values[RST_MODEL_N_VARIABLES];
+    fmi2Status status = fmi2OK;
+    int t;
+    for (t = RST_REAL; t <= RST_BOOLEAN && status <= fmi2Warning; t++) {
+        size_t n = evolving((rst_type)t, vr, RST_MODEL_N_VARIABLES), i;
+        if (n == 0)
+            continue;
+        status = get_values(inst, (rst_type)t, vr, n, values);
+        for (i = 0; i < n && status <= fmi2Warning; i++)
+            rst_store(inst)[vr[i]] = values[i];
+    }
+    return status;
+}
+
+static fmi2Status restore_state(rst_instance *inst)
+{
+    fmi2ValueReference vr[RST_MODEL_N_VARIABLES];
+    double values[RST_MODEL_N_VARIABLES];
+    fmi2Status status = fmi2OK;
+    int t;
+    size_t i;
+    for (t = RST_REAL; t <= RST_BOOLEAN && status <= fmi2Warning; t++) {
+        size_t n = 0;
+        for (i = 0; i < RST_MODEL_N_VARIABLES; i++)
+            if (RST_MODEL_VARIABLES[i].state && RST_MODEL_VARIABLES[i].type == (rst_type)t) {
+                vr[n] = (fmi2ValueReference)i;
+                values[n++] = rst_store(inst)[i];
+            }
+        if (n > 0)
+            status = set_values(inst, (rst_type)t, vr, n, values);
+    }
+    return status;
+}
+
+const rst_model RST_MODEL = {
+    .identifier = RST_MODEL_IDENTIFIER, .guid = RST_MODEL_GUID,
+    .variables = RST_MODEL_VARIABLES, .n_variables = RST_MODEL_N_VARIABLES, .backend_size = sizeof(guard),
+    .instantiate = instantiate, .free_instance = free_instance, .setup_experiment = setup_experiment,
+    .enter_initialization = forward_EnterInitializationMode, .exit_initialization = forward_ExitInitializationMode,
+    .set = set_values, .get_outputs = get_values, .do_step = do_step, .terminate = forward_Terminate,
+    .reset = forward_Reset, .save_state = save_state, .restore_state = restore_state};
