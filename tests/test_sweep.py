@@ -219,7 +219,9 @@ def test_fewer_columns_same_numbers(serial, impact_fmu):
     spec = SweepSpec(**SPEC)
     for backend in ("package", "fmu"):
         res = run_sweep(spec, backend, fmu=impact_fmu, scheduler="serial", columns=["v_approach", "e", "valid"])
-        assert list(res.columns) == ["case", "pair", "v_approach", "e", "valid"]
+        # case, pair, ok and the validity flags travel with every row (issue 13)
+        assert list(res.columns) == ["case", "pair", "v_approach", "e", "valid", "zener.in_range", "jgm.in_range",
+                                     "ok"]
         for name in res.columns:
             assert np.array_equal(res[name], serial[backend][name], equal_nan=name == "e"), (backend, name)
     with pytest.raises(ValueError, match="unknown column"):

@@ -1,8 +1,12 @@
-"""Sweeps lose nothing (issue 13): finished chunks on disk as they complete, Ctrl-C writes what
-is done and exits 130, --resume completes only the missing chunks and gives the table of an
-uninterrupted run; guards before any work (case counts, memory budget, CLI integers, output
-paths); validity counted and warned about."""
+"""Sweeps lose nothing (issue 13): finished chunks on disk as they complete, Ctrl-C (SIGINT to the
+process group, as a terminal sends it) writes what is done and exits 130, --resume completes only
+the missing chunks and gives the table of an uninterrupted run, for both back ends, serially and
+on a 2-worker LocalCluster; guards before any work (case counts, axis sizes, memory budget or
+streaming to disk, CLI integers, output paths, the FMU file); validity on every row, counted and
+warned about; progress output in a terminal and redirected."""
 import os
+import resource
+import shutil
 import signal
 import subprocess
 import sys
@@ -14,7 +18,8 @@ import pytest
 
 from restitution.sweep import SweepSpec, compare_results, read_table, run_sweep
 from restitution.sweep.__main__ import main as sweep_cli
-from restitution.sweep.run import SweepInterrupted, check_memory, table_bytes
+from restitution.sweep.run import (DiskSweepResult, SizeError, SweepInterrupted, check_memory, plan_size,
+                                   table_bytes)
 
 PYTHON = sys.executable
 ENV = {**os.environ, "PYTHONUNBUFFERED": "1"}
@@ -30,9 +35,9 @@ SLOW_SPEC = dict(pairs=["s2_tool_steel/al_6061"], grid={"v": "geomspace:0.1:10:4
 TOL = 1e-13
 
 
-def _cli(*args, cwd=None):
+def _cli(*args, cwd=None, env=None, **kwargs):
     return subprocess.run([PYTHON, "-m", "restitution.sweep", *args], capture_output=True, text=True,
-                          cwd=cwd, env=ENV, timeout=300)
+                          cwd=cwd, env=env or ENV, timeout=300, **kwargs)
 
 
 def _one_line_error(proc, *words):
@@ -55,28 +60,59 @@ def test_case_counts_are_python_ints_and_axes_are_not_built():
     assert "1,000,000,000 cases" in big.describe()
 
 
-def test_memory_budget_refuses_with_numbers():
+def test_memory_budget_refuses_with_numbers_or_streams_to_disk(tmp_path):
     spec = SweepSpec(grid={"v": "linspace:0.1:1:1000"}, random={"sphere.E": {"normal_rel": 0.01}}, samples=10 ** 6)
-    with pytest.raises(ValueError, match=r"1,000,000,000 cases would take .*GiB.*memory budget of 1 MiB"):
+    with pytest.raises(SizeError, match=r"1,000,000,000 cases would take .*GiB.*memory budget of 1 MiB"):
         check_memory(spec, budget=2 ** 20)
     small = SweepSpec(grid={"v": "1,2,3"})
     assert check_memory(small, budget=2 ** 20) == table_bytes(3) > 0
     assert table_bytes(10, ["e"]) < table_bytes(10)
+    # over the budget but small enough for the disk: streamed, with the numbers
+    mid = SweepSpec(random={"v": "uniform:1:2"}, samples=10 ** 4)
+    plan = plan_size(mid, budget=2 ** 10, out=tmp_path / "s.csv")
+    assert plan.stream and plan.memory == table_bytes(10 ** 4) and 0 < plan.disk <= plan.disk_free
+    assert "streamed to disk chunk by chunk" in plan.describe()
+    assert not plan_size(mid, out=tmp_path / "s.csv").stream  # within the default budget: in memory
+    # too big for the disk as well (255 TB): refused, with both numbers
+    huge = SweepSpec(random={"v": "uniform:1:2"}, samples=10 ** 12)
+    with pytest.raises(SizeError, match=r"memory budget .* streamed to disk it would need .* free"):
+        plan_size(huge, out=tmp_path / "s.csv")
+    with pytest.raises(SizeError, match="--backend both compares the two tables in memory"):
+        plan_size(mid, budget=2 ** 10, backends=2, out=tmp_path / "s.csv")
+    with pytest.raises(SizeError, match="at most 100,000,000 per axis"):
+        SweepSpec(grid={"v": {"linspace": [0.1, 1, 10 ** 9]}}).check_axes()
+
+
+def _address_space(limit):
+    return lambda: resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
 
 
 def test_cli_refuses_absurd_sizes_before_any_work(tmp_path):
+    # 1e9 cases: 237 GiB in memory, about 1 TB streamed to disk (skip on a machine with that much free)
+    if shutil.disk_usage(tmp_path).free > 10 ** 12:
+        pytest.skip("this machine could stream a 1e9-case table to disk")
     proc = _cli("--random", "v=uniform:1:2", "--samples", "1000000000", "--out", str(tmp_path / "s.csv"))
-    _one_line_error(proc, "1,000,000,000 cases", "memory budget")
+    _one_line_error(proc, "1,000,000,000 cases", "memory budget", "streamed to disk it would need")
     grid = ["--grid", "v=linspace:0.1:1:65536", "--grid", "t/d=linspace:0.1:1:65536",
             "--grid", "sphere.E=linspace:1e9:2e9:65536", "--grid", "plate.E=linspace:1e9:2e9:65536"]
     proc = _cli(*grid, "--out", str(tmp_path / "s.csv"))
-    _one_line_error(proc, "18,446,744,073,709,551,616 cases")
+    _one_line_error(proc, "18,446,744,073,709,551,616 cases")  # was "0 cases"
     assert not (tmp_path / "s.csv").exists()
-    # --dry-run answers from the sizes (a 1e9-point axis is not built) and says it would be refused
-    proc = _cli("--grid", "v=linspace:0.1:1:1000000000", "--dry-run")
-    assert proc.returncode == 0 and "1,000,000,000 cases" in proc.stdout and "memory budget" in proc.stdout
-    proc = _cli("--grid", "v=1,2,3", "--dry-run", "--memory-budget", "1K")
-    assert proc.returncode == 0 and "3 cases" in proc.stdout, proc.stdout
+    # --dry-run answers from the sizes: with 2 GiB of address space, the 7.45 GiB of a built
+    # 1e9-point axis (or the 80 GB of 1e10) cannot be allocated
+    small_memory = _address_space(2 * 2 ** 30)
+    proc = _cli("--grid", "v=linspace:0.1:1:1000000000", "--dry-run", preexec_fn=small_memory)
+    assert proc.returncode == 0, proc.stderr
+    assert "1,000,000,000 cases" in proc.stdout and "at most 100,000,000 per axis" in proc.stdout
+    proc = _cli("--grid", "v=linspace:0.1:1:10000000000", "--grid", "t/d=linspace:1:2:10000000000", "--dry-run",
+                preexec_fn=small_memory)
+    assert proc.returncode == 0, proc.stderr
+    assert "100,000,000,000,000,000,000 cases" in proc.stdout  # was 7,766,279,631,452,241,920
+    proc = _cli("--random", "v=uniform:1:2", "--samples", "1000000", "--dry-run", preexec_fn=small_memory)
+    assert proc.returncode == 0 and "1,000,000 cases" in proc.stdout, proc.stdout
+    assert "243 MiB (255,000,000 bytes) in memory, within the memory budget" in proc.stdout, proc.stdout
+    proc = _cli("--grid", "v=1,2,3", "--dry-run", "--memory-budget", "500", "--out", str(tmp_path / "s.csv"))
+    assert proc.returncode == 0 and "3 cases" in proc.stdout and "streamed to disk" in proc.stdout, proc.stdout
 
 
 @pytest.mark.parametrize("args, words", [
@@ -88,13 +124,44 @@ def test_cli_refuses_absurd_sizes_before_any_work(tmp_path):
     (["--memory-budget", "lots"], ["--memory-budget"]),
     (["--set", "zener_method=4294967297", "--backend", "fmu"], ["zener_method = 4294967297", "out of range"]),
     (["--grid", "v=arange:0:1:0"], ["arange step = 0"]),
+    (["--grid", "v=geomspace:0:1:5"], ["geomspace needs first and last non-zero"]),
+    (["--grid", "v"], ["expected NAME=VALUE", "'v'"]),
     (["no_such_spec.toml"], ["no_such_spec.toml", "No such file"]),
+    (["list.json"], ["list.json", "expected a table", "list"]),
+    (["pairs.toml"], ["pairs = 5", "expected a list"]),
+    (["grid.toml"], ["grid = [1]", "expected a table"]),
+    (["run.toml"], ["run = 3", "[run]"]),
     (["--backend", "both", "--columns", "e"], ["--columns must keep ok"]),
+    (["--columns", "e,E"], ["--columns", "unknown column(s) ['E']"]),
+    (["--backend", "fmu", "--fmu", "missing.fmu"], ["--fmu missing.fmu", "no such file"]),
+    (["--backend", "fmu", "--fmu", "list.json"], ["--fmu list.json", "not an FMU"]),
+    (["--backend", "fmu", "--fmu", "BouncingBall.fmu"], ["--fmu BouncingBall.fmu", "not a SpherePlateImpact FMU"]),
 ])
-def test_cli_user_mistakes_are_one_line_errors(tmp_path, args, words):
-    proc = _cli(*args, "--grid" if "--grid" not in args else "--no-plot",
-                *(["v=1,2"] if "--grid" not in args else []), "--out", str(tmp_path / "s.csv"), cwd=tmp_path)
+def test_cli_user_mistakes_are_one_line_errors(tmp_path, args, words, bouncing_ball_fmu):
+    (tmp_path / "list.json").write_text("[1, 2]")
+    (tmp_path / "pairs.toml").write_text("pairs = 5")
+    (tmp_path / "grid.toml").write_text("grid = [1]")
+    (tmp_path / "run.toml").write_text("run = 3")
+    shutil.copy(bouncing_ball_fmu, tmp_path / "BouncingBall.fmu")
+    grid = [] if "--grid" in args or args[0].endswith((".toml", ".json")) else ["--grid", "v=1,2"]
+    proc = _cli(*args, *grid, "--no-plot", "--scheduler", "serial", "--out", str(tmp_path / "s.csv"), cwd=tmp_path)
     _one_line_error(proc, *words)
+    assert not (tmp_path / "s.csv").exists() and not (tmp_path / "s.csv.parts").exists()
+
+
+@pytest.fixture(scope="module")
+def bouncing_ball_fmu(tmp_path_factory):
+    """An FMU that is not a SpherePlateImpact FMU."""
+    from restitution.fmu.build import build_one
+
+    return build_one("BouncingBall", tmp_path_factory.mktemp("ball"), standalone=False)
+
+
+def test_cli_unreachable_scheduler_is_one_line_error(tmp_path):
+    env = {**ENV, "DASK_DISTRIBUTED__COMM__TIMEOUTS__CONNECT": "2s"}
+    proc = _cli("--grid", "v=1,2", "--scheduler", "tcp://127.0.0.1:9", "--no-plot", "--out", str(tmp_path / "s.csv"),
+                env=env)
+    _one_line_error(proc, "--scheduler tcp://127.0.0.1:9", "cannot connect")
 
 
 def test_codes_are_range_checked_in_the_spec():
@@ -109,7 +176,7 @@ def test_codes_are_range_checked_in_the_spec():
 def test_output_paths_are_checked_before_the_run(tmp_path):
     a_file = tmp_path / "file"
     a_file.write_text("x")
-    for out, words in ((tmp_path, ["is a directory"]), (a_file / "s.csv", ["cannot write"]),
+    for out, words in ((tmp_path, ["is a directory"]), (a_file / "s.csv", ["is not a directory"]),
                        ("/proc/no/such.csv", ["cannot write"])):
         proc = _cli(*SLOW_ARGS, "--scheduler", "serial", "--out", str(out))
         _one_line_error(proc, "--out", *words)  # at once: the slow sweep never started
@@ -156,15 +223,70 @@ def test_serial_interrupt_keeps_finished_chunks_and_resume_completes(tmp_path):
         run_sweep(other, scheduler="serial", parts=tmp_path / "p", resume=True)
 
 
-# --- the CLI interrupted by SIGINT in a child process -------------------------------------
+def test_cli_resume_on_another_sweeps_chunks_is_one_line_error(tmp_path):
+    run_sweep(SweepSpec(grid={"v": "1,2,3"}), scheduler="serial", parts=tmp_path / "s.csv.parts" / "package")
+    proc = _cli("--grid", "v=1,2,4", "--resume", "--scheduler", "serial", "--no-plot", "--out", str(tmp_path / "s.csv"))
+    _one_line_error(proc, "--resume", "belong to another sweep")
+    assert not (tmp_path / "s.csv").exists()
+
+
+def test_table_on_disk_when_over_the_memory_budget(tmp_path):
+    """in_memory=False: only counts in memory; the table is streamed from the finished chunks, the
+    same as the in-memory one (CSV and Parquet), also after an interrupt and a resume."""
+    spec = SweepSpec(pairs=["s2_tool_steel/al_6061", "table4:A2"], grid={"v": "geomspace:0.1:3000:30", "t/d": "0.05,1,5"},
+                     random={"sphere.E": {"normal_rel": 0.05}}, samples=5, seed=2)
+    whole = run_sweep(spec, scheduler="serial", chunk_size=100)
+    with pytest.raises(SweepInterrupted) as info:
+        run_sweep(spec, _Interrupting(4), scheduler="serial", chunk_size=100, parts=tmp_path / "p", in_memory=False)
+    partial = info.value.result
+    assert isinstance(partial, DiskSweepResult) and partial.columns == {}
+    assert len(partial) == 300 and info.value.missing == spec.n_cases - 300
+    table = read_table(partial.write(tmp_path / "partial.csv"))
+    assert np.array_equal(table["case"], np.arange(300))
+    res = run_sweep(spec, scheduler="serial", chunk_size=7, parts=tmp_path / "p", resume=True, in_memory=False)
+    assert isinstance(res, DiskSweepResult) and len(res) == spec.n_cases == len(whole)
+    assert res.out_of_range() == whole.out_of_range() and res.out_of_range()["valid"] > 0
+    assert res.summary().split(": ", 1)[1].split("; ", 1)[1] == whole.summary().split(": ", 1)[1].split("; ", 1)[1]
+    assert res.warning() == whole.warning()
+    whole.write(tmp_path / "whole.csv")
+    assert (tmp_path / "whole.csv").read_bytes() == res.write(tmp_path / "disk.csv").read_bytes()
+    for name, col in read_table(res.write(tmp_path / "disk.parquet")).items():
+        ref = whole[name]
+        assert np.array_equal(col, ref, equal_nan=ref.dtype.kind == "f"), name
+    with pytest.raises(RuntimeError, match="no COR map"):
+        res.plot(tmp_path / "map.png")
+
+
+def test_cli_streams_a_table_over_the_budget_to_disk(tmp_path):
+    args = ["--pair", "s2_tool_steel/al_6061", "--random", "v=uniform:0.1:3000", "--samples", "3000",
+            "--chunk-size", "700", "--scheduler", "serial", "--columns", "e"]
+    ref = _cli(*args, "--no-plot", "--out", str(tmp_path / "ref.csv"))
+    assert ref.returncode == 0, ref.stderr
+    proc = _cli(*args, "--memory-budget", "10K", "--out", str(tmp_path / "s.csv"))
+    assert proc.returncode == 0, proc.stderr
+    assert "over the memory budget" in proc.stderr and "streamed to disk chunk by chunk" in proc.stderr
+    assert "no COR map" in proc.stderr and not (tmp_path / "s_cor_map.png").exists()
+    assert "warning:" in proc.stderr  # v up to 3 km/s: V* beyond 1000, counted from the chunks
+    assert (tmp_path / "s.csv").read_bytes() == (tmp_path / "ref.csv").read_bytes()
+    table = read_table(tmp_path / "s.csv")
+    assert list(table) == ["case", "pair", "e", "valid", "zener.in_range", "jgm.in_range", "ok"]  # validity kept
+    assert not (tmp_path / "s.csv.parts").exists()
+
+
+# --- the CLI interrupted by Ctrl-C in a child process -------------------------------------
 @pytest.fixture(scope="module")
-def slow_reference():
-    return run_sweep(SweepSpec(**SLOW_SPEC), scheduler="serial", chunk_size=30)
+def slow_reference(impact_fmu):
+    """The slow sweep, uninterrupted, per back end (the resumed tables must equal these)."""
+    spec = SweepSpec(**SLOW_SPEC)
+    return {"package": run_sweep(spec, scheduler="serial", chunk_size=30),
+            "fmu": run_sweep(spec, "fmu", fmu=impact_fmu, scheduler="serial", chunk_size=30)}
 
 
 def _interrupt_after_chunks(args, parts: Path, n_chunks: int, cwd):
+    """Run the CLI in a process group of its own and send SIGINT to the whole group once ``n_chunks``
+    chunks are on disk: what Ctrl-C in a terminal does (the Dask workers get it too)."""
     proc = subprocess.Popen([PYTHON, "-m", "restitution.sweep", *args], stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True, cwd=cwd, env=ENV)
+                            stderr=subprocess.PIPE, text=True, cwd=cwd, env=ENV, start_new_session=True)
     deadline = time.monotonic() + 120
     while time.monotonic() < deadline and proc.poll() is None:
         if len(list(parts.glob("chunk-*.npz"))) >= n_chunks:
@@ -174,7 +296,7 @@ def _interrupt_after_chunks(args, parts: Path, n_chunks: int, cwd):
     import psutil
 
     children = psutil.Process(proc.pid).children(recursive=True)  # Dask's workers, if any
-    proc.send_signal(signal.SIGINT)
+    os.killpg(proc.pid, signal.SIGINT)
     out, err = proc.communicate(timeout=120)
     gone, alive = psutil.wait_procs(children, timeout=30)
     assert not alive, f"orphan processes after the interrupt: {alive}"
@@ -182,19 +304,22 @@ def _interrupt_after_chunks(args, parts: Path, n_chunks: int, cwd):
 
 
 @pytest.mark.slow
+@pytest.mark.parametrize("backend", ["package", "fmu"])
 @pytest.mark.parametrize("scheduler", [["--scheduler", "serial"], ["--scheduler", "local", "--workers", "2"]],
                          ids=["serial", "localcluster2"])
-def test_cli_sigint_writes_what_is_done_and_resume_completes(tmp_path, slow_reference, scheduler):
+def test_cli_ctrl_c_writes_what_is_done_and_resume_completes(tmp_path, slow_reference, scheduler, backend,
+                                                            impact_fmu):
     out = tmp_path / "s.csv"
-    args = [*SLOW_ARGS, *scheduler, "--out", str(out)]
-    rc, stdout, stderr = _interrupt_after_chunks(args, tmp_path / "s.csv.parts" / "package", 4, tmp_path)
+    args = [*SLOW_ARGS, *scheduler, "--backend", backend, "--fmu", str(impact_fmu), "--out", str(out)]
+    rc, stdout, stderr = _interrupt_after_chunks(args, tmp_path / "s.csv.parts" / backend, 4, tmp_path)
     assert rc == 130, stderr
-    assert "Traceback" not in stderr, stderr
+    # no worker's KeyboardInterrupt, no FMU instance freed under a running chunk (a worker lost)
+    assert "Traceback" not in stderr and "ERROR" not in stderr and "fmi2Fatal" not in stderr, stderr
     partial = read_table(out)
     n_done = partial["case"].size
     assert 4 * 30 <= n_done < 1200
     assert f"{1200 - n_done:,} of 1,200 cases are missing" in stderr and "--resume" in stderr
-    ref = slow_reference.columns
+    ref = slow_reference[backend].columns
     for name in ("e", "zener.tau0"):  # the finished cases are right
         sel = partial["case"]
         assert np.allclose(partial[name], ref[name][sel], rtol=TOL, atol=0), name
@@ -205,6 +330,62 @@ def test_cli_sigint_writes_what_is_done_and_resume_completes(tmp_path, slow_refe
     assert np.array_equal(table["case"], np.arange(1200))
     assert all(v <= TOL for v in compare_results(table, ref).values())
     assert not (tmp_path / "s.csv.parts").exists()  # whole table written: parts removed
+
+
+def test_serial_fmu_takes_ctrl_c_between_cases_not_at_the_chunks_end(impact_fmu):
+    """The FMU back end checks for a held Ctrl-C between cases: a long chunk ends after the case
+    in progress, not after its thousands of FMU calls."""
+    from restitution.sweep import backends
+
+    calls = []
+
+    def check():
+        calls.append(1)
+        if len(calls) == 5:
+            raise KeyboardInterrupt
+
+    cases = SweepSpec(grid={"v": "linspace:0.1:2:5000"}).cases()
+    backend = backends.get_backend("fmu", impact_fmu)
+    backends._INTERRUPT_CHECK = check
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            backend.evaluate(cases, backend.local_payload())
+    finally:
+        backends._INTERRUPT_CHECK = None
+        backends.release_fmus()
+    assert len(calls) == 5
+
+
+def test_fmu_instance_released_while_a_chunk_runs_is_freed_after_it(impact_fmu, tmp_path):
+    """What a cancelled task meets on a worker: release_fmus() (client.run) while another thread still
+    evaluates a chunk with the instance. Freeing it under the running chunk killed the worker; now the
+    chunk stops at the next case and the instance is freed then. In a child process: it may crash."""
+    script = tmp_path / "release.py"
+    script.write_text(f"""
+import threading, time
+from restitution.sweep import SweepSpec, backends
+cases = SweepSpec(grid={{"v": "linspace:0.1:2:200"}}, fixed={{"zener_method": "ode", "plate_waves": "on"}}).cases()
+backend = backends.get_backend("fmu", {str(impact_fmu)!r})
+payload = backend.local_payload()
+errors = []
+def work():
+    try:
+        backend.evaluate(cases, payload)
+    except Exception as exc:
+        errors.append(exc)
+t = threading.Thread(target=work)
+t.start()
+while not any(i.busy for i in list(backends._INSTANCES.values())):  # inside the chunk (about 5 ms a case)
+    time.sleep(0.01)
+assert backends.release_fmus() == 1
+t.join(60)
+assert not t.is_alive()
+print("stopped:", [str(e) for e in errors])
+print("instances left:", len(backends._INSTANCES))
+""")
+    proc = subprocess.run([PYTHON, str(script)], capture_output=True, text=True, env=ENV, timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    assert "FMU instance released" in proc.stdout and "instances left: 0" in proc.stdout, proc.stdout
 
 
 # --- validity ---------------------------------------------------------------------------
@@ -227,6 +408,45 @@ def test_summary_counts_and_cli_warns_about_out_of_range_cases(tmp_path):
     clean = _cli("--pair", "s2_tool_steel/al_6061", "--grid", "v=1,2", "--scheduler", "serial", "--no-plot",
                  "--out", str(tmp_path / "c.csv"))
     assert clean.returncode == 0 and "warning" not in clean.stderr
+
+
+def _with_terminal_stderr(cmd, cwd=None):
+    """(exit status, stdout, stderr) of ``cmd`` with stderr on a pseudo-terminal (80 columns)."""
+    import fcntl
+    import pty
+    import struct
+    import termios
+
+    master, slave = pty.openpty()
+    fcntl.ioctl(slave, termios.TIOCSWINSZ, struct.pack("HHHH", 24, 80, 0, 0))
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=slave, stdin=subprocess.DEVNULL, text=True,
+                            env=ENV, cwd=cwd)
+    os.close(slave)
+    chunks = []
+    while True:
+        try:
+            data = os.read(master, 65536)
+        except OSError:  # EIO: the child closed the terminal
+            break
+        if not data:
+            break
+        chunks.append(data)
+    out = proc.stdout.read()
+    proc.wait(timeout=300)
+    os.close(master)
+    return proc.returncode, out, b"".join(chunks).decode("utf-8", "replace")
+
+
+def test_progress_in_a_terminal_ends_with_the_final_state_on_its_own_line(tmp_path):
+    # long enough (about 40 ode chunks) that a terminal may show the redrawn line; not asserted
+    proc = _with_terminal_stderr([PYTHON, "-m", "restitution.sweep", *SLOW_ARGS, "--scheduler", "serial",
+                                  "--out", str(tmp_path / "s.csv")])
+    rc, out, err = proc
+    assert rc == 0, err
+    lines = err.replace("\r\n", "\n").split("\n")
+    final = [line.rsplit("\r", 1)[-1] for line in lines if "chunks done" in line]
+    assert len(final) == 1 and final[0].startswith("[serial] 40/40 chunks done in "), err
+    assert out.splitlines()[1].startswith("1200 cases with the package back end"), out  # not glued to the bar
 
 
 def test_progress_when_redirected_is_one_final_line(tmp_path):
@@ -256,6 +476,36 @@ def test_cor_map_title_fits_a_single_pair(tmp_path):
     plt.close(fig)
     spec = SweepSpec(pairs=["s2_tool_steel/al_6061"], grid={"v": "geomspace:0.1:100:8", "t/d": "geomspace:0.05:5:6"})
     assert run_sweep(spec, scheduler="serial").plot(tmp_path / "map.png").stat().st_size > 10_000
+
+
+@pytest.fixture(scope="module")
+def cli_built_fmus(tmp_path_factory):
+    """What `python -m restitution.fmu build --out DIR` makes (the pythonfmu FMUs, and the native ones
+    where they can be built)."""
+    out = tmp_path_factory.mktemp("built")
+    proc = subprocess.run([PYTHON, "-m", "restitution.fmu", "build", "--out", str(out)], capture_output=True,
+                          text=True, env=ENV, timeout=600)
+    assert proc.returncode == 0, proc.stderr
+    return out
+
+
+def test_cli_fmu_back_end_on_the_built_fmus_python_and_native(tmp_path, cli_built_fmus):
+    """--fmu DIR/SpherePlateImpact.fmu and DIR/native/SpherePlateImpact.fmu (C only: the sweep refused it
+    with a traceback, looking for the bundled Python package) give the same table, refused cases too."""
+    native = cli_built_fmus / "native" / "SpherePlateImpact.fmu"
+    if not native.is_file():
+        pytest.skip("no native FMU built here")
+    args = ["--pair", "s2_tool_steel/al_6061", "--grid", "v=geomspace:0.1:100:10", "--grid", "t/d=0.05,1",
+            "--random", "sphere.E=normal_rel:0.6", "--samples", "3", "--seed", "4", "--backend", "fmu",
+            "--scheduler", "serial", "--no-plot"]
+    tables = {}
+    for name, fmu in (("python", cli_built_fmus / "SpherePlateImpact.fmu"), ("native", native)):
+        proc = _cli(*args, "--fmu", str(fmu), "--out", str(tmp_path / f"{name}.csv"))
+        assert proc.returncode == 0 and "Traceback" not in proc.stderr, proc.stderr
+        tables[name] = read_table(tmp_path / f"{name}.csv")
+    assert np.count_nonzero(~tables["python"]["ok"]) > 0  # sphere.E drawn negative: refused by both
+    assert np.array_equal(tables["python"]["ok"], tables["native"]["ok"])
+    assert all(v <= 1e-12 for v in compare_results(tables["native"], tables["python"]).values())
 
 
 def test_fmu_back_end_refuses_codes_that_would_wrap(impact_fmu):

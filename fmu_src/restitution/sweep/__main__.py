@@ -51,6 +51,8 @@ def check_output(path: Path, what: str = "--out") -> None:
     writable directory (created if missing). Checked before the run starts."""
     if path.is_dir():
         raise ValueError(f"{what} {path}: is a directory; give a file name (.csv or .parquet)")
+    if path.parent.exists() and not path.parent.is_dir():
+        raise ValueError(f"{what} {path}: {path.parent} is not a directory")
     parent = path.parent
     try:
         parent.mkdir(parents=True, exist_ok=True)
@@ -81,7 +83,7 @@ def _pairs(items):
     for item in items or []:
         name, sep, value = item.partition("=")
         if not sep:
-            raise SystemExit(f"expected NAME=VALUE, got {item!r}")
+            raise ValueError(f"expected NAME=VALUE, got {item!r}")
         out[name.strip()] = value.strip()
     return out
 
@@ -100,7 +102,13 @@ def _list() -> str:
 
 def build_spec(args) -> tuple[SweepSpec, dict]:
     data = load_spec(args.spec) if args.spec else {}
-    run = dict(data.pop("run", {}) or {})
+    if not isinstance(data, dict):
+        raise ValueError(f"spec file {args.spec}: expected a table (pairs, grid, random, fixed, samples, seed, "
+                         f"[run]), got a {type(data).__name__}")
+    run = data.pop("run", {}) or {}
+    if not isinstance(run, dict):
+        raise ValueError(f"spec file {args.spec}: run = {run!r}: expected a table [run]")
+    run = dict(run)
     data = {k: (dict(v) if isinstance(v, dict) else v) for k, v in data.items()}
     if args.pair:
         data["pairs"] = list(args.pair)
@@ -167,12 +175,24 @@ def main(argv=None) -> int:
         print(_list())
         return 0
     try:
+        return _main(parser, args)
+    except KeyboardInterrupt:  # outside the sweep itself (which writes what is done): nothing to keep
+        print("\ninterrupted before the sweep started or after its table was written", file=sys.stderr)
+        return EXIT_INTERRUPTED
+
+
+def _main(parser, args) -> int:
+    from .run import SizeError, _keep, plan_size, table_bytes
+
+    try:
         spec, run = build_spec(args)
         run_ints = {key: _int_in(low, high)(str(run[key])) for key, low, high in (
             ("workers", 1, MAX_WORKERS), ("chunk_size", 1, MAX_CHUNK)) if run.get(key) is not None}
     except (ValueError, argparse.ArgumentTypeError) as exc:
         parser.error(str(exc))
     backend = args.backend or run.get("backend", "package")
+    if backend not in ("package", "fmu", "both"):
+        parser.error(f"[run] backend = {backend!r}: use 'package', 'fmu' or 'both'")
     scheduler = args.scheduler or run.get("scheduler")
     workers = args.workers if args.workers is not None else run_ints.get("workers")
     chunk = args.chunk_size if args.chunk_size is not None else run_ints.get("chunk_size")
@@ -181,6 +201,10 @@ def main(argv=None) -> int:
     columns = args.columns or run.get("columns")
     if isinstance(columns, str):
         columns = [c.strip() for c in columns.split(",") if c.strip()]
+    try:
+        _keep(columns)
+    except ValueError as exc:
+        parser.error(f"--columns: {exc}")
     if backend == "both" and columns is not None:
         missing = [c for c in ("ok", *INPUT_NAMES) if c not in columns]
         if missing:  # checked before the run, not after it
@@ -199,22 +223,32 @@ def main(argv=None) -> int:
             parser.error(f"--out {out}: writing Parquet needs pyarrow (pip install pyarrow); or write .csv")
     plot = None if (args.no_plot or run.get("plot") is False) else Path(
         args.plot or run.get("plot") or out.with_name(out.stem + "_cor_map.png"))
+    parts = out.with_name(out.name + ".parts")
     print(f"sweep: {spec.describe()}")
-    from .run import check_memory, table_bytes
 
-    try:
-        need = check_memory(spec, columns, args.memory_budget, backends=2 if backend == "both" else 1)
-        check_output(out)
-        if plot is not None:
-            check_output(plot, "--plot")
-    except ValueError as exc:
-        if args.dry_run and "memory budget" in str(exc):
-            print(f"sweep: {exc}")
+    n_backends = 2 if backend == "both" else 1
+    try:  # the size guard, from the axis sizes alone
+        spec.check_axes()
+        plan = plan_size(spec, columns, args.memory_budget, backends=n_backends, out=out, parts=parts)
+    except SizeError as exc:
+        if args.dry_run:
+            print(f"sweep: refused: {exc}")
             return 0
         parser.error(str(exc))
     if args.dry_run:
-        print(f"sweep: the table would take {need:,} bytes in memory ({table_bytes(1, columns)} bytes a case)")
+        print(f"sweep: {plan.describe()} ({table_bytes(1, columns) * n_backends} bytes a case)")
         return 0
+    try:
+        check_output(out)
+        if parts.exists() and not parts.is_dir():
+            raise ValueError(f"--out {out}: {parts} (where finished chunks go) exists and is not a directory")
+        if plot is not None and not plan.stream:
+            check_output(plot, "--plot")
+        if backend in ("fmu", "both") and fmu is not None:
+            from .backends import check_impact_fmu
+            fmu = check_impact_fmu(fmu)
+    except ValueError as exc:
+        parser.error(str(exc))
 
     if backend in ("fmu", "both") and fmu is None:
         from ..fmu.build import BuildError, default_fmu
@@ -223,28 +257,41 @@ def main(argv=None) -> int:
         except BuildError as exc:
             parser.error(str(exc))
 
-    from .run import SweepInterrupted, open_client, run_sweep
+    from .run import ResumeError, SweepInterrupted, open_client, run_sweep
 
+    if plan.stream:
+        print(f"sweep: {plan.describe()}", file=sys.stderr)
     progress = not args.no_progress
     status = 0
-    parts = out.with_name(out.name + ".parts")
     backends = ("package", "fmu") if backend == "both" else (backend,)
+    if args.resume and not all((parts / name / "manifest.json").is_file() for name in backends):
+        print(f"--resume: no finished chunks in {parts}: the whole sweep runs", file=sys.stderr)
     results = {}
     try:
         with contextlib.ExitStack() as stack:
-            target = "serial" if scheduler == "serial" else stack.enter_context(open_client(scheduler, workers))
+            target = "serial"
+            if scheduler != "serial":
+                try:
+                    target = stack.enter_context(open_client(scheduler, workers))
+                except OSError as exc:  # an address nothing answers at (Dask waits its connect timeout)
+                    parser.error(f"--scheduler {scheduler}: cannot connect: {exc}")
             for name in backends:
                 res = run_sweep(spec, name, fmu=fmu, scheduler=target, chunk_size=chunk, progress=progress,
-                                columns=columns, parts=parts / name, resume=args.resume)
+                                columns=columns, parts=parts / name, resume=args.resume, in_memory=not plan.stream)
                 print(res.summary())
                 results[name] = res
     except SweepInterrupted as exc:
-        written = exc.result.write(out)
+        try:
+            written = exc.result.write(out)
+        except KeyboardInterrupt:
+            print(f"\ninterrupted again while writing {out}: nothing written there; the finished chunks are "
+                  f"kept in {parts}: run the same command with --resume", file=sys.stderr)
+            return EXIT_INTERRUPTED
         print(f"\ninterrupted: wrote the {len(exc.result):,} finished cases to {written}; {exc.missing:,} of "
               f"{spec.n_cases:,} cases are missing (finished chunks kept in {parts}); run the same command "
               f"with --resume to complete them", file=sys.stderr)
         return EXIT_INTERRUPTED
-    except ValueError as exc:  # --resume on another sweep's parts
+    except ResumeError as exc:  # --resume on another sweep's parts
         parser.error(str(exc))
     if backend == "both":
         from .compare import agreement_report
@@ -259,14 +306,22 @@ def main(argv=None) -> int:
             print(f"the FMU and the package agree on all {compared} cases within each output's conditioning "
                   "(restitution.agreement)")
     result = results[backends[0]]
-    print(f"table: {result.write(out)}")
+    try:
+        print(f"table: {result.write(out)}")
+    except KeyboardInterrupt:
+        print(f"\ninterrupted while writing {out}: nothing written there; every chunk is kept in {parts}: "
+              f"run the same command with --resume to write the table", file=sys.stderr)
+        return EXIT_INTERRUPTED
     import shutil
 
     shutil.rmtree(parts, ignore_errors=True)  # the table is whole: the finished chunks are not needed
     for res in results.values():
         if res.warning():
             print(f"{res.backend}: {res.warning()}", file=sys.stderr)
-    if plot is not None:
+    if plot is not None and plan.stream:
+        print(f"no COR map: the table is too big for memory (streamed to {out}); plot a smaller sweep",
+              file=sys.stderr)
+    elif plot is not None:
         try:
             print(f"COR map: {result.plot(plot)}")
         except ModuleNotFoundError as exc:

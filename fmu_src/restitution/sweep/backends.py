@@ -32,7 +32,8 @@ import numpy as np
 
 from .spec import CODES, INPUTS, INTEGER_INPUTS, OUTPUTS
 
-__all__ = ["Backend", "PackageBackend", "FmuBackend", "get_backend", "code_fingerprint", "release_fmus"]
+__all__ = ["Backend", "PackageBackend", "FmuBackend", "get_backend", "code_fingerprint", "release_fmus",
+           "check_impact_fmu"]
 
 _REAL_OUT = [name for name, _f, t in OUTPUTS if t == "Real"]
 _BOOL_OUT = [name for name, _f, t in OUTPUTS if t == "Boolean"]
@@ -165,6 +166,8 @@ class _LoadedFmu:
         from fmpy import read_model_description
         from fmpy.fmi2 import FMU2Slave
 
+        global _FMI_CALL_ERRORS
+        _FMI_CALL_ERRORS = _fmi_call_errors()
         md = read_model_description(unzip_dir)
         self.unzip_dir = unzip_dir
         variables = {v.name: v for v in md.modelVariables}
@@ -176,11 +179,18 @@ class _LoadedFmu:
         self.slave = FMU2Slave(guid=md.guid, unzipDirectory=unzip_dir,
                                modelIdentifier=md.coSimulation.modelIdentifier,
                                instanceName=f"sweep-{os.getpid()}-{threading.get_ident()}")
-        self.code_file = _instantiate_with_bundled_code(self.slave, unzip_dir)
-        self.code = code_fingerprint(Path(self.code_file).parent)
+        if os.path.isfile(os.path.join(unzip_dir, "resources", "slavemodule.txt")):  # a pythonfmu FMU
+            self.code_file = _instantiate_with_bundled_code(self.slave, unzip_dir)
+            self.code = code_fingerprint(Path(self.code_file).parent)
+        else:  # a native FMU (C only): its binary is the code that runs
+            self.slave.instantiate(loggingOn=False, callbacks=_quiet_callbacks())
+            self.code_file = self.slave.dll._name
+            self.code = hashlib.sha256(Path(self.code_file).read_bytes()).hexdigest()[:12]
         self.slave.setupExperiment(startTime=0.0)
         self.slave.enterInitializationMode()
         self.slave.exitInitializationMode()
+        self.busy = False  #: a chunk is being evaluated (in the thread that owns the instance)
+        self.doomed = None  #: released while busy: closed (and this directory removed) when the chunk returns
 
     def reset(self):
         s = self.slave
@@ -192,6 +202,22 @@ class _LoadedFmu:
     def evaluate(self, cases: dict, outputs=None) -> dict:
         """Set every input of every case (the varying ones case by case), read the outputs
         (``outputs``: names to read, default all; ``e`` is always read, for ``ok``)."""
+        with _LOCK:
+            if self.slave is None or self.doomed is not None:
+                raise RuntimeError("this FMU instance was released")
+            self.busy = True
+        try:
+            return self._evaluate(cases, outputs)
+        finally:
+            with _LOCK:
+                self.busy = False
+                doomed, self.doomed = self.doomed, None
+            if doomed is not None:  # release_fmus ran meanwhile (a cancelled chunk): free it now
+                self.close()
+                if doomed:
+                    shutil.rmtree(doomed, ignore_errors=True)
+
+    def _evaluate(self, cases: dict, outputs=None) -> dict:
         n = np.size(cases["v_approach"])
         self.reset()
         reals = [name for name, _kw, t, _s in INPUTS if t == "Real"]
@@ -202,28 +228,47 @@ class _LoadedFmu:
                 raise ValueError(f"{name} = {float(bad[0])!r} is out of range: codes {sorted(CODES[name].values())}")
         varying = {name for name, col in columns.items() if n and not np.all(col == col[0])}
         s = self.slave
+        real_names = [k for k in _REAL_OUT if outputs is None or k in outputs or k == "e"]
+        bool_names = [k for k in _BOOL_OUT if outputs is None or k in outputs]
         if n:
-            # Case 0 sets everything; constant columns then stay as set.
-            s.setReal([self.vr[k] for k in reals], [float(columns[k][0]) for k in reals])
-            s.setInteger([self.vr[k] for k in INTEGER_INPUTS], [int(columns[k][0]) for k in INTEGER_INPUTS])
+            # The constant columns once; the varying ones case by case.
+            try:
+                s.setReal([self.vr[k] for k in reals if k not in varying],
+                          [float(columns[k][0]) for k in reals if k not in varying])
+                s.setInteger([self.vr[k] for k in INTEGER_INPUTS if k not in varying],
+                             [int(columns[k][0]) for k in INTEGER_INPUTS if k not in varying])
+            except _FMI_CALL_ERRORS:  # a value every case shares is refused: no case can be evaluated
+                out = _empty_outputs(n)
+                return {k: v for k, v in out.items() if k in real_names or k in bool_names or k == "ok"}
         var_real = [k for k in reals if k in varying]
         var_int = [k for k in INTEGER_INPUTS if k in varying]
         vr_real = [self.vr[k] for k in var_real]
         vr_int = [self.vr[k] for k in var_int]
         real_rows = np.stack([columns[k] for k in var_real], axis=1).tolist() if var_real else None
         int_rows = np.stack([columns[k] for k in var_int], axis=1).astype(int).tolist() if var_int else None
-        real_names = [k for k in _REAL_OUT if outputs is None or k in outputs or k == "e"]
-        bool_names = [k for k in _BOOL_OUT if outputs is None or k in outputs]
         real_vrs = [self.vr[k] for k in real_names]
         bool_vrs = [self.vr[k] for k in bool_names]
         real_out = np.empty((n, len(real_vrs)))
         bool_out = np.empty((n, len(bool_vrs)), dtype=bool)
         get_real, get_bool, set_real, set_int = s.getReal, s.getBoolean, s.setReal, s.setInteger
+        check = _INTERRUPT_CHECK  # serial runs: Ctrl-C taken between FMU calls, not at the chunk's end
         for i in range(n):
-            if real_rows is not None:
-                set_real(vr_real, real_rows[i])
-            if int_rows is not None:
-                set_int(vr_int, int_rows[i])
+            if check is not None:
+                check()
+            if self.doomed is not None:  # released meanwhile: the chunk was cancelled, stop between calls
+                raise RuntimeError("the sweep was cancelled: FMU instance released")
+            try:
+                if real_rows is not None:
+                    set_real(vr_real, real_rows[i])
+                if int_rows is not None:
+                    set_int(vr_int, int_rows[i])
+            except _FMI_CALL_ERRORS:
+                # The FMU refused a value of this case (fmi2Error, logged): the case is out of range,
+                # as an FMU that keeps the value and reads NaN reports it. The next case sets every
+                # varying input again.
+                real_out[i] = np.nan
+                bool_out[i] = False
+                continue
             real_out[i] = get_real(real_vrs)
             if bool_vrs:
                 bool_out[i] = get_bool(bool_vrs)
@@ -241,6 +286,17 @@ class _LoadedFmu:
                 pass
             self.slave = None
 
+
+def _fmi_call_errors() -> tuple:
+    try:
+        from fmpy.fmi1 import FMICallException
+    except ImportError:  # fmpy without it: only our own errors are caught
+        return ()
+    return (FMICallException,)
+
+
+#: What fmpy raises when an FMI call returns fmi2Error (a refused value).
+_FMI_CALL_ERRORS = ()
 
 _CALLBACKS = None
 
@@ -325,17 +381,36 @@ def _instance(payload) -> _LoadedFmu:
 
 
 def release_fmus() -> int:
-    """Free every FMU instance this process holds and delete their extracted files; the count freed."""
+    """Free every FMU instance this process holds and delete their extracted files; the count freed.
+
+    An instance evaluating a chunk in another thread (a task that was cancelled but still runs:
+    Dask cannot stop a running task) is freed by that thread when the chunk returns, never under it."""
     with _LOCK:
         instances = list(_INSTANCES.values())
         _INSTANCES.clear()
-        dirs = [own for _unzip, own in _EXTRACTED.values()]
+        extracted = list(_EXTRACTED.values())
         _EXTRACTED.clear()
-    for inst in instances:
+        busy = [inst for inst in instances if inst.busy]
+        idle = [inst for inst in instances if not inst.busy]
+        for inst in instances:  # from now on evaluate() refuses them
+            inst.doomed = ""
+        dirs = []
+        for unzip, own in extracted:
+            user = next((inst for inst in busy if inst.unzip_dir == unzip), None)
+            if user is None:
+                dirs.append(own)
+            else:  # removed when that chunk returns
+                user.doomed = own
+    for inst in idle:
         inst.close()
-    for d in dirs:
-        shutil.rmtree(d, ignore_errors=True)
+    for own in dirs:
+        shutil.rmtree(own, ignore_errors=True)
     return len(instances)
+
+
+#: Set by a serial sweep (restitution.sweep.run) to its DeferredInterrupt's check: the FMU back end
+#: calls it between cases, so Ctrl-C ends the chunk between two FMU calls without waiting for it.
+_INTERRUPT_CHECK = None
 
 
 atexit.register(release_fmus)
@@ -374,6 +449,28 @@ class FmuBackend(Backend):
 
     def describe(self) -> str:
         return f"fmu ({self.path.name}, sha256 {self.sha[:12]})"
+
+
+def check_impact_fmu(path, option: str = "--fmu") -> Path:
+    """``path`` if it is a SpherePlateImpact FMU (a file, an FMU archive, with every input and output
+    a sweep or a scene uses); else ValueError, one line naming ``option`` and the path."""
+    path = Path(path)
+    if not path.is_file():
+        raise ValueError(f"{option} {path}: {'not a file' if path.exists() else 'no such file'}")
+    try:
+        from fmpy import read_model_description
+
+        md = read_model_description(str(path))
+    except Exception as exc:  # noqa: BLE001 - whatever the archive is, it is not an FMU we can read
+        raise ValueError(f"{option} {path}: not an FMU ({type(exc).__name__}: {exc})") from None
+    names = {v.name for v in md.modelVariables}
+    missing = [name for name, _kw, _t, _s in INPUTS if name not in names]
+    missing += [name for name, _f, _t in OUTPUTS if name not in names]
+    if missing or md.coSimulation is None:
+        what = f"no variable(s) {', '.join(missing[:4])}{' ...' if len(missing) > 4 else ''}" if missing else \
+            "no co-simulation interface"
+        raise ValueError(f"{option} {path}: not a SpherePlateImpact FMU ({md.modelName}: {what})")
+    return path
 
 
 def get_backend(name: str = "package", fmu=None) -> Backend:

@@ -14,7 +14,9 @@ With ``parts=DIR`` every finished chunk is written to DIR as it completes (one `
 chunk, written under a temporary name and renamed, so a file there is always whole), beside a
 ``manifest.json`` naming the spec, back end, chunk size and columns. An interrupt (Ctrl-C) then
 raises :class:`SweepInterrupted` carrying the table of the finished chunks, and
-``resume=True`` on the same DIR evaluates only the chunks that are missing.
+``resume=True`` on the same DIR evaluates only the chunks that are missing. With
+``in_memory=False`` as well, nothing but counts stays in memory: the result's :meth:`~SweepResult.write`
+streams the table from DIR chunk by chunk (for tables bigger than the memory budget, see :func:`plan_size`).
 """
 from __future__ import annotations
 
@@ -34,13 +36,22 @@ import numpy as np
 
 from ..cosim.interrupt import DeferredInterrupt
 from .backends import Backend, FmuBackend, code_fingerprint, get_backend, release_fmus
-from .spec import INPUT_NAMES, INTEGER_INPUTS, OUTPUT_NAMES, OUTPUTS as _OUTPUT_TYPES, T_OVER_D, SweepSpec
+from .spec import INPUT_NAMES, INTEGER_INPUTS, OUTPUT_NAMES, OUTPUTS as _OUTPUT_TYPES, T_OVER_D, SizeError, SweepSpec
 
-__all__ = ["run_sweep", "SweepResult", "SweepInterrupted", "open_client", "machine_workers", "compare_results",
-           "COLUMNS", "table_bytes", "memory_budget", "check_memory"]
+__all__ = ["run_sweep", "SweepResult", "DiskSweepResult", "SweepInterrupted", "ResumeError", "open_client",
+           "machine_workers", "compare_results", "COLUMNS", "VALIDITY", "table_bytes", "memory_budget", "check_memory", "plan_size", "SizePlan", "SizeError"]
 
 #: Column order of a result table.
 COLUMNS = ("case", "pair", *INPUT_NAMES, T_OVER_D, *OUTPUT_NAMES, "ok")
+#: Validity columns every table keeps, whatever ``columns`` asks for (with ``case``, ``pair`` and ``ok``).
+VALIDITY = ("valid", "jgm.in_range", "zener.in_range")
+_ALWAYS = ("case", "pair", *VALIDITY, "ok")
+#: Rows converted to text at a time when a table is written as CSV (bounds the memory it takes).
+CSV_BLOCK = 65_536
+
+
+class ResumeError(ValueError):
+    """``resume=True`` on the finished chunks of another sweep (spec, back end, chunk size or columns)."""
 
 
 class SweepInterrupted(KeyboardInterrupt):
@@ -62,6 +73,17 @@ def table_bytes(n_cases: int, columns=None) -> int:
     return int(n_cases) * per_case
 
 
+def output_bytes(n_cases: int, columns=None, suffix: str = ".csv", label: int = 40) -> int:
+    """Upper estimate of the size of the written table: CSV text (a float's repr is at most 24
+    characters, ``label`` characters for the pair) or Parquet (about the table in memory). Python ints."""
+    if suffix.lower() == ".parquet":
+        return table_bytes(n_cases, columns)
+    names = COLUMNS if columns is None else [c for c in COLUMNS if c in columns]
+    booleans = {"ok", *(name for name, _, vtype in _OUTPUT_TYPES if vtype == "Boolean")}
+    per_case = sum(6 if name in booleans else label + 1 if name == "pair" else 25 for name in names)
+    return int(n_cases) * per_case
+
+
 def memory_budget(fraction: float = 0.5) -> int:
     """Default memory budget of a sweep table [bytes]: ``fraction`` of the memory available now
     (MemAvailable on Linux, else of the physical memory)."""
@@ -79,15 +101,65 @@ def memory_budget(fraction: float = 0.5) -> int:
     return int(available * fraction)
 
 
+@dataclass
+class SizePlan:
+    """Where a sweep's table goes: in memory (``stream`` false) or streamed to disk chunk by chunk."""
+
+    n_cases: int
+    memory: int  #: bytes the table(s) take in memory
+    budget: int  #: the memory budget [bytes]
+    stream: bool = False  #: over the budget, but fits on disk: kept on disk, never gathered
+    disk: int = 0  #: bytes needed on disk when streaming (finished chunks + the written table)
+    disk_free: int = 0  #: bytes free where the table is written
+
+    def describe(self) -> str:
+        text = f"the table would take {_bytes(self.memory)} in memory"
+        if not self.stream:
+            text += f", within the memory budget of {_bytes(self.budget)}"
+        else:
+            text += (f", over the memory budget of {_bytes(self.budget)}: it is streamed to disk chunk by chunk "
+                     f"(needs {_bytes(self.disk)} on disk, {_bytes(self.disk_free)} free) and never gathered")
+        return text
+
+
 def check_memory(spec: SweepSpec, columns=None, budget: int | None = None, backends: int = 1) -> int:
-    """Bytes the table(s) will take; ValueError with the numbers when above ``budget``
-    (default :func:`memory_budget`). Called before any work."""
+    """Bytes the table(s) will take; :class:`SizeError` with the numbers when above ``budget``
+    (default :func:`memory_budget`) or when an axis is too long to build. Called before any work."""
+    spec.check_axes()
+    return plan_size(spec, columns, budget, backends=backends).memory
+
+
+def plan_size(spec: SweepSpec, columns=None, budget: int | None = None, backends: int = 1, out=None,
+              parts=None) -> SizePlan:
+    """The size guard, from the axis sizes alone (nothing is built): a :class:`SizePlan`, or
+    :class:`SizeError` with the numbers. A table over the memory budget (default
+    :func:`memory_budget`) is streamed to disk when ``out`` (the table's path) is given, one back
+    end runs and the finished chunks plus the written table fit in the free space there."""
     need = backends * table_bytes(spec.n_cases, columns)
     budget = memory_budget() if budget is None else int(budget)
-    if need > budget:
-        raise ValueError(f"the table of {spec.n_cases:,} cases would take {_bytes(need)}, over the memory budget "
-                         f"of {_bytes(budget)}: sweep fewer cases, keep fewer --columns, or raise --memory-budget")
-    return need
+    plan = SizePlan(spec.n_cases, need, budget)
+    if need <= budget:
+        return plan
+    refused = (f"the table of {spec.n_cases:,} cases would take {_bytes(need)}, over the memory budget "
+               f"of {_bytes(budget)}")
+    advice = "sweep fewer cases, keep fewer --columns, or raise --memory-budget"
+    if out is None:
+        raise SizeError(f"{refused}: {advice}")
+    if backends > 1:
+        raise SizeError(f"{refused}; --backend both compares the two tables in memory: {advice}, "
+                        f"or run each back end on its own")
+    out = Path(out)
+    where = next((d for d in (out.parent.resolve(), *out.parent.resolve().parents) if d.exists()), Path("/"))
+    free = shutil.disk_usage(where).free
+    disk = table_bytes(spec.n_cases, columns) + output_bytes(
+        spec.n_cases, columns, out.suffix, label=max([len(p) for p in spec.pairs] + [0]))
+    if parts is not None and Path(parts).exists():  # resuming: what is there already counts as free
+        free += sum(f.stat().st_size for f in Path(parts).rglob("*") if f.is_file())
+    if disk > free:
+        raise SizeError(f"{refused}, and streamed to disk it would need {_bytes(disk)} in {where} "
+                        f"({_bytes(free)} free): {advice}")
+    plan.stream, plan.disk, plan.disk_free = True, disk, free
+    return plan
 
 
 def _bytes(n: int) -> str:
@@ -132,10 +204,33 @@ def open_client(scheduler=None, n_workers: int | None = None, threads_per_worker
     kwargs = dict(n_workers=n_workers or machine_workers(), threads_per_worker=threads_per_worker,
                   processes=True, dashboard_address=None, silence_logs=logging.ERROR)
     kwargs.update(cluster_kwargs)
-    with _without_fmu_resources_on_sys_path():  # the workers start with this process's sys.path
+    # the workers start with this process's sys.path, and ignoring Ctrl-C (see _workers_ignore_sigint)
+    with _without_fmu_resources_on_sys_path(), _workers_ignore_sigint():
         cluster = LocalCluster(**kwargs)
     with cluster, Client(cluster) as client:
         yield client
+
+
+@contextlib.contextmanager
+def _workers_ignore_sigint():
+    """SIGINT ignored while a LocalCluster spawns its worker processes, which keep that disposition.
+
+    Ctrl-C in a terminal reaches every process of the foreground group: the workers' event loops
+    would die with a KeyboardInterrupt traceback each, and an FMU back end's worker would take it
+    inside an FMU call (fmi2Fatal). The client process alone takes Ctrl-C: it cancels the tasks,
+    keeps the finished chunks and closes the cluster, which stops the workers. A Ctrl-C during
+    these start-up seconds is ignored (press it again once the sweep runs)."""
+    import signal
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
 
 
 @contextlib.contextmanager
@@ -164,7 +259,20 @@ def _run_chunk(start: int, stop: int, spec: SweepSpec, backend: Backend, payload
     cases.update(outputs)
     if keep is not None:
         cases = {k: v for k, v in cases.items() if k in keep}
+    info["counts"] = _counts(cases)
     return cases, info
+
+
+def _counts(columns: dict) -> dict:
+    """Cases, evaluated cases (``ok``), cases inside the validated ranges (``valid``) and evaluated
+    cases outside each range (``valid``, ``jgm.in_range``, ``zener.in_range`` false), as ints."""
+    n = int(np.size(columns["case"]))
+    ok = np.asarray(columns["ok"], dtype=bool) if "ok" in columns else np.ones(n, dtype=bool)
+    counts = {"cases": n, "ok": int(np.count_nonzero(ok)),
+              "inside": int(np.count_nonzero(columns["valid"])) if "valid" in columns else n}
+    for flag in VALIDITY:
+        counts[flag] = int(np.count_nonzero(ok & ~np.asarray(columns[flag], dtype=bool))) if flag in columns else 0
+    return counts
 
 
 @dataclass
@@ -193,26 +301,26 @@ class SweepResult:
     def cases_per_second(self) -> float:
         return len(self) / self.elapsed if self.elapsed > 0 else math.inf
 
+    def counts(self) -> dict:
+        """``cases``, ``ok`` (evaluated), ``inside`` (``valid``: inside the validated ranges), and per
+        flag (``valid``, ``jgm.in_range``, ``zener.in_range``) the evaluated cases outside it."""
+        return _counts(self.columns)
+
     def summary(self) -> str:
+        c = self.counts()
         text = (f"{len(self)} cases with the {self.backend} back end on {self.scheduler} "
                 f"({self.n_workers} worker(s), {self.n_chunks} chunk(s)): {self.elapsed:.3g} s, "
                 f"{self.cases_per_second:,.0f} cases/s")
-        if "ok" in self.columns:
-            ok = int(np.count_nonzero(self.columns["ok"]))
-            text += f"; {ok} evaluated, {len(self) - ok} with inputs out of range"
-        if "valid" in self.columns:
-            text += f"; {int(np.count_nonzero(self.columns['valid']))} inside the models' validated ranges"
-            counts = self.out_of_range()
-            text += (f" ({counts['valid']} outside: {counts['jgm.in_range']} beyond JGM's V* <= 1000, "
-                     f"{counts['zener.in_range']} beyond Zener's lambda <= 1.5)")
+        text += f"; {c['ok']} evaluated, {c['cases'] - c['ok']} with inputs out of range"
+        text += (f"; {c['inside']} inside the models' validated ranges ({c['valid']} outside: "
+                 f"{c['jgm.in_range']} beyond JGM's V* <= 1000, {c['zener.in_range']} beyond Zener's lambda <= 1.5)")
         return text
 
     def out_of_range(self) -> dict:
         """Evaluated cases (``ok``) outside the validated ranges, per flag (``valid``,
-        ``jgm.in_range``, ``zener.in_range``; flags not kept in the table count 0)."""
-        ok = np.asarray(self.columns["ok"], dtype=bool) if "ok" in self.columns else np.ones(len(self), bool)
-        return {flag: int(np.count_nonzero(ok & ~np.asarray(self.columns[flag], dtype=bool)))
-                if flag in self.columns else 0 for flag in ("valid", "jgm.in_range", "zener.in_range")}
+        ``jgm.in_range``, ``zener.in_range``)."""
+        c = self.counts()
+        return {flag: c[flag] for flag in VALIDITY}
 
     def warning(self) -> str | None:
         """A one-line warning when any evaluated case lies outside the validated ranges, else None."""
@@ -225,31 +333,21 @@ class SweepResult:
 
     # --- output ---
     def write(self, path) -> Path:
-        """Write the table: ``.parquet`` (needs pyarrow) or ``.csv``."""
-        path = Path(path)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        if path.suffix.lower() == ".parquet":
-            return self.to_parquet(path)
-        return self.to_csv(path)
+        """Write the table: ``.parquet`` (needs pyarrow) or ``.csv``, under a temporary name renamed
+        when whole (an interrupted write leaves no half table)."""
+        return _write_atomic(Path(path), lambda tmp: self._write_to(tmp, Path(path).suffix))
+
+    def _write_to(self, path: Path, suffix: str) -> None:
+        if suffix.lower() == ".parquet":
+            self.to_parquet(path)
+        else:
+            self.to_csv(path)
 
     def to_csv(self, path) -> Path:
         path = Path(path)
-        names = list(self.columns)
-        cols = []
-        for name in names:
-            col = self.columns[name]
-            if col.dtype == bool:
-                cols.append(np.where(col, "True", "False"))
-            elif col.dtype.kind in "iu":
-                cols.append(col.astype(str))
-            elif col.dtype.kind == "f":
-                cols.append(np.array([repr(float(x)) for x in col.tolist()], dtype=object))
-            else:
-                cols.append(np.array([_csv_text(x) for x in col.tolist()], dtype=object))
         with open(path, "w", encoding="utf-8", newline="") as f:
-            f.write(",".join(names) + "\n")
-            for row in zip(*cols):
-                f.write(",".join(row) + "\n")
+            f.write(",".join(self.columns) + "\n")
+            _write_csv_rows(f, self.columns)
         return path
 
     def to_parquet(self, path) -> Path:
@@ -279,6 +377,106 @@ class SweepResult:
 def _csv_text(x) -> str:
     text = str(x)
     return f'"{text}"' if ("," in text or '"' in text) else text
+
+
+def _write_csv_rows(f, columns: dict) -> None:
+    """The rows of ``columns`` as CSV text, :data:`CSV_BLOCK` rows at a time (the text of a whole
+    table would take many times its memory)."""
+    names = list(columns)
+    n = int(np.size(columns[names[0]])) if names else 0
+    for lo in range(0, n, CSV_BLOCK):
+        hi = min(lo + CSV_BLOCK, n)
+        cols = []
+        for name in names:
+            col = columns[name][lo:hi]
+            if col.dtype == bool:
+                cols.append(np.where(col, "True", "False").tolist())
+            elif col.dtype.kind in "iu":
+                cols.append(col.astype(str).tolist())
+            elif col.dtype.kind == "f":
+                cols.append([repr(x) for x in col.tolist()])
+            else:
+                cols.append([_csv_text(x) for x in col.tolist()])
+        f.write("".join(",".join(row) + "\n" for row in zip(*cols)))
+
+
+def _write_atomic(path: Path, write) -> Path:
+    """``write(tmp)`` to a temporary file beside ``path``, then renamed to ``path``."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(f".{path.name}.tmp{os.getpid()}")
+    try:
+        write(tmp)
+        os.replace(tmp, path)
+    finally:
+        with contextlib.suppress(OSError):
+            tmp.unlink()
+    return path
+
+
+@dataclass
+class DiskSweepResult(SweepResult):
+    """A sweep whose table stays on disk, in its finished chunks (``run_sweep(..., in_memory=False)``):
+    the counts are known, :meth:`write` streams the table chunk by chunk; ``columns`` is empty."""
+
+    parts: Path | None = None  #: the directory of the finished chunks
+    chunk_counts: dict = field(default_factory=dict)  #: chunk start -> counts
+
+    def __len__(self):
+        return sum(c["cases"] for c in self.chunk_counts.values())
+
+    def __getitem__(self, name):
+        raise KeyError(f"{name!r}: this sweep's table is on disk ({self.parts}), not in memory; write() it")
+
+    def counts(self) -> dict:
+        total = {k: 0 for k in ("cases", "ok", "inside", *VALIDITY)}
+        for c in self.chunk_counts.values():
+            for k in total:
+                total[k] += c[k]
+        return total
+
+    def _write_to(self, path: Path, suffix: str) -> None:
+        store = _PartStore(self.parts)
+        keep = self.info.get("keep")
+        starts = sorted(self.chunk_counts)
+        if suffix.lower() == ".parquet":
+            import pyarrow as pa
+            import pyarrow.parquet as pq
+
+            writer = None
+            try:
+                for a in starts:
+                    cols = _assemble(self.spec, [store.read(a)[0]], keep)
+                    table = pa.table({k: (v.tolist() if v.dtype == object else v) for k, v in cols.items()})
+                    if writer is None:
+                        writer = pq.ParquetWriter(path, table.schema)
+                    writer.write_table(table)
+                if writer is None:  # no chunk finished: an empty table with the columns
+                    cols = _assemble(self.spec, [], keep)
+                    pq.write_table(pa.table({k: v.tolist() for k, v in cols.items()}), path)
+            finally:
+                if writer is not None:
+                    writer.close()
+            return
+        names = [c for c in COLUMNS if keep is None or c in keep]
+        with open(path, "w", encoding="utf-8", newline="") as f:
+            f.write(",".join(names) + "\n")
+            for a in starts:
+                _write_csv_rows(f, _assemble(self.spec, [store.read(a)[0]], keep))
+
+    def to_csv(self, path) -> Path:
+        self._write_to(Path(path), ".csv")
+        return Path(path)
+
+    def to_parquet(self, path) -> Path:
+        self._write_to(Path(path), ".parquet")
+        return Path(path)
+
+    def to_pandas(self):
+        raise RuntimeError(f"this sweep's table is on disk ({self.parts}), too big for memory; write() it")
+
+    def plot(self, path, **kwargs) -> Path:
+        raise RuntimeError("no COR map for a sweep streamed to disk: its table does not fit in memory "
+                           "(plot a smaller sweep, or from the written table)")
 
 
 def read_table(path) -> dict:
@@ -343,11 +541,15 @@ def _chunks(n: int, chunk_size: int):
 
 
 def _assemble(spec: SweepSpec, parts, keep) -> dict:
+    """The table from the chunks' columns (consumed: each column of the chunks is freed once joined,
+    so the peak is the table plus one column, not twice the table)."""
     names = [c for c in COLUMNS if keep is None or c in keep]
     if parts:
-        columns = {name: np.concatenate([p[name] for p in parts]) for name in names}
+        columns = {name: np.concatenate([p.pop(name) for p in parts]) for name in names}
     else:
-        columns = {name: np.empty(0) for name in names}
+        booleans = {"ok", *(n for n, _f, t in _OUTPUT_TYPES if t == "Boolean")}
+        columns = {name: np.empty(0, dtype=bool if name in booleans else np.int64 if name == "case" else float)
+                   for name in names}
     labels = np.array(list(spec.pairs) + [""], dtype=object)
     columns["pair"] = labels[np.asarray(columns["pair"], dtype=np.int64)]
     for name in INTEGER_INPUTS:
@@ -362,12 +564,13 @@ def _keep(columns):
     unknown = set(columns) - set(COLUMNS)
     if unknown:
         raise ValueError(f"unknown column(s) {sorted(unknown)}; the table has {', '.join(COLUMNS)}")
-    return frozenset(("case", "pair", *columns))
+    return frozenset((*_ALWAYS, *columns))  # validity travels with every row
 
 
 def run_sweep(spec: SweepSpec | dict, backend: str | Backend = "package", *, fmu=None, scheduler=None,
               n_workers: int | None = None, chunk_size: int | None = None, progress: bool = False,
-              columns=None, release: bool = True, parts=None, resume: bool = False) -> SweepResult:
+              columns=None, release: bool = True, parts=None, resume: bool = False,
+              in_memory: bool = True) -> SweepResult:
     """Evaluate every case of ``spec`` and return the table.
 
     ``backend``: "package" (vectorized :func:`restitution.impact`) or "fmu" (the FMU at ``fmu``,
@@ -378,65 +581,65 @@ def run_sweep(spec: SweepSpec | dict, backend: str | Backend = "package", *, fmu
     ``chunk_size``: cases per task (default: the back end's, at most a quarter of each worker's
     share so the work spreads and progress moves). ``progress``: a progress line on stderr
     (redrawn in a terminal; elsewhere only the final state). ``columns``: keep only these
-    columns (besides ``case`` and ``pair``), for sweeps whose full table would be too big to
-    gather. ``release=False`` keeps the FMU instances loaded in the workers for the next sweep
-    (free them with ``client.run(release_fmus)``). ``parts``: directory where each finished chunk
-    is written as it completes; ``resume=True`` keeps the chunks already there (same spec, back
-    end, chunk size and columns) and evaluates only the missing ones. An interrupt raises
+    columns (besides ``case``, ``pair``, ``ok`` and the validity flags, which every table has), for
+    sweeps whose full table would be too big to gather. ``release=False`` keeps the FMU instances
+    loaded in the workers for the next sweep (free them with ``client.run(release_fmus)``).
+    ``parts``: directory where each finished chunk is written as it completes; ``resume=True``
+    keeps the chunks already there (same spec, back end, chunk size and columns) and evaluates
+    only the missing ones. ``in_memory=False`` (needs ``parts``): the chunks are not gathered, a
+    :class:`DiskSweepResult` streams the table from ``parts`` when written. An interrupt raises
     :class:`SweepInterrupted` with the finished chunks' table.
     """
     if isinstance(spec, dict):
         spec = SweepSpec.from_dict(spec)
+    if not in_memory and parts is None:
+        raise ValueError("in_memory=False keeps the table on disk: give parts=DIR")
+    spec.check_axes()
     backend = get_backend(backend, fmu)
     n = spec.n_cases
     keep = _keep(columns)
     store = None if parts is None else _PartStore(Path(parts))
+    run = _Run(spec, backend, keep, store, in_memory)
 
     if scheduler == "serial":
         chunk_size = _chunk_size(store, resume, chunk_size or backend.default_chunk)
         chunks = _chunks(n, chunk_size)
-        done = store.open(spec, backend, chunk_size, keep, resume) if store else {}
+        run.open(chunk_size, resume, len(chunks), "this process (serial)", 1)
         payload = backend.local_payload() if isinstance(backend, FmuBackend) else backend.payload()
         bar = _Progress(len(chunks), progress, "serial")
-        bar.update(len(done))
-        t0 = time.perf_counter()
-        # an FMU in this process: Ctrl-C waits for the chunk's FMU calls to return
+        bar.update(len(run.done))
+        # an FMU in this process: Ctrl-C is taken between two FMU calls, never inside one
         deferred = DeferredInterrupt() if isinstance(backend, FmuBackend) else contextlib.nullcontext()
         try:
-            with deferred:
+            with deferred, _fmu_interrupt_check(deferred):
                 for a, b in chunks:
-                    if a in done:
+                    if a in run.done:
                         continue
-                    done[a] = _run_chunk(a, b, spec, backend, payload, keep)
-                    if store:
-                        store.write(a, b, done[a])
-                    bar.update(len(done))
+                    run.finished(a, b, _run_chunk(a, b, spec, backend, payload, keep))
+                    bar.update(len(run.done))
                     if isinstance(deferred, DeferredInterrupt):
                         deferred.check()
         except KeyboardInterrupt:
-            bar.close(len(done))
-            raise _interrupted(spec, backend, done, "this process (serial)", 1, time.perf_counter() - t0,
-                               len(chunks), keep, n) from None
+            bar.close(len(run.done))
+            raise run.interrupted() from None
         finally:
             if isinstance(backend, FmuBackend) and release:
                 release_fmus()
-        bar.close(len(done))
-        elapsed = time.perf_counter() - t0
-        return _result(spec, backend, _ordered(done), "this process (serial)", 1, elapsed, len(chunks), keep)
+        bar.close(len(run.done))
+        return run.result()
 
     with open_client(scheduler, n_workers) as client:
         workers = _count_workers(client)
-        where = _describe_client(client, scheduler)
         if chunk_size is None:
             chunk_size = max(1, min(backend.default_chunk, math.ceil(n / (4 * workers))))
         chunk_size = _chunk_size(store, resume, chunk_size)
         chunks = _chunks(n, chunk_size)
-        done = store.open(spec, backend, chunk_size, keep, resume) if store else {}
-        todo = [(a, b) for a, b in chunks if a not in done]
+        run.open(chunk_size, resume, len(chunks), _describe_client(client, scheduler), workers)
+        todo = [(a, b) for a, b in chunks if a not in run.done]
         bar = _Progress(len(chunks), progress, "dask")
-        bar.update(len(done))
-        t0 = time.perf_counter()
+        bar.update(len(run.done))
         futures = []
+        payload = None
         try:
             payload = backend.payload()
             if payload is not None and todo:
@@ -448,35 +651,74 @@ def run_sweep(spec: SweepSpec | dict, backend: str | Backend = "package", *, fmu
             bounds = {f.key: ab for f, ab in zip(futures, todo)}
             for future in as_completed(futures):
                 a, b = bounds[future.key]
-                done[a] = future.result()
-                if store:
-                    store.write(a, b, done[a])
+                run.finished(a, b, future.result())
                 future.release()
-                bar.update(len(done))
+                bar.update(len(run.done))
         except KeyboardInterrupt:
-            bar.close(len(done))
+            bar.close(len(run.done))
             with contextlib.suppress(Exception):
                 client.cancel(futures)
-            raise _interrupted(spec, backend, done, where, workers, time.perf_counter() - t0, len(chunks),
-                               keep, n) from None
+            raise run.interrupted() from None
         finally:
             with contextlib.suppress(Exception):
                 client.cancel(futures)
             if isinstance(backend, FmuBackend) and release:
                 with contextlib.suppress(Exception):
-                    client.run(release_fmus)
-        bar.close(len(done))
-        elapsed = time.perf_counter() - t0
-        return _result(spec, backend, _ordered(done), where, workers, elapsed, len(chunks), keep)
+                    client.run(release_fmus)  # an instance still busy with a cancelled chunk is freed after it
+            if hasattr(payload, "release"):
+                with contextlib.suppress(Exception):
+                    client.cancel([payload])
+        bar.close(len(run.done))
+        return run.result()
 
 
-def _ordered(done: dict) -> list:
-    return [done[a] for a in sorted(done)]
+class _Run:
+    """The finished chunks of one run: in memory (start -> (columns, info)), or on disk only
+    (start -> (None, info)) when ``in_memory`` is false; written to ``store`` as they finish."""
+
+    def __init__(self, spec, backend, keep, store, in_memory: bool):
+        self.spec, self.backend, self.keep, self.store, self.in_memory = spec, backend, keep, store, in_memory
+        self.done = {}
+
+    def open(self, chunk_size, resume, n_chunks, where, workers):
+        self.n_chunks, self.where, self.workers = n_chunks, where, workers
+        if self.store is not None:
+            self.done = self.store.open(self.spec, self.backend, chunk_size, self.keep, resume,
+                                        load_columns=self.in_memory)
+        self.t0 = time.perf_counter()
+
+    def finished(self, a, b, part):
+        if self.store is not None:
+            self.store.write(a, b, part)
+        self.done[a] = part if self.in_memory else (None, part[1])
+
+    def result(self) -> SweepResult:
+        elapsed = time.perf_counter() - self.t0
+        results = [self.done[a] for a in sorted(self.done)]
+        if self.in_memory:
+            return _result(self.spec, self.backend, results, self.where, self.workers, elapsed, self.n_chunks,
+                           self.keep)
+        return _disk_result(self.spec, self.backend, self.done, self.where, self.workers, elapsed, self.n_chunks,
+                            self.keep, self.store.path)
+
+    def interrupted(self) -> "SweepInterrupted":
+        result = self.result()
+        return SweepInterrupted(result, self.spec.n_cases - len(result))
 
 
-def _interrupted(spec, backend, done, where, workers, elapsed, n_chunks, keep, n) -> SweepInterrupted:
-    result = _result(spec, backend, _ordered(done), where, workers, elapsed, n_chunks, keep)
-    return SweepInterrupted(result, n - len(result))
+@contextlib.contextmanager
+def _fmu_interrupt_check(deferred):
+    """The FMU back end checks ``deferred`` between cases while it is in force (serial runs)."""
+    from . import backends
+
+    if not isinstance(deferred, DeferredInterrupt):
+        yield
+        return
+    backends._INTERRUPT_CHECK = deferred.check
+    try:
+        yield
+    finally:
+        backends._INTERRUPT_CHECK = None
 
 
 def _chunk_size(store, resume: bool, chunk_size: int) -> int:
@@ -500,14 +742,15 @@ class _PartStore:
         except (OSError, ValueError):
             return None
 
-    def open(self, spec, backend, chunk_size, keep, resume: bool) -> dict:
-        """Chunks already finished (``resume``; start -> (columns, info)), after checking that
-        they belong to this sweep; without ``resume``, an empty directory."""
+    def open(self, spec, backend, chunk_size, keep, resume: bool, load_columns: bool = True) -> dict:
+        """Chunks already finished (``resume``; start -> (columns, info), columns None unless
+        ``load_columns``), after checking that they belong to this sweep; without ``resume``, an
+        empty directory."""
         manifest = {"spec": spec.as_dict(), "backend": backend.name, "chunk_size": int(chunk_size),
                     "n_cases": int(spec.n_cases), "columns": None if keep is None else sorted(keep)}
         old = self.manifest() if resume else None
         if old is not None and old != json.loads(json.dumps(manifest)):
-            raise ValueError(f"--resume: the finished chunks in {self.path} belong to another sweep "
+            raise ResumeError(f"--resume: the finished chunks in {self.path} belong to another sweep "
                              f"(spec, back end or columns differ); run without --resume to start over")
         if old is None and self.path.exists():
             shutil.rmtree(self.path)
@@ -516,12 +759,22 @@ class _PartStore:
             self._write_text("manifest.json", json.dumps(manifest, indent=1))
         done = {}
         for file in sorted(self.path.glob("chunk-*.npz")):
-            a, b = (int(x) for x in file.stem.split("-")[1:3])
-            with np.load(file, allow_pickle=False) as z:
-                columns = {k[2:]: z[k] for k in z.files if k.startswith("c:")}
-                info = json.loads(str(z["info"]))
-            done[a] = (columns, info)
+            a = int(file.stem.split("-")[1])
+            done[a] = self.read(a, file, load_columns)
         return done
+
+    def _file(self, a: int) -> Path:
+        return next(self.path.glob(f"chunk-{a:015d}-*.npz"))
+
+    def read(self, a: int, file: Path | None = None, load_columns: bool = True):
+        """(columns or None, info) of the chunk starting at case ``a``."""
+        with np.load(file or self._file(a), allow_pickle=False) as z:
+            info = json.loads(str(z["info"]))
+            columns = None
+            if load_columns or "counts" not in info:
+                columns = {k[2:]: z[k] for k in z.files if k.startswith("c:")}
+                info.setdefault("counts", _counts(columns))
+        return (columns if load_columns else None), info
 
     def write(self, a: int, b: int, part) -> None:
         columns, info = part
@@ -578,9 +831,7 @@ def _describe_client(client, scheduler) -> str:
     return f"the Dask scheduler at {client.scheduler.address}"
 
 
-def _result(spec, backend, results, where, workers, elapsed, n_chunks, keep) -> SweepResult:
-    parts = [r[0] for r in results]
-    infos = [r[1] for r in results]
+def _info(backend, infos) -> dict:
     codes = sorted({i["code"] for i in infos})
     info = {"code": codes, "processes": len({i["pid"] for i in infos}),
             "cpu_seconds": float(sum(i["cpu"] for i in infos)), "client_code": code_fingerprint()}
@@ -588,6 +839,20 @@ def _result(spec, backend, results, where, workers, elapsed, n_chunks, keep) -> 
         info["fmu_code_files"] = sorted({i["fmu_code_file"] for i in infos})
     if backend.name == "package" and codes and codes != [info["client_code"]]:
         warnings.warn(f"the workers ran restitution code {codes}, this process has {info['client_code']}: "
-                      f"install the same restitution on the workers", RuntimeWarning, stacklevel=3)
+                      f"install the same restitution on the workers", RuntimeWarning, stacklevel=4)
+    return info
+
+
+def _disk_result(spec, backend, done, where, workers, elapsed, n_chunks, keep, parts) -> "DiskSweepResult":
+    info = _info(backend, [done[a][1] for a in sorted(done)])
+    info["keep"] = keep
+    return DiskSweepResult(columns={}, spec=spec, backend=backend.describe(), scheduler=where, n_workers=workers,
+                           elapsed=elapsed, n_chunks=n_chunks, info=info, parts=Path(parts),
+                           chunk_counts={a: done[a][1]["counts"] for a in done})
+
+
+def _result(spec, backend, results, where, workers, elapsed, n_chunks, keep) -> SweepResult:
+    parts = [r[0] for r in results]
+    info = _info(backend, [r[1] for r in results])
     return SweepResult(columns=_assemble(spec, parts, keep), spec=spec, backend=backend.describe(), scheduler=where,
                        n_workers=workers, elapsed=elapsed, n_chunks=n_chunks, info=info)

@@ -26,7 +26,12 @@ import numpy as np
 from ..materials import MATERIALS, TABLE4_CASES, table4_case
 
 __all__ = ["SweepSpec", "INPUTS", "OUTPUTS", "CODES", "RANDOM_BLOCK", "canonical_name", "load_spec",
-           "parse_values", "parse_distribution", "resolve_pair"]
+           "parse_values", "parse_distribution", "resolve_pair", "SizeError"]
+
+
+class SizeError(ValueError):
+    """A sweep refused before any work by the size guard: an axis too long to build, or a table too
+    big for the memory budget and for the disk (the message gives the numbers)."""
 
 # (FMU name, impact() keyword, FMI type, start value): the FMU's inputs and parameters.
 INPUTS = (
@@ -181,6 +186,8 @@ def axis_size(name: str, spec) -> int:
         return max(0, math.ceil((stop - start) / step))
     if len(args) != 3 or int(args[2]) != args[2] or args[2] < 1:
         raise ValueError(f"{name}: {kind} needs [first, last, count] with an integer count >= 1")
+    if kind == "geomspace" and (args[0] == 0 or args[1] == 0 or (args[0] < 0) != (args[1] < 0)):
+        raise ValueError(f"{name}: geomspace needs first and last non-zero and of the same sign, got {args[:2]!r}")
     return int(args[2])
 
 
@@ -372,6 +379,14 @@ class SweepSpec:
                 raise ValueError(f"{k}: a relative draw needs a base value from the grid or fixed")
 
     # --- structure ---
+    def check_axes(self) -> None:
+        """:class:`SizeError` when an axis has more values than :data:`MAX_AXIS_VALUES` (each worker
+        builds the axes it draws its cases from), from the sizes alone."""
+        for k, size in self._axis_sizes.items():
+            if size > MAX_AXIS_VALUES:
+                raise SizeError(f"{k}: the axis has {size:,} values; at most {MAX_AXIS_VALUES:,} per axis "
+                                f"(each worker builds it): use a coarser axis or a random draw")
+
     @property
     def _axes(self) -> dict:
         if self._axes_built is None:
@@ -415,12 +430,16 @@ class SweepSpec:
 
     @classmethod
     def from_dict(cls, data: dict) -> "SweepSpec":
+        if not isinstance(data, dict):
+            raise ValueError(f"a sweep spec is a table (pairs, grid, random, fixed, samples, seed), "
+                             f"got {type(data).__name__}")
         data = dict(data)
         data.pop("run", None)  # run options (back end, scheduler, output) live beside the spec
         unknown = set(data) - {"pairs", "grid", "random", "fixed", "samples", "seed"}
         if unknown:
             raise ValueError(f"unknown sweep spec key(s) {sorted(unknown)}: "
                              f"use pairs, grid, random, fixed, samples, seed (and a [run] table)")
+        check_types(data)
         return cls(**data)
 
     # --- cases ---
@@ -498,6 +517,26 @@ class SweepSpec:
         if self._dists:
             bits.append(f"{self.samples:,} random sample(s) of {', '.join(self._dists)} per grid point")
         return f"{self.n_cases:,} cases: " + (", ".join(bits) if bits else "one case at the start values")
+
+
+def check_types(data: dict) -> None:
+    """ValueError (one line naming the key) unless ``pairs`` is a list of strings and ``grid``,
+    ``random``, ``fixed`` are tables keyed by parameter names."""
+    pairs = data.get("pairs", [])
+    if not isinstance(pairs, (list, tuple)) or not all(isinstance(p, str) for p in pairs):
+        raise ValueError(f"pairs = {pairs!r}: expected a list of 'sphere/plate' strings, "
+                         f"e.g. pairs = [\"s2_tool_steel/al_6061\"]")
+    for key in ("grid", "random", "fixed"):
+        table = data.get(key, {})
+        if not isinstance(table, dict):
+            raise ValueError(f"{key} = {table!r}: expected a table of parameter = value(s), e.g. [{key}] v_approach = ...")
+        for name, value in table.items():
+            if not isinstance(name, str):
+                raise ValueError(f"{key}: {name!r} is not a parameter name")
+            if isinstance(value, dict) and key != "fixed" and len(value) == 1:
+                continue  # a value range or a distribution: checked with its kind
+            if not isinstance(value, (str, int, float, list, tuple, dict)) or isinstance(value, bool):
+                raise ValueError(f"{key}.{name} = {value!r}: expected a number, a word, a list or a range")
 
 
 def load_spec(path) -> dict:
