@@ -1,7 +1,8 @@
 """Scenes lose nothing and flag what they extrapolate (issue 13): every finished drop on disk,
-Ctrl-C (SIGINT to a child process) writes what is done and exits 130, validity columns and
-counts, values the FMU would reject refused by the loader naming the key, one-line errors,
-progress output that behaves when redirected."""
+Ctrl-C (SIGINT to the child's process group, as a terminal sends it) writes what is done and exits
+130, validity columns and counts, values the FMU would reject refused by the loader naming the key
+(and a value an FMU refuses at run time reported the same way), one-line errors, progress output
+that behaves in a terminal and when redirected."""
 import csv
 import os
 import signal
@@ -9,10 +10,11 @@ import subprocess
 import sys
 import time
 import tomllib
+from dataclasses import replace
 
 import pytest
 
-from restitution.scene import SceneError, parse_scene
+from restitution.scene import SceneError, parse_scene, run_scene
 from restitution.scene.__main__ import main
 from restitution.scene.loader import MAX_BOUNCES
 
@@ -98,17 +100,53 @@ def test_cli_user_mistakes_are_one_line_errors(tmp_path, impact_fmu):
     a_file.write_text("x")
     good = tmp_path / "good.toml"
     good.write_text(scene_text())
-    for args, words in (((tmp_path / "missing.toml",), ["missing.toml", "cannot read"]),
-                        ((scene,), ["balls[0].diameter", "1e300 m"]),
-                        ((good, "--out", a_file), ["--out", "not a directory"]),
-                        ((good, "--out", a_file / "sub"), ["--out", "cannot write"])):
-        proc = _run_cli("run", *args, "--fmu", impact_fmu, "--no-plot")
+    latin1 = tmp_path / "latin1.toml"
+    latin1.write_bytes(scene_text().replace('name = "test"', 'name = "caf\u00e9"').encode("latin-1"))
+    out = tmp_path / "out"
+    fmu = ("--fmu", impact_fmu)
+    for args, words in (((tmp_path / "missing.toml", *fmu), ["missing.toml", "cannot read"]),
+                        ((scene, *fmu), ["balls[0].diameter", "1e300 m"]),
+                        ((latin1, *fmu), ["latin1.toml", "not UTF-8"]),
+                        ((good, *fmu, "--out", a_file), ["--out", "not a directory"]),
+                        ((good, *fmu, "--out", a_file / "sub"), ["--out", "cannot write"]),
+                        ((good, "--fmu", tmp_path / "missing.fmu", "--out", out), ["--fmu", "no such file"]),
+                        ((good, "--fmu", a_file, "--out", out), ["--fmu", "not an FMU"])):
+        proc = _run_cli("run", *args, "--no-plot")
         assert proc.returncode == 2, proc.stderr
         assert "Traceback" not in proc.stderr
         line, = proc.stderr.strip().splitlines()
         assert all(w in line for w in words), (words, line)
-    proc = _run_cli("report", good, "--repeat", "0")
-    assert proc.returncode == 2 and "--repeat" in proc.stderr and "Traceback" not in proc.stderr
+    assert not out.exists() or not any(out.iterdir())  # a bad --fmu is refused before anything is written
+    for args, words in (((good, "--repeat", "0"), ["--repeat"]),  # argparse: its usage line, then the error
+                        ((good, "--methods", "exact,bogus"), ["--methods", "'bogus'"]),
+                        ((good, "--out", tmp_path, "--fmu", impact_fmu), ["--out", "is a directory"]),
+                        ((good, "--out", a_file / "r.md", "--fmu", impact_fmu), ["--out", "not a directory"])):
+        proc = _run_cli("report", *args)  # refused before any scene runs
+        assert proc.returncode == 2, proc.stderr
+        assert "Traceback" not in proc.stderr
+        lines = proc.stderr.strip().splitlines()
+        assert len(lines) == 1 or lines[0].startswith("usage:"), proc.stderr
+        assert all(w in lines[-1] for w in words), (words, lines[-1])
+
+
+def test_a_value_the_fmu_refuses_names_the_scene_key(tmp_path, impact_fmu):
+    """The loader refuses what this FMU would; a scene built past the loader (or another FMU with a
+    narrower domain) meets the FMU's refusal, reported as the loader would, naming the key, with the
+    drops finished before it kept."""
+    scene = load(scene_text(heights='["0.1 m", "0.2 m"]'))
+    thin = replace(scene.plates[0], name="thin", thickness=-1.0)
+    ball = replace(scene.balls[0], plates=("plate", "thin"))
+    bad = replace(scene, plates=(scene.plates[0], thin), balls=(ball,))
+    done = []
+    with pytest.raises(SceneError) as info:
+        run_scene(bad, fmu=impact_fmu, progress=False, on_drop=done.append)
+    message = str(info.value)
+    assert info.value.key == "plates[1].thickness", message
+    assert "plate.t = -1.0" in message and "outside the allowed range" in message
+    assert len(done) == 2  # both drops on the good plate finished first
+    huge = replace(scene, balls=(replace(scene.balls[0], diameter=1e300),))
+    with pytest.raises(SceneError, match=r"balls\[0\]\.diameter: the FMU rejects this value: sphere.d = 1e\+300"):
+        run_scene(huge, fmu=impact_fmu, progress=False)
 
 
 def test_drop_from_a_megametre_is_flagged(tmp_path, impact_fmu, capsys):
@@ -157,7 +195,7 @@ def test_sigint_keeps_every_finished_drop(tmp_path, impact_fmu):
     out = tmp_path / "out"
     proc = subprocess.Popen([PYTHON, "-m", "restitution.scene", "run", str(scene), "--fmu", str(impact_fmu),
                              "--out", str(out), "--no-plot"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            text=True, env=ENV)
+                            text=True, env=ENV, start_new_session=True)
     table = out / "slow.csv"
 
     def finished_drops():
@@ -170,7 +208,7 @@ def test_sigint_keeps_every_finished_drop(tmp_path, impact_fmu):
     while time.monotonic() < deadline and proc.poll() is None and len(finished_drops()) < 3:
         time.sleep(0.05)
     assert proc.poll() is None, "the scene ended before it could be interrupted"
-    proc.send_signal(signal.SIGINT)
+    os.killpg(proc.pid, signal.SIGINT)  # Ctrl-C: the whole process group
     _, err = proc.communicate(timeout=120)
     drops = finished_drops()
     assert 3 <= len(drops) < 200
@@ -183,6 +221,43 @@ def test_sigint_keeps_every_finished_drop(tmp_path, impact_fmu):
         assert sum(r["drop_height_m"] == h for r in rows) == summary[h]
     assert proc.returncode == 130, err
     assert f"{len(drops)} of 200 drops finished" in err and "Traceback" not in err
+
+
+def test_progress_in_a_terminal_ends_with_the_final_state_on_its_own_line(tmp_path, impact_fmu):
+    import fcntl
+    import pty
+    import struct
+    import termios
+
+    scene = tmp_path / "s.toml"
+    heights = "[" + ", ".join(f'"{0.05 + 0.005 * k:.3f} m"' for k in range(12)) + "]"
+    # zener_method = ode: a couple of seconds, so a terminal may show the bar (not asserted: timing)
+    scene.write_text(scene_text(heights=heights, model='[model]\nzener_method = "ode"\nplate_waves = "on"\n',
+                                v_min='"0.001 m/s"'))
+    master, slave = pty.openpty()
+    fcntl.ioctl(slave, termios.TIOCSWINSZ, struct.pack("HHHH", 24, 80, 0, 0))
+    proc = subprocess.Popen([PYTHON, "-m", "restitution.scene", "run", str(scene), "--fmu", str(impact_fmu),
+                             "--out", str(tmp_path), "--no-plot"], stdout=subprocess.PIPE, stderr=slave,
+                            stdin=subprocess.DEVNULL, text=True, env=ENV)
+    os.close(slave)
+    chunks = []
+    while True:
+        try:
+            data = os.read(master, 65536)
+        except OSError:  # EIO: the child closed the terminal
+            break
+        if not data:
+            break
+        chunks.append(data)
+    out = proc.stdout.read()
+    assert proc.wait(timeout=300) == 0
+    os.close(master)
+    err = b"".join(chunks).decode("utf-8", "replace").replace("\r\n", "\n")
+    shown = [line.rsplit("\r", 1)[-1] for line in err.split("\n")]  # what the terminal shows on each line
+    finals = [line for line in shown if "drops done" in line]
+    assert len(finals) == 1 and finals[0].startswith("s (ode): 12/12 drops done, "), err
+    assert not [line for line in shown if "%|" in line], err  # any bar was cleared, not left behind
+    assert out.startswith("test: 12 drops, "), out  # the summary on its own line
 
 
 def test_report_prints_one_final_line_per_variant_not_per_repeat(tmp_path, impact_fmu):

@@ -9,6 +9,7 @@
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import tempfile
 from pathlib import Path
@@ -48,19 +49,51 @@ def _output_dir(out: Path) -> Path:
     return out
 
 
+def _output_file(out: Path) -> Path:
+    """``out`` (a file to write or refresh) checked before the run starts."""
+    if out.is_dir():
+        raise UsageError(f"--out {out}: is a directory; give a file name (e.g. scenes.md)")
+    parent = out.parent
+    if parent.exists() and not parent.is_dir():
+        raise UsageError(f"--out {out}: {parent} is not a directory")
+    try:
+        parent.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryFile(dir=parent):
+            pass
+    except OSError as exc:
+        raise UsageError(f"--out {out}: cannot write in {parent}: {exc.strerror or exc}") from None
+    if out.exists() and not os.access(out, os.W_OK):
+        raise UsageError(f"--out {out}: not writable")
+    return out
+
+
+def _fmu(args) -> Path:
+    """The FMU to run, checked (or built) before anything is written."""
+    from .runner import ensure_fmu
+
+    try:
+        return ensure_fmu(args.fmu, rebuild=args.rebuild if hasattr(args, "rebuild") else False,
+                          log=lambda text: print(text, file=sys.stderr))
+    except SceneError:
+        raise
+    except ValueError as exc:  # --fmu PATH that is not a SpherePlateImpact FMU
+        raise UsageError(str(exc)) from None
+
+
 def _run(args) -> int:
     from .runner import DropWriter, SceneInterrupted, run_scene
 
     scene = load_scene(args.file)
     out = _output_dir(Path(args.out) if args.out else Path("scene-results") / scene.stem)
+    fmu = _fmu(args)
     suffix = "_all_on" if args.all_on else ""
     table = out / f"{scene.stem}{suffix}.csv"
     summary = out / f"{scene.stem}{suffix}_summary.csv"
     with DropWriter(table, scene) as writer:  # each finished drop is on disk before the next starts
         try:
-            result = run_scene(scene, fmu=args.fmu, effects="all_on" if args.all_on else "scene",
+            result = run_scene(scene, fmu=fmu, effects="all_on" if args.all_on else "scene",
                                zener_method=args.zener_method, progress=False if args.no_progress else None,
-                               rebuild=args.rebuild, on_drop=writer.write)
+                               on_drop=writer.write)
         except SceneInterrupted as exc:
             exc.result.write_summary_csv(summary)
             print(f"interrupted: {len(exc.result.drops)} of {exc.n_drops} drops finished and written to {table} "
@@ -79,8 +112,18 @@ def _run(args) -> int:
 def _report(args) -> int:
     from .report import write_report
 
-    methods = args.methods.split(",") if args.methods else None
-    reports, table = write_report(args.files, out=args.out, fmu=args.fmu, repeat=args.repeat, methods=methods,
+    methods = [m.strip() for m in args.methods.split(",")] if args.methods else None
+    from ..zener import ZENER_METHODS
+
+    for method in methods or ():
+        if method not in ZENER_METHODS:
+            raise UsageError(f"--methods {args.methods}: {method!r} is not a Zener method ({', '.join(ZENER_METHODS)})")
+    for path in args.files:  # every scene loads before any runs
+        load_scene(path)
+    if args.out is not None:
+        _output_file(args.out)
+    fmu = _fmu(args)
+    reports, table = write_report(args.files, out=args.out, fmu=fmu, repeat=args.repeat, methods=methods,
                                   progress=False if args.no_progress else None,
                                   log=lambda text: print(text, file=sys.stderr))
     print(table)
@@ -137,6 +180,9 @@ def main(argv=None) -> int:
     except (SceneError, BuildError, UsageError) as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt:  # outside the drops (FMU build or load, report): nothing finished to keep
+        print("\ninterrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
 
 
 if __name__ == "__main__":

@@ -452,6 +452,9 @@ def load_scene(path) -> Scene:
         text = path.read_text(encoding="utf-8")
     except OSError as exc:
         raise SceneError(f"cannot read the scene file: {exc.strerror or exc}", source=str(path)) from None
+    except UnicodeDecodeError as exc:
+        raise SceneError(f"not UTF-8 text (byte {exc.start}): a scene file is TOML, UTF-8 encoded",
+                         source=str(path)) from None
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:

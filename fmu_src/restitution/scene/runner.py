@@ -41,7 +41,7 @@ from ..model import EFFECT_MODES, RESTITUTION_MODELS, ZENER_SLOPE_BOUND
 from ..zener import ZENER_METHODS, inelasticity_parameter
 from ..cosim.bouncing import impact_sequence
 from ..cosim.interrupt import DeferredInterrupt
-from .loader import Drop, Scene
+from .loader import Drop, Scene, SceneError
 
 __all__ = ["DropResult", "SceneResult", "SceneInterrupted", "DropWriter", "run_scene", "ensure_fmu",
            "open_instance", "COLUMNS", "READ_OUTPUTS", "VALIDITY", "drop_parameters"]
@@ -76,11 +76,10 @@ def ensure_fmu(fmu=None, rebuild: bool = False, log=None) -> Path:
     """Path of the FMU to run: ``fmu`` as given, else the default SpherePlateImpact.fmu
     (dist/ of a source checkout, a per-user cache otherwise), (re)built when missing, built from
     other sources, or when ``rebuild`` is true (:func:`restitution.fmu.default_fmu`)."""
-    if fmu is not None:
-        path = Path(fmu)
-        if not path.is_file():
-            raise FileNotFoundError(f"FMU {path} not found")
-        return path
+    if fmu is not None:  # ValueError (one line naming --fmu) unless it is a SpherePlateImpact FMU
+        from ..sweep.backends import check_impact_fmu
+
+        return check_impact_fmu(fmu)
     from ..cosim.fmu import build_default_fmu
 
     return build_default_fmu(rebuild=rebuild, log=log)
@@ -378,10 +377,25 @@ def _run_drop(instance, scene: Scene, drop: Drop, params: dict, read_names, read
     # evaluation at fmi2ExitInitializationMode is then the first impact's, not a wasted one.
     v_first = math.sqrt(2.0 * g * drop.drop_height)
     slave.reset()
+    seen = len(instance.messages)
     slave.setupExperiment(startTime=0.0)
     slave.enterInitializationMode()
-    instance.set(**params, v_approach=v_first)
-    slave.exitInitializationMode()
+    try:
+        instance.set(**params, v_approach=v_first)
+        slave.exitInitializationMode()
+        failure = None
+    except Exception as exc:  # noqa: BLE001 - fmpy raises on fmi2Error; the FMU's log says which value
+        failure = exc
+    rejected = [text for status, text in instance.messages[seen:] if status >= _FMI2_ERROR]
+    if rejected or failure is not None:
+        try:  # reset and back in step mode (out of initialization and any error mode): it can be reused or freed
+            instance.reset()
+        except Exception:  # noqa: BLE001 - the error being reported matters, not this one
+            pass
+    if rejected:  # a value this FMU does not accept (the loader checks the domain; another FMU may differ)
+        raise _rejected(scene, drop, rejected[0]) from None
+    if failure is not None:
+        raise failure
 
     vr_in = [instance.vr("v_approach")]
     real_names = ("v_rebound", *read_names)
@@ -417,6 +431,33 @@ def _run_drop(instance, scene: Scene, drop: Drop, params: dict, read_names, read
     return DropResult(drop=drop, time=np.array(times), v_approach=np.array(speeds), v_rebound=v_reb,
                       columns=columns, plasticity=flags[:, 0], plate_waves=flags[:, 1], stop_reason=stop,
                       gravity=g, validity={name: flags[:, 2 + k] for k, name in enumerate(VALIDITY)})
+
+
+#: fmi2Status of a rejected value (fmi2Error; fmi2Fatal is 4).
+_FMI2_ERROR = 3
+
+
+def _rejected(scene: Scene, drop: Drop, message: str) -> SceneError:
+    """A loader-style error naming the scene key behind the FMU variable that ``message`` (the FMU's
+    log line, "<variable> = <value> is outside ...") is about."""
+    variable = message.split(" = ", 1)[0].strip()
+    i, j = scene.balls.index(drop.ball), scene.plates.index(drop.plate)
+    if variable == "sphere.d":
+        key = f"balls[{i}].diameter"
+    elif variable.startswith("sphere."):
+        key = f"balls[{i}].material"
+    elif variable == "plate.t":
+        key = f"plates[{j}].thickness"
+    elif variable.startswith("plate."):
+        key = f"plates[{j}].material"
+    elif variable == "v_approach":
+        key = f"balls[{i}].drop_heights[{drop.ball.drop_heights.index(drop.drop_height)}]"
+    elif variable in ("effect_tolerance", "zener_method", "restitution_model", "plasticity", "plate_waves"):
+        key = f"model.{variable}"
+    else:
+        key = variable
+    return SceneError(f"the FMU rejects this value: {message}", key,
+                      str(scene.path) if scene.path is not None else scene.name)
 
 
 def run_scene(scene: Scene, fmu=None, *, effects: str = "scene", zener_method: str | None = None,
