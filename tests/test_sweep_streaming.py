@@ -213,8 +213,10 @@ def test_serial_interrupt_keeps_finished_chunks_and_resume_completes(tmp_path):
     assert len(partial) == 300 and info.value.missing == spec.n_cases - 300
     assert len(list((tmp_path / "p").glob("chunk-*.npz"))) == 3
     assert np.array_equal(partial["case"], np.arange(300))
-    resumed = run_sweep(spec, "package", scheduler="serial", chunk_size=7, parts=tmp_path / "p", resume=True)
+    counting = _Interrupting(0)  # never interrupts; counts the chunks it evaluates
+    resumed = run_sweep(spec, counting, scheduler="serial", chunk_size=7, parts=tmp_path / "p", resume=True)
     assert resumed.info["processes"] == 1 and resumed.n_chunks == 9  # the parts' chunk size is kept
+    assert counting.calls == 9 - 3  # only the missing chunks are evaluated
     assert np.array_equal(resumed["pair"], whole["pair"])
     assert all(v <= TOL for v in compare_results(resumed, whole).values())
     # parts of another sweep are refused, not mixed in
@@ -474,8 +476,24 @@ def test_cor_map_title_fits_a_single_pair(tmp_path):
     assert 0 <= box.x0 and box.x1 <= fig.bbox.width  # was clipped on both sides
     assert "\n" in text.get_text() and text.get_text().replace("\n", " ") == title
     plt.close(fig)
-    spec = SweepSpec(pairs=["s2_tool_steel/al_6061"], grid={"v": "geomspace:0.1:100:8", "t/d": "geomspace:0.05:5:6"})
-    assert run_sweep(spec, scheduler="serial").plot(tmp_path / "map.png").stat().st_size > 10_000
+    # the map itself: one pair crossing the validated range's edge (the long title), drawn as saved
+    spec = SweepSpec(pairs=["s2_tool_steel/al_6061"], grid={"v": "geomspace:0.1:3000:8", "t/d": "geomspace:0.05:5:6"})
+    titles = []
+    close = plt.close
+
+    def measure_then_close(fig=None):  # the saved figure's title, as drawn
+        titles.append((fig._suptitle.get_text(), fig._suptitle.get_window_extent(fig.canvas.get_renderer()),
+                       fig.bbox.width))
+        close(fig)
+
+    plt.close = measure_then_close
+    try:
+        assert run_sweep(spec, scheduler="serial").plot(tmp_path / "map.png").stat().st_size > 10_000
+    finally:
+        plt.close = close
+    (text, box, width), = titles
+    assert "validated range" in text
+    assert 0 <= box.x0 and box.x1 <= width, (text, box, width)
 
 
 @pytest.fixture(scope="module")
