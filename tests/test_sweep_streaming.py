@@ -81,6 +81,16 @@ def test_memory_budget_refuses_with_numbers_or_streams_to_disk(tmp_path):
         plan_size(mid, budget=2 ** 10, backends=2, out=tmp_path / "s.csv")
     with pytest.raises(SizeError, match="at most 100,000,000 per axis"):
         SweepSpec(grid={"v": {"linspace": [0.1, 1, 10 ** 9]}}).check_axes()
+    with pytest.raises(SizeError, match="case numbers are 64-bit"):
+        plan_size(SweepSpec(random={"v": "uniform:1:2"}, samples=10 ** 12,
+                            grid={"t/d": {"linspace": [1, 2, 10 ** 7]}}), budget=2 ** 80, out=tmp_path / "s.csv")
+
+
+@pytest.mark.parametrize("kwargs", [dict(chunk_size=-1), dict(chunk_size=0), dict(n_workers=0), dict(chunk_size=2.5)])
+def test_run_sweep_refuses_sizes_that_silently_gave_nothing(kwargs):
+    """The API as well as the CLI: chunk_size = -1 gave a table of 0 rows, 0 became the default."""
+    with pytest.raises(ValueError, match="expected an integer >= 1"):
+        run_sweep(SweepSpec(grid={"v": "1,2"}), scheduler="serial", **kwargs)
 
 
 def _address_space(limit):

@@ -122,6 +122,13 @@ class SizePlan:
         return text
 
 
+def _check_case_numbers(spec: SweepSpec) -> None:
+    """Case numbers are 64-bit integers in the table: :class:`SizeError` for 2**63 cases or more."""
+    if spec.n_cases >= 2 ** 63:
+        raise SizeError(f"{spec.n_cases:,} cases: case numbers are 64-bit integers, at most "
+                        f"{2 ** 63 - 1:,} cases a sweep")
+
+
 def check_memory(spec: SweepSpec, columns=None, budget: int | None = None, backends: int = 1) -> int:
     """Bytes the table(s) will take; :class:`SizeError` with the numbers when above ``budget``
     (default :func:`memory_budget`) or when an axis is too long to build. Called before any work."""
@@ -135,6 +142,7 @@ def plan_size(spec: SweepSpec, columns=None, budget: int | None = None, backends
     :class:`SizeError` with the numbers. A table over the memory budget (default
     :func:`memory_budget`) is streamed to disk when ``out`` (the table's path) is given, one back
     end runs and the finished chunks plus the written table fit in the free space there."""
+    _check_case_numbers(spec)
     need = backends * table_bytes(spec.n_cases, columns)
     budget = memory_budget() if budget is None else int(budget)
     plan = SizePlan(spec.n_cases, need, budget)
@@ -594,7 +602,11 @@ def run_sweep(spec: SweepSpec | dict, backend: str | Backend = "package", *, fmu
         spec = SweepSpec.from_dict(spec)
     if not in_memory and parts is None:
         raise ValueError("in_memory=False keeps the table on disk: give parts=DIR")
+    for name, value in (("chunk_size", chunk_size), ("n_workers", n_workers)):
+        if value is not None and (isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1):
+            raise ValueError(f"{name} = {value!r}: expected an integer >= 1")
     spec.check_axes()
+    _check_case_numbers(spec)
     backend = get_backend(backend, fmu)
     n = spec.n_cases
     keep = _keep(columns)
