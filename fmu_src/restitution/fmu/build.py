@@ -41,6 +41,8 @@ SLAVES = HERE / "slaves"
 #: FMU model identifier -> pythonfmu slave script (shipped with the package).
 FMUS = {"SpherePlateImpact": SLAVES / "sphere_plate_impact_slave.py",
         "BouncingBall": SLAVES / "bouncing_ball_slave.py"}
+#: What both slaves import, shipped beside each script in resources/.
+SLAVE_SUPPORT = SLAVES / "restitution_slave_support.py"
 
 #: Where the build records what it was built from, inside the FMU.
 BUILD_INFO = "resources/build_info.json"
@@ -163,7 +165,7 @@ def _physics_only(directory, names):
 def source_files(model: str) -> list[Path]:
     """Every file ``<model>.fmu`` is built from: the slave, the bundled physics modules and data,
     this build module, the interface table's generator and the guard (C front and native-host loader)."""
-    files = [FMUS[model], Path(__file__).resolve(), HERE / "interface.py"]
+    files = [FMUS[model], SLAVE_SUPPORT, Path(__file__).resolve(), HERE / "interface.py"]
     files += sorted((HERE / "cfront").glob("*.[ch]"))
     files += sorted((HERE / "native_host").glob("*.[ch]")) + sorted((HERE / "native_host").glob("*.py"))
     files += sorted(PACKAGE.glob("*.py"))
@@ -236,7 +238,7 @@ def build_one(model: str, out_dir: Path, standalone: bool = True, log=None) -> P
     with tempfile.TemporaryDirectory(prefix=f".{model}-build-", dir=out_dir) as tmp:
         staged = Path(tmp) / "stage" / "restitution"
         shutil.copytree(PACKAGE, staged, ignore=_physics_only)
-        fmu = Path(FmuBuilder.build_FMU(script, dest=tmp, project_files=[staged],
+        fmu = Path(FmuBuilder.build_FMU(script, dest=tmp, project_files=[staged, SLAVE_SUPPORT],
                                         canGetAndSetFMUstate=True, canSerializeFMUstate=True))
         slave_module = _slave_module(model)
         info = json.dumps({"model": model, "source_hash": source_hash(model)}, indent=1)

@@ -203,7 +203,7 @@ GUARD_CFLAGS = ("-std=gnu99", "-O2", "-Wall", "-Wextra", "-Werror", "-shared", "
 
 
 def _fmi2_headers() -> Path:
-    from ..native.build_native import NativeBuildSkipped, fmi2_include_dir
+    from restitution.fmu.native.build_native import NativeBuildSkipped, fmi2_include_dir
 
     try:
         return fmi2_include_dir()
@@ -227,7 +227,7 @@ def guard_command(output: Path, generated: Path, real_name: str, compiler: str =
 def write_guard_headers(directory: Path, model_description: str, interface_header: Optional[str] = None) -> None:
     """rst_interface.h (``interface_header``, or one made from the modelDescription for an FMU without a
     VARIABLES table) and rst_model_info.h into ``directory``."""
-    from ..interface import c_header, model_info, model_info_header, variables_from_model_description
+    from restitution.fmu.interface import c_header, model_info, model_info_header, variables_from_model_description
 
     if interface_header is None:
         identifier = model_info(model_description)[0]

@@ -29,19 +29,23 @@ event-exact master ``restitution.cosim.bounce``). Impacts are instantaneous (the
 duration, tens of microseconds, is not spent), as in that master.
 
 State: every quantity the ball evolves is a registered variable (outputs and the local
-``flight.*``), because pythonfmu's fmi2GetFMUstate saves registered variables only.
-Bad input never raises: it is logged with fmi2Error and ``fmi2DoStep`` returns fmi2Discard
-until a valid value is set. The module has a unique name (two pythonfmu FMUs whose scripts
-share a module name clash in one process).
+``flight.*``); the FMU state is every registered variable, tagged with the model, the state
+format and the variable list, and validated (parameters and input as the setters would, the
+rest numbers) before anything is restored. Bad input never raises: a value outside its range is
+refused, the previous value kept, and the refusal logged with fmi2Error (in the built FMU the C
+guard refuses it first and returns fmi2Error). The module has a unique name (two pythonfmu FMUs
+whose scripts share a module name clash in one process).
 """
 from __future__ import annotations
 
 import math
 
 from pythonfmu import Boolean, Fmi2Causality, Fmi2Slave, Fmi2Variability, Integer, Real
-from pythonfmu.enums import Fmi2Initial, Fmi2Status
+from pythonfmu.enums import Fmi2Initial
 
 from restitution.validation import interval_check
+from restitution_slave_support import (checked_setter, restore_state, state_check, state_from_bytes, state_schema,
+                                       state_to_bytes)
 
 P, IN, OUT, LOCAL = "parameter", "input", "output", "local"
 
@@ -125,53 +129,49 @@ class BouncingBall(Fmi2Slave):
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
         self._values = {}  # parameters and the input, by FMI name
-        self._invalid = {}  # name -> message, for values currently rejected
         self._s = dict(_INITIAL_STATE)  # evolving state, by table key
+        self._setters = {}  # every registered variable's setter, by FMI name (FMU state restore)
         self._start_time = 0.0
         for name, vtype, causality, _unit, start, description, key in VARIABLES:
             var_cls = {"Real": Real, "Integer": Integer, "Boolean": Boolean}[vtype]
             if causality in (P, IN):
                 self._values[name] = start
+                self._setters[name] = checked_setter(self, name, allowed_range, self._values, lambda _name: None)
                 self.register_variable(var_cls(
                     name, causality=Fmi2Causality.parameter if causality == P else Fmi2Causality.input,
                     variability=Fmi2Variability.fixed if causality == P else Fmi2Variability.continuous,
                     start=start, description=description, getter=self._value_getter(name),
-                    setter=self._value_setter(name)), nested=False)
+                    setter=self._setters[name]), nested=False)
                 continue
             variability = Fmi2Variability.continuous if vtype == "Real" else Fmi2Variability.discrete
+            self._setters[name] = self._state_setter(key)
             self.register_variable(var_cls(
                 name, causality=Fmi2Causality.output if causality == OUT else Fmi2Causality.local,
                 variability=variability, initial=Fmi2Initial.calculated, description=description,
-                getter=self._state_getter(key), setter=self._state_setter(key)), nested=False)
+                getter=self._state_getter(key), setter=self._setters[name]), nested=False)
+        self._schema = state_schema("BouncingBall", [row[0] for row in VARIABLES])
 
     # --- variable access ---------------------------------------------------------------
     def _value_getter(self, name):
         return lambda: self._values[name]
 
-    def _value_setter(self, name):
-        ok, allowed, _low, _high = allowed_range(name)
-
-        def set_value(value):
-            self._values[name] = value
-            try:
-                good = bool(ok(value))
-            except (TypeError, ValueError, OverflowError):
-                good = False
-            if good:
-                self._invalid.pop(name, None)
-            else:
-                message = f"{name} = {value!r} is outside the allowed range: {allowed}"
-                self._invalid[name] = message
-                self.log(message, Fmi2Status.error)
-        return set_value
-
     def _state_getter(self, key):
         return lambda: self._s[key]
 
-    def _state_setter(self, key):  # used by fmi2SetFMUstate
+    def _state_setter(self, key):  # used by fmi2SetFMUstate (and the guard's state restore)
         def set_value(value):
             self._s[key] = value
         return set_value
+
+    def _get_fmu_state(self):
+        return {"schema": self._schema, "values": {var.name: var.getter() for var in self.vars.values()}}
+
+    def _set_fmu_state(self, state):
+        checks = {row[0]: state_check(row[0], allowed_range, row[1]) for row in VARIABLES if row[2] in (P, IN)}
+        restore_state(self, state, self._schema, checks, self._setters)
+
+    _fmu_state_to_bytes = staticmethod(state_to_bytes)
+    _fmu_state_from_bytes = staticmethod(state_from_bytes)
 
     # --- the ball ------------------------------------------------------------------------
     def _start_flight(self, t, h, v):
@@ -214,14 +214,10 @@ class BouncingBall(Fmi2Slave):
 
     def exit_initialization_mode(self):
         self._s = dict(_INITIAL_STATE)
-        h0 = self._values["h0"]
-        self._start_flight(self._start_time, h0 if "h0" not in self._invalid else 0.0, 0.0)
+        self._start_flight(self._start_time, self._values["h0"], 0.0)
         self._update_outputs(self._start_time)
 
     def do_step(self, current_time: float, step_size: float) -> bool:
-        if self._invalid:
-            self.log("doStep discarded: " + "; ".join(self._invalid.values()), Fmi2Status.discard)
-            return False
         s = self._s
         g = float(self._values["g"])
         wait = int(self._values["contact_mode"]) == 1
@@ -248,6 +244,5 @@ class BouncingBall(Fmi2Slave):
         for name, _vtype, causality, _unit, start, _description, _key in VARIABLES:
             if causality in (P, IN):
                 self._values[name] = start
-        self._invalid.clear()
         self._s = dict(_INITIAL_STATE)
         self._start_time = 0.0

@@ -5,9 +5,14 @@ evaluates :func:`restitution.impact` lazily (only when an output is read or a st
 taken after something changed) and exposes the results. Nothing here is physics.
 
 Bad input never raises (pythonfmu would turn an exception into fmi2Fatal for every
-instance): the value is kept, a message naming the variable, its value and the allowed
-range is logged with fmi2Error, outputs read NaN and ``fmi2DoStep`` returns fmi2Discard
-until valid values are set again (or the instance is reset).
+instance): a value outside its range is refused, the previous value kept, and a message
+naming the variable, its value and the allowed range is logged with fmi2Error (in the built
+FMU the C guard refuses it first and returns fmi2Error). An evaluation that fails, or gives a
+non-finite output the interface does not document, is logged with the inputs; the outputs then
+read NaN (Booleans false) and ``fmi2DoStep`` returns fmi2Discard.
+
+The FMU state is exactly the inputs and parameters, tagged with the model, the state format
+and the variable list; a state is validated as the setters would before anything is restored.
 
 The module has a name of its own (not ``model``): two pythonfmu FMUs whose scripts share
 a module name clash in one process.
@@ -29,6 +34,8 @@ if os.path.isdir(os.path.join(_HERE, "restitution")) and sys.path[0] != _HERE:
 
 from restitution.model import DOMAIN, EFFECT_MODES, RESTITUTION_MODELS, ZENER_METHODS, impact  # noqa: E402
 from restitution.validation import interval_check  # noqa: E402
+from restitution_slave_support import (checked_setter, finite_or, restore_state, state_check,  # noqa: E402
+                                       state_from_bytes, state_schema, state_to_bytes)
 
 P, IN, OUT = "parameter", "input", "output"
 
@@ -89,7 +96,26 @@ _CHOICES = {
     "plate_waves": (EFFECT_MODES, "0 = off, 1 = on or 2 = auto"),
 }
 _CODE_OFFSET = {"restitution_model": 1, "zener_method": 1, "plasticity": 0, "plate_waves": 0}
+_LINEAR = ZENER_METHODS.index("linear") + 1
+#: FMU name of each Real output, by ImpactResult key
+_REAL_OUTPUTS = {row[6]: row[0] for row in VARIABLES if row[2] == OUT and row[1] == "Real"}
+
+
+def undocumented_nonfinite(outputs: dict, zener_method: int) -> list[str]:
+    """The Real outputs that are NaN or infinite where the interface does not say they may be
+    (``name = value`` texts): +inf is documented for plate.m_eff when e_ze = 1 (a half-space) and
+    for zener.tau0 and zener.t_contact with the linear method at lambda >= 2 (the oscillator never
+    returns). Anything else non-finite is an evaluation failure."""
+    bad = []
+    for key, name in _REAL_OUTPUTS.items():
+        x = outputs[key]
+        documented = ((key == "m_eff" and outputs["e_ze"] == 1.0)
+                      or (key in ("tau0", "t_contact") and zener_method == _LINEAR and outputs["lam"] >= 2.0))
+        if not finite_or(x, documented):
+            bad.append(f"{name} = {x!r}")
+    return bad
 _PACKAGE_KEY = {row[0]: row[6] for row in VARIABLES}
+_TYPES = {row[0]: row[1] for row in VARIABLES}
 
 
 def allowed_interval(name):
@@ -131,7 +157,6 @@ class SpherePlateImpact(Fmi2Slave):
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
         self._values = {}  # name -> current value of every input and parameter
-        self._invalid = {}  # name -> message, for values currently rejected
         self._outputs = {}
         self._stale = True  # an input or parameter changed since the last evaluation
         self._call = None  # impact()'s arguments but v, built when a parameter changed
@@ -156,40 +181,23 @@ class SpherePlateImpact(Fmi2Slave):
             self.register_variable(var_cls(
                 name, causality=fmi_causality, variability=variability, start=start,
                 description=description, getter=self._input_getter(name),
-                setter=self._setter(name)), nested=False)
+                setter=checked_setter(self, name, allowed_range, self._values, self._changed)), nested=False)
+        self._schema = state_schema("SpherePlateImpact", list(self._values))
 
     # --- variable access -------------------------------------------------------------
     def _input_getter(self, name):
         return lambda: self._values[name]
 
-    def _setter(self, name):
-        ok, allowed, _low, _high = allowed_range(name)
-        is_parameter = name != "v_approach"
-
-        def set_value(value):
-            if value == self._values.get(name) and name not in self._invalid:
-                return
-            self._values[name] = value
-            self._stale = True
-            if is_parameter:
-                self._call = None
-            try:
-                good = ok(value)
-            except (TypeError, ValueError, OverflowError):
-                good = False
-            if good:
-                self._invalid.pop(name, None)
-            else:
-                message = f"{name} = {value!r} is outside the allowed range: {allowed}"
-                self._invalid[name] = message
-                self.log(message, Fmi2Status.error)
-        return set_value
+    def _changed(self, name):
+        self._stale = True
+        if name != "v_approach":
+            self._call = None
 
     def _output_getter(self, key, vtype):
         nan = math.nan if vtype == "Real" else False
 
         def get_value():
-            if self._stale or self._invalid or self._failure is not None:
+            if self._stale or self._failure is not None:
                 outputs = self._evaluate()
                 return outputs.get(key, nan) if outputs is not None else nan
             return self._outputs[key]  # the common case: cached, valid
@@ -217,8 +225,6 @@ class SpherePlateImpact(Fmi2Slave):
     # --- evaluation --------------------------------------------------------------------
     def _evaluate(self):
         """Outputs for the current inputs, recomputed only when an input or parameter changed."""
-        if self._invalid:
-            return None
         if not self._stale:
             return self._outputs if self._failure is None else None
         self._stale = False
@@ -238,12 +244,19 @@ class SpherePlateImpact(Fmi2Slave):
             args, kwargs = self._call
             result = impact(float(v["v_approach"]), *args, **kwargs)
         except Exception as exc:  # a numerical failure must not become fmi2Fatal
-            self._failure = f"evaluation failed for {self._describe_inputs()}: {type(exc).__name__}: {exc}"
-            self.log(self._failure, Fmi2Status.error)
-            return None
+            return self._fail(f"{type(exc).__name__}: {exc}")
+        outputs = result.as_dict()
+        bad = undocumented_nonfinite(outputs, int(v["zener_method"]))
+        if bad:
+            return self._fail("non-finite output " + ", ".join(bad))
         self._failure = None
-        self._outputs = result.as_dict()
+        self._outputs = outputs
         return self._outputs
+
+    def _fail(self, reason):
+        self._failure = f"evaluation failed for {self._describe_inputs()}: {reason}"
+        self.log(self._failure, Fmi2Status.error)
+        return None
 
     def _describe_inputs(self):
         return ", ".join(f"{k} = {val!r}" for k, val in self._values.items())
@@ -253,17 +266,36 @@ class SpherePlateImpact(Fmi2Slave):
         self._evaluate()
 
     def do_step(self, current_time: float, step_size: float) -> bool:
-        if self._invalid:
-            self.log("doStep discarded: " + "; ".join(self._invalid.values()), Fmi2Status.discard)
+        if self._evaluate() is None:
+            self.log("fmi2DoStep discarded: the model could not be evaluated for the current inputs "
+                     "(see the error above)", Fmi2Status.discard)
             return False
-        return self._evaluate() is not None
+        return True
 
     def reset(self):
         for name, _vtype, causality, _unit, start, _description, _key in VARIABLES:
             if causality != OUT:
                 self._values[name] = start
-        self._invalid.clear()
         self._stale = True
         self._call = None
         self._failure = None
         self._outputs = {}
+
+    # --- FMU state: the inputs and parameters, with a schema tag, validated before restoring ---
+    def _get_fmu_state(self):
+        return {"schema": self._schema, "values": dict(self._values)}
+
+    def _set_fmu_state(self, state):
+        checks = {name: state_check(name, allowed_range, _TYPES[name]) for name in self._values}
+        setters = {name: self._state_setter(name) for name in self._values}
+        restore_state(self, state, self._schema, checks, setters)
+
+    def _state_setter(self, name):
+        def set_value(value):
+            if value != self._values[name]:
+                self._values[name] = value
+                self._changed(name)
+        return set_value
+
+    _fmu_state_to_bytes = staticmethod(state_to_bytes)
+    _fmu_state_from_bytes = staticmethod(state_from_bytes)
