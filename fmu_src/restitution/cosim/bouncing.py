@@ -109,7 +109,9 @@ def fmu_rebound(instance):
     """Rebound function backed by a SpherePlateImpact :class:`FmuInstance`.
 
     At each impact: set ``v_approach``, read the outputs (direct feedthrough: valid right
-    after fmi2SetReal, no step needed). The master steps the FMU across each flight.
+    after fmi2SetReal, no step needed). The master steps the FMU across each flight, on the FMU's
+    own clock (FMI 2.0 steps must follow each other), so a second drop through the same instance
+    continues that clock where the first ended; the impact model does not depend on time.
     """
     names = list(RECORDED)
     fields_ = [RECORDED[n] for n in names]
@@ -121,9 +123,9 @@ def fmu_rebound(instance):
         slave.setReal([vr_in], [v])
         return dict(zip(fields_, slave.getReal(vrs)))
 
-    def advance(t, dt):
+    def advance(_t, dt):
         if dt > 0.0:
-            instance.do_step(t, dt)
+            instance.do_step(instance.time, dt)
 
     rebound.advance = advance
     return rebound

@@ -101,11 +101,19 @@ class FmuInstance:
                                 instanceName=self.instance_name)
         self._slave.instantiate(loggingOn=True, callbacks=self._make_callbacks())
         self.time = start_time
-        self._slave.setupExperiment(startTime=start_time)
-        self._slave.enterInitializationMode()
-        if parameters:
-            self.set(**parameters)
-        self._slave.exitInitializationMode()
+        try:
+            self._call(lambda: self._slave.setupExperiment(startTime=start_time))
+            self._call(self._slave.enterInitializationMode)
+            if parameters:
+                self.set(**parameters)
+            self._call(self._slave.exitInitializationMode)
+        except BaseException:  # a refused parameter: free the instance, then say why
+            self._slave.freeInstance()
+            self._slave = None
+            _LOG_ROUTES.pop(self.instance_name, None)
+            if self._own_dir:
+                shutil.rmtree(self.unzip_dir, ignore_errors=True)
+            raise
 
     def _make_callbacks(self):
         return _shared_callbacks()
@@ -120,18 +128,30 @@ class FmuInstance:
         return self.variables[name].valueReference
 
     def set(self, **values):
-        """Set variables by name; dotted FMI names are passed as ``**{"sphere.E": 2e11}``."""
+        """Set variables by name; dotted FMI names are passed as ``**{"sphere.E": 2e11}``. A value the
+        FMU refuses raises FmiStatusError (status fmi2Error, the FMU's message): the FMU keeps the
+        previous values of the call's variables of that type."""
         reals, ints, bools = {}, {}, {}
         for name, value in values.items():
             kind = self.variables[name].type
             target = reals if kind == "Real" else ints if kind in ("Integer", "Enumeration") else bools
             target[self.vr(name)] = value
         if reals:
-            self._slave.setReal(list(reals), [float(v) for v in reals.values()])
+            self._call(self._slave.setReal, list(reals), [float(v) for v in reals.values()])
         if ints:
-            self._slave.setInteger(list(ints), [int(v) for v in ints.values()])
+            self._call(self._slave.setInteger, list(ints), [int(v) for v in ints.values()])
         if bools:
-            self._slave.setBoolean(list(bools), [bool(v) for v in bools.values()])
+            self._call(self._slave.setBoolean, list(bools), [bool(v) for v in bools.values()])
+
+    def _call(self, function, *args):
+        """An fmpy call; a status above fmi2Warning becomes FmiStatusError with the FMU's last message."""
+        try:
+            return function(*args)
+        except Exception as exc:  # fmpy raises on any status above fmi2Warning
+            status = getattr(exc, "status", None)
+            if status is None:
+                raise
+            raise FmiStatusError(f"{exc}; FMU log: {self.last_message()}", status) from exc
 
     def get(self, *names):
         """Values of the named variables, in order (Reals as float, Booleans as bool)."""
@@ -139,26 +159,22 @@ class FmuInstance:
         for name in names:
             var = self.variables[name]
             if var.type == "Real":
-                out.append(self._slave.getReal([var.valueReference])[0])
+                out.append(self._call(self._slave.getReal, [var.valueReference])[0])
             elif var.type in ("Integer", "Enumeration"):
-                out.append(self._slave.getInteger([var.valueReference])[0])
+                out.append(self._call(self._slave.getInteger, [var.valueReference])[0])
             else:
-                out.append(bool(self._slave.getBoolean([var.valueReference])[0]))
+                out.append(bool(self._call(self._slave.getBoolean, [var.valueReference])[0]))
         return out
 
     def get_reals(self, names) -> list[float]:
         """Several Reals in one fmi2GetReal call (the fast path for hot loops)."""
-        return self._slave.getReal([self.vr(n) for n in names])
+        return self._call(self._slave.getReal, [self.vr(n) for n in names])
 
     # --- stepping ---------------------------------------------------------------------
     def do_step(self, current_time: float | None = None, step_size: float = 0.0):
         """fmi2DoStep; raises FmiStatusError on fmi2Discard/fmi2Error (the FMU's log says why)."""
         t = self.time if current_time is None else current_time
-        try:
-            self._slave.doStep(currentCommunicationPoint=t, communicationStepSize=step_size)
-        except Exception as exc:  # fmpy raises on any non-OK status
-            status = getattr(exc, "status", None)
-            raise FmiStatusError(f"{exc}; FMU log: {self.last_message()}", status) from exc
+        self._call(self._slave.doStep, t, step_size)
         self.time = t + step_size
 
     def last_message(self) -> str:
