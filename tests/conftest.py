@@ -11,11 +11,62 @@ sys.path.insert(0, str(ROOT / "fmu_src" / "restitution" / "fmu" / "slaves"))
 
 
 @pytest.fixture(scope="session")
-def impact_fmu(tmp_path_factory) -> Path:
-    """SpherePlateImpact.fmu built from the current sources (and validated) into a temp dir."""
-    from restitution.fmu.build import build_one
+def built_fmus(tmp_path_factory) -> Path:
+    """Every FMU of the project built from the current sources (and validated) into one temp dir:
+    SpherePlateImpact.fmu and BouncingBall.fmu (pythonfmu, behind the C guard), and their native
+    twins in native/ where a C compiler is available."""
+    from restitution.fmu.build import build_all
 
-    return build_one("SpherePlateImpact", tmp_path_factory.mktemp("fmu"))
+    out = tmp_path_factory.mktemp("fmu")
+    build_all(out)
+    return out
+
+
+@pytest.fixture(scope="session")
+def impact_fmu(built_fmus) -> Path:
+    """The pythonfmu SpherePlateImpact.fmu."""
+    return built_fmus / "SpherePlateImpact.fmu"
+
+
+@pytest.fixture(scope="session")
+def ball_fmu(built_fmus) -> Path:
+    """The pythonfmu BouncingBall.fmu."""
+    return built_fmus / "BouncingBall.fmu"
+
+
+def _native(built_fmus, model):
+    path = built_fmus / "native" / f"{model}.fmu"
+    if not path.is_file():
+        pytest.skip(f"native {model}.fmu not built here (needs gcc)")
+    return path
+
+
+@pytest.fixture(scope="session")
+def native_impact_fmu(built_fmus) -> Path:
+    """The native SpherePlateImpact.fmu (C front and C physics, no Python)."""
+    return _native(built_fmus, "SpherePlateImpact")
+
+
+@pytest.fixture(scope="session")
+def native_ball_fmu(built_fmus) -> Path:
+    """The native BouncingBall.fmu."""
+    return _native(built_fmus, "BouncingBall")
+
+
+#: The two implementations of each FMU: tests that hold for both take these fixtures.
+IMPLEMENTATIONS = ("python", "native")
+
+
+@pytest.fixture(scope="session", params=IMPLEMENTATIONS)
+def any_impact_fmu(request, built_fmus) -> Path:
+    """SpherePlateImpact.fmu, once as the pythonfmu FMU and once as the native one."""
+    return built_fmus / "SpherePlateImpact.fmu" if request.param == "python" else _native(built_fmus, "SpherePlateImpact")
+
+
+@pytest.fixture(scope="session", params=IMPLEMENTATIONS)
+def any_ball_fmu(request, built_fmus) -> Path:
+    """BouncingBall.fmu, once as the pythonfmu FMU and once as the native one."""
+    return built_fmus / "BouncingBall.fmu" if request.param == "python" else _native(built_fmus, "BouncingBall")
 
 
 #: Test files whose results depend on floating-point kernels: .ci/run runs them (``-m numerics``)

@@ -1,8 +1,10 @@
-"""Repeated bounces through SpherePlateImpact.fmu (fmpy) with the event-exact master
-(restitution.cosim.bounce), checked against the package and an independent recursion.
+"""Repeated bounces through SpherePlateImpact.fmu (fmpy; both implementations, pythonfmu and native)
+with the event-exact master (restitution.cosim.bounce), checked against the package and an
+independent recursion.
 
 For every material pair and thickness below (the paper's Tables 1, 3 and 4):
-* every rebound the FMU gives equals the package's value for that approach speed (1e-12 rel);
+* every rebound the FMU gives equals the package's value for that approach speed, within each
+  output's conditioning (restitution.agreement; the pythonfmu FMU runs the package itself);
 * apex heights fall as e^2 (each apex = previous apex * e^2, the first = drop height * e^2);
 * the ball's mechanical energy never rises, sampled along the whole trajectory;
 * the number of impacts and every impact instant (hence the rest time) are finite and agree
@@ -11,13 +13,15 @@ For every material pair and thickness below (the paper's Tables 1, 3 and 4):
 from __future__ import annotations
 
 import math
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
 from fmpy import extract
 
 import restitution as r
-from restitution.cosim import FmuInstance, bounce, fmu_rebound, impact_fmu_parameters, package_rebound
+from restitution.agreement import disagreements, tolerances
+from restitution.cosim import FmiStatusError, FmuInstance, bounce, fmu_rebound, impact_fmu_parameters, package_rebound
 from restitution.cosim.bouncing import STANDARD_GRAVITY
 
 DROP = 0.3  # [m]
@@ -85,9 +89,15 @@ def _exact_add(partials, x):
 
 
 @pytest.fixture(scope="module")
-def fmu(impact_fmu):
-    with FmuInstance(impact_fmu, "bounces") as instance:
+def fmu(any_impact_fmu):
+    with FmuInstance(any_impact_fmu, "bounces") as instance:
         yield instance
+
+
+def _impact(b, k):
+    """Impact ``k`` of a bounce sequence, as an object with the result's field names."""
+    return SimpleNamespace(**{f: getattr(b, f)[k] for f in ("e", "e_ep", "e_ze", "lam", "tau0", "t_contact",
+                                                            "v_rebound")})
 
 
 def _drop(fmu, sphere, plate, **kw):
@@ -102,14 +112,15 @@ def test_bounces_through_the_fmu(fmu, name):
     b = _drop(fmu, sphere, plate)
     params = {**sphere.params(), **plate.params()}
 
-    # every rebound is the package's for that approach speed (array path; the first and last
-    # impacts also through the scalar path)
+    # every rebound is the package's for that approach speed, within each output's conditioning
+    # (array path; the first and last impacts also through the scalar path)
     ref = r.impact(b.v_approach, **params)
-    for field in ("e", "e_ep", "e_ze", "lam", "tau0", "t_contact", "v_rebound"):
-        np.testing.assert_allclose(getattr(b, field), getattr(ref, field), rtol=1e-12, atol=0, err_msg=field)
-        for k in (0, b.n_impacts - 1):
-            assert getattr(b, field)[k] == pytest.approx(getattr(r.impact(float(b.v_approach[k]), **params), field),
-                                                         rel=1e-12, abs=0.0), (field, k)
+    tol, flips = tolerances(b.v_approach, params)
+    assert not disagreements(b, ref, tol, flips), name
+    for k in (0, b.n_impacts - 1):
+        one = r.impact(float(b.v_approach[k]), **params)
+        tol_k, flips_k = tolerances(float(b.v_approach[k]), params)
+        assert not disagreements(_impact(b, k), one, tol_k, flips_k), (name, k)
 
     # apex heights fall as e^2
     e, apex = b.e, b.apex
@@ -130,12 +141,16 @@ def test_bounces_through_the_fmu(fmu, name):
     assert np.all(np.diff(energy) <= 1e-9 * energy[0]), name
     assert np.all(b.height(b.time) <= 1e-9) and np.all(b.height(t) >= 0.0)
 
-    # count, instants and rest time agree with the independent recursion
+    # count, instants and rest time agree with the independent recursion: to 1e-12, plus what the
+    # conditioning allows e at each impact to differ, which each later approach speed inherits
     speeds, times, reason = recursion(sphere, plate)
     assert b.n_impacts == len(speeds) and b.stop_reason == reason, name
-    np.testing.assert_allclose(b.v_approach, speeds, rtol=1e-12, atol=0)
-    np.testing.assert_allclose(b.time, times, rtol=1e-12, atol=0)
-    assert math.isfinite(b.rest_time) and b.rest_time == pytest.approx(times[-1], rel=1e-12)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        drift = np.concatenate([[0.0], np.cumsum(np.where(b.e > 0, tol["e"] / np.abs(b.e), 0.0))[:-1]])
+    rtol = 1e-12 + drift
+    assert np.all(np.abs(b.v_approach - speeds) <= rtol * np.abs(speeds)), name
+    assert np.all(np.abs(b.time - times) <= rtol * np.abs(times)), name
+    assert math.isfinite(b.rest_time) and abs(b.rest_time - times[-1]) <= rtol[-1] * times[-1]
     if reason == "v_min":  # the stop rule fired at the first rebound below v_min, not before
         assert b.v_rebound[-1] < 0.1 and np.all(b.v_rebound[:-1] >= 0.1) and np.all(b.e > 0.0)
     else:
@@ -153,15 +168,18 @@ def test_cases_cover_both_stop_rules_and_long_sequences(fmu):
     assert counts[0] == 1 and counts[1] > 10_000 and counts[2] > 1_000
 
 
-def test_fmu_and_package_masters_agree_bit_for_bit(fmu):
+def test_python_fmu_and_package_masters_agree_bit_for_bit(impact_fmu):
+    """The pythonfmu FMU runs the package's own code in this process: the same bits."""
     sphere, plate = CASES["T3-s2/al6061-t3.175mm"]
-    through_fmu = _drop(fmu, sphere, plate, drop_height=1.0, gravity=3.7, v_min=0.02)
+    with FmuInstance(impact_fmu, "bit for bit") as fmu:
+        through_fmu = _drop(fmu, sphere, plate, drop_height=1.0, gravity=3.7, v_min=0.02)
+        clock = fmu.time
     direct = bounce(package_rebound(**sphere.params(), **plate.params()), drop_height=1.0, gravity=3.7, v_min=0.02)
     assert through_fmu.n_impacts == direct.n_impacts > 5
     for field in ("time", "v_approach", "e", "e_ep", "e_ze", "lam", "tau0", "t_contact", "v_rebound", "apex"):
         assert np.array_equal(getattr(through_fmu, field), getattr(direct, field)), field
     # the FMU was stepped across every flight: its clock ends at the last impact
-    assert fmu.time == pytest.approx(direct.rest_time, rel=1e-12)
+    assert clock == pytest.approx(direct.rest_time, rel=1e-12)
 
 
 def test_stop_rule_ends_a_zeno_like_sequence():
@@ -195,9 +213,11 @@ def test_invalid_model_output_stops_the_master_clearly(fmu):
         bounce(lambda v: {"e": math.nan, "e_ep": 1.0, "e_ze": 1.0, "lam": 0.0, "tau0": 3.2, "t_contact": 0.0,
                           "v_rebound": math.nan}, DROP)
     fmu.reset()
-    fmu.set(**{"plate.t": -1.0})  # the FMU logs it and discards the flight step
-    with pytest.raises(Exception, match="discard"):
-        bounce(fmu_rebound(fmu), DROP)
+    with pytest.raises(FmiStatusError, match=r"plate.t = -1.0 is outside the allowed range"):
+        fmu.set(**{"plate.t": -1.0})  # refused with fmi2Error: the previous value stays
+    defaults = {**r.Sphere(r.MATERIALS["s2_tool_steel"], 6.35e-3).params(),
+                **r.Plate(r.MATERIALS["al_6061"], 6.35e-3).params()}
+    assert bounce(fmu_rebound(fmu), DROP).n_impacts == bounce(package_rebound(**defaults), DROP).n_impacts
     fmu.reset()
 
 

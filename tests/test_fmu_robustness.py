@@ -1,14 +1,14 @@
-"""SpherePlateImpact.fmu under bad input, many instances, a foreign FMU, state round trips and
-a million steps (fmpy host).
+"""SpherePlateImpact.fmu, both implementations (pythonfmu behind the C guard, and native), under
+bad input, many instances, state round trips and a million steps (fmpy host); the pythonfmu one
+also next to a different pythonfmu FMU.
 
 * Every input and parameter set to NaN, +inf, -inf, a negative value, zero where a positive
-  value is needed, nu >= 0.5, an integer code out of range: fmi2SetXXX succeeds and the FMU
-  logs one fmi2Error message naming the variable, its value and the allowed range; outputs
-  read NaN; fmi2DoStep returns fmi2Discard (never fmi2Fatal); another instance stepping
-  alongside is unaffected; a valid value again, or fmi2Reset, gives correct results again.
+  value is needed, nu >= 0.5, an integer code out of range: fmi2SetXXX returns fmi2Error and
+  the FMU logs one message naming the variable, its value and the allowed range; the previous
+  value is kept, so outputs and fmi2DoStep go on as before (never fmi2Fatal); another instance
+  stepping alongside is unaffected.
 * Eight instances with different materials stepped interleaved give the same bits as one at
-  a time, and the package's numbers.
-* It runs next to a different pythonfmu FMU (built here, own module name) in one process.
+  a time, and the package's numbers (within each output's conditioning, restitution.agreement).
 * fmi2Get/SetFMUstate and (de)serialization round-trip every variable exactly.
 * One million steps in one instance: unchanged results, resident memory growing < 1 MiB.
 """
@@ -22,11 +22,13 @@ import subprocess
 import sys
 import textwrap
 import time
+from types import SimpleNamespace
 
 import pytest
 from fmpy import extract
 
 import restitution as r
+from restitution.agreement import disagreements, tolerances
 from restitution.cosim import FmiStatusError, FmuInstance, impact_fmu_parameters
 from restitution.model import DOMAIN
 
@@ -77,31 +79,41 @@ REAL_OUTPUTS = {"e": "e", "v_rebound": "v_rebound", "jgm.e": "e_ep", "jgm.V_c": 
                 "plate.m_eff": "m_eff", "plate.v_after": "v_plate"}
 OUTPUT_NAMES = list(REAL_OUTPUTS)
 BOOL_OUTPUTS = ["valid", "zener.in_range", "jgm.in_range", "e_negative", "effects.plasticity", "effects.plate_waves"]
+BOOL_FIELDS = ["valid", "lambda_in_range", "vstar_in_range", "e_negative", "plasticity_used", "plate_waves_used"]
 MODELS, METHODS, MODES = r.RESTITUTION_MODELS, r.ZENER_METHODS, r.EFFECT_MODES
+
+
+def _package_call(settings: dict):
+    """(v, params, options) of restitution.impact for a dict of FMU settings (defaults for the rest)."""
+    s = {name: start for name, (start, _text) in INPUTS.items()}
+    s.update(settings)
+    params = {f"{body}_{k}": s[f"{body}.{k}"] for body in ("sphere", "plate")
+              for k in ("E", "nu", "Sy", "rho", "d" if body == "sphere" else "t")}
+    options = dict(restitution_model=MODELS[s["restitution_model"] - 1], zener_method=METHODS[s["zener_method"] - 1],
+                   plasticity=MODES[s["plasticity"]], plate_waves=MODES[s["plate_waves"]],
+                   effect_tolerance=s["effect_tolerance"], ode_rtol=s["zener.ode_tolerance"])
+    return s["v_approach"], params, options
 
 
 def reference(settings: dict):
     """The package's result for a dict of FMU settings (defaults for anything not given)."""
-    s = {name: start for name, (start, _text) in INPUTS.items()}
-    s.update(settings)
-    return r.impact(s["v_approach"], *(s[f"{body}.{k}"] for body in ("sphere", "plate")
-                                       for k in ("E", "nu", "Sy", "rho", "d" if body == "sphere" else "t")),
-                    restitution_model=MODELS[s["restitution_model"] - 1], zener_method=METHODS[s["zener_method"] - 1],
-                    plasticity=MODES[s["plasticity"]], plate_waves=MODES[s["plate_waves"]],
-                    effect_tolerance=s["effect_tolerance"], ode_rtol=s["zener.ode_tolerance"])
+    v, params, options = _package_call(settings)
+    return r.impact(v, **params, **options)
 
 
 def assert_outputs(fmu, settings, context=""):
-    got = fmu.get_reals(OUTPUT_NAMES)
-    ref = reference(settings)
-    for name, value in zip(OUTPUT_NAMES, got):
-        want = getattr(ref, REAL_OUTPUTS[name])
-        assert value == want or value == pytest.approx(want, rel=1e-12, abs=0.0), (name, context)
+    """Every Real and Boolean output equals the package's within the output's conditioning
+    (restitution.agreement: the native FMU's libm and numpy may differ in last bits)."""
+    v, params, options = _package_call(settings)
+    got = dict(zip(REAL_OUTPUTS.values(), fmu.get_reals(OUTPUT_NAMES)))
+    got.update(zip(BOOL_FIELDS, fmu.get(*BOOL_OUTPUTS)))
+    problems = disagreements(SimpleNamespace(**got), r.impact(v, **params, **options), *tolerances(v, params, **options))
+    assert not problems, (context, problems)
 
 
 @pytest.fixture(scope="module")
-def unzipped(impact_fmu, tmp_path_factory):
-    return extract(str(impact_fmu), str(tmp_path_factory.mktemp("unzipped")))
+def unzipped(any_impact_fmu, tmp_path_factory):
+    return extract(str(any_impact_fmu), str(tmp_path_factory.mktemp("unzipped")))
 
 
 GOOD_SETTINGS = {**impact_fmu_parameters(r.Sphere(r.MATERIALS["tungsten_carbide"], 4.76e-3),
@@ -109,9 +121,9 @@ GOOD_SETTINGS = {**impact_fmu_parameters(r.Sphere(r.MATERIALS["tungsten_carbide"
 
 
 @pytest.fixture(scope="module")
-def bystander(impact_fmu, unzipped):
+def bystander(any_impact_fmu, unzipped):
     """An instance that keeps stepping, with valid values, next to every misbehaving one."""
-    with FmuInstance(impact_fmu, "bystander", unzip_dir=unzipped, parameters=GOOD_SETTINGS) as fmu:
+    with FmuInstance(any_impact_fmu, "bystander", unzip_dir=unzipped, parameters=GOOD_SETTINGS) as fmu:
         yield fmu
 
 
@@ -120,25 +132,24 @@ def _message_for(name, value, allowed):
 
 
 @pytest.mark.parametrize("name,value", BAD, ids=[f"{n}={v!r}" for n, v in BAD])
-def test_bad_value_is_logged_discarded_and_recoverable(impact_fmu, unzipped, bystander, name, value):
+def test_bad_value_is_refused_and_the_previous_one_kept(any_impact_fmu, unzipped, bystander, name, value):
     start, allowed = INPUTS[name]
-    with FmuInstance(impact_fmu, "bad", unzip_dir=unzipped) as bad:
+    with FmuInstance(any_impact_fmu, "bad", unzip_dir=unzipped) as bad:
         bad.set(v_approach=2.3)
         bad.do_step(step_size=1e-3)
         bystander.do_step(step_size=1e-3)
+        before = bad.get_reals(OUTPUT_NAMES)
         n_before = len(bad.messages)
 
-        bad.set(**{name: value})  # fmi2SetReal/Integer itself succeeds (fmpy raises otherwise)
-        logged = bad.messages[n_before:]
-        assert logged == [(FMI_ERROR, _message_for(name, value, allowed))]
-        assert all(math.isnan(x) for x in bad.get_reals(OUTPUT_NAMES))
-        assert bad.get(*BOOL_OUTPUTS) == [False] * len(BOOL_OUTPUTS)
-        for _ in range(2):  # discarded, not fatal, every time, with the reason
-            with pytest.raises(FmiStatusError) as err:
-                bad.do_step(step_size=1e-3)
-            assert err.value.status == FMI_DISCARD
-            assert bad.messages[-1][0] == FMI_DISCARD and name in bad.messages[-1][1] and allowed in bad.messages[-1][1]
-        assert FMI_FATAL not in [status for status, _ in bad.messages]
+        with pytest.raises(FmiStatusError) as err:
+            bad.set(**{name: value})
+        assert err.value.status == FMI_ERROR
+        assert bad.messages[n_before:] == [(FMI_ERROR, _message_for(name, value, allowed))]
+        assert bad.get(name) == [2.3 if name == "v_approach" else start]  # the previous value, kept
+        for _ in range(2):  # and the instance goes on with it
+            bad.do_step(step_size=1e-3)
+            assert _same(bad.get_reals(OUTPUT_NAMES), before)
+        assert_outputs(bad, {"v_approach": 2.3}, "after the refusal")
 
         # the other instance is unaffected (and re-evaluates: its input changes every time)
         v = 3.1 + 1e-3 * len(bad.messages) + bystander.time
@@ -146,59 +157,41 @@ def test_bad_value_is_logged_discarded_and_recoverable(impact_fmu, unzipped, bys
         bystander.do_step(step_size=1e-3)
         assert_outputs(bystander, {**GOOD_SETTINGS, "v_approach": v}, "bystander")
 
-        # a valid value again: correct results again, no new complaint
-        n_before = len(bad.messages)
-        bad.set(**{name: start})
-        bad.set(v_approach=2.3)
-        bad.do_step(step_size=1e-3)
-        assert_outputs(bad, {"v_approach": 2.3}, "after a valid value")
-        assert all(status < FMI_ERROR for status, _ in bad.messages[n_before:])
+        # refused in a vector call too: all or nothing, with a valid neighbour
+        other, other_value = ("plate.t", 3e-3) if name != "plate.t" else ("sphere.d", 4e-3)
+        if bad.variables[name].type == "Real":
+            with pytest.raises(FmiStatusError):
+                bad.set(**{other: other_value, name: value})
+            assert bad.get(other) == [INPUTS[other][0]]
+        assert FMI_FATAL not in [status for status, _ in bad.messages]
 
-        # or fmi2Reset: back to the start values
-        bad.set(**{name: value})
-        bad.reset()
-        bad.do_step(step_size=1e-3)
-        assert_outputs(bad, {}, "after reset")
+
+def _same(a, b):
+    return all(x == y or (math.isnan(x) and math.isnan(y)) for x, y in zip(a, b))
 
 
 @pytest.mark.parametrize("name,value", [("plate.t", NAN), ("sphere.nu", 0.5), ("zener_method", 9), ("v_approach", -INF)])
-def test_bad_value_during_initialization(impact_fmu, unzipped, name, value):
+def test_bad_value_during_initialization(any_impact_fmu, unzipped, name, value):
     """Set between fmi2EnterInitializationMode and fmi2ExitInitializationMode: same behaviour."""
-    with FmuInstance(impact_fmu, "init", unzip_dir=unzipped, parameters={name: value}) as fmu:
-        assert (FMI_ERROR, _message_for(name, value, INPUTS[name][1])) in fmu.messages
-        with pytest.raises(FmiStatusError) as err:
-            fmu.do_step(step_size=1e-3)
-        assert err.value.status == FMI_DISCARD
-        fmu.set(**{name: INPUTS[name][0]})
-        fmu.do_step(step_size=1e-3)
-        assert_outputs(fmu, {}, name)
+    with pytest.raises(FmiStatusError) as err:
+        FmuInstance(any_impact_fmu, "init", unzip_dir=unzipped, parameters={name: value})
+    assert err.value.status == FMI_ERROR and _message_for(name, value, INPUTS[name][1]) in str(err.value)
 
 
 @pytest.mark.parametrize("name,value", [("sphere.E", 1e13), ("plate.t", 1e-7), ("sphere.d", 1e-6),
                                         ("plate.E", 1e5), ("v_approach", 1e4), ("sphere.rho", 1e5),
                                         ("plate.t", 100.0), ("sphere.Sy", 1e3)])
-def test_valid_but_absurd_values_are_never_fatal(impact_fmu, unzipped, name, value):
-    """At the ends of the declared domain (physically extreme): either finite results, or a logged
-    evaluation failure and fmi2Discard; never fmi2Fatal, and valid values recover."""
-    with FmuInstance(impact_fmu, "absurd", unzip_dir=unzipped) as fmu:
+def test_valid_but_absurd_values_give_the_packages_numbers(any_impact_fmu, unzipped, name, value):
+    """At the ends of the declared domain (physically extreme) the model stays finite (the domain is
+    declared so that it does): the step succeeds with the package's numbers, and valid values after."""
+    with FmuInstance(any_impact_fmu, "absurd", unzip_dir=unzipped) as fmu:
         fmu.set(**{name: value})
-        try:
-            fmu.do_step(step_size=1e-3)
-            outcome = "ok"
-        except FmiStatusError as err:
-            assert err.status == FMI_DISCARD
-            assert any(status == FMI_ERROR and "evaluation failed" in text and name in text
-                       for status, text in fmu.messages)
-            outcome = "discard"
-        values = fmu.get_reals(OUTPUT_NAMES)
-        if outcome == "ok":
-            assert_outputs(fmu, {name: value}, name)
-        else:
-            assert all(math.isnan(x) for x in values)
-        assert FMI_FATAL not in [status for status, _ in fmu.messages]
+        fmu.do_step(step_size=1e-3)
+        assert_outputs(fmu, {name: value}, name)
         fmu.set(**{name: INPUTS[name][0]})
         fmu.do_step(step_size=1e-3)
         assert_outputs(fmu, {}, name)
+        assert all(status < FMI_ERROR for status, _ in fmu.messages)
 
 
 # --- many instances --------------------------------------------------------------------------------
@@ -227,12 +220,14 @@ def _speeds(i, n=40):
     return [0.01 + 0.37 * i + 0.25 * k + 1e-3 * k * k for k in range(n)]
 
 
-def test_eight_instances_interleaved_equal_one_at_a_time(impact_fmu, unzipped):
+def test_eight_instances_interleaved_equal_one_at_a_time(any_impact_fmu, unzipped):
     settings = _eight_settings()
+    if "native" in any_impact_fmu.parts:  # ode (zener_method = 4) is the Python FMU's only
+        settings = [dict(s, zener_method=1) if s["zener_method"] == 4 else s for s in settings]
     n = 40
 
     def make(i):
-        return FmuInstance(impact_fmu, f"m{i}", unzip_dir=unzipped, parameters=settings[i])
+        return FmuInstance(any_impact_fmu, f"m{i}", unzip_dir=unzipped, parameters=settings[i])
 
     interleaved = [[] for _ in settings]
     instances = [make(i) for i in range(len(settings))]
@@ -253,12 +248,10 @@ def test_eight_instances_interleaved_equal_one_at_a_time(impact_fmu, unzipped):
                 fmu.set(v_approach=_speeds(i)[k])
                 fmu.do_step(step_size=1e-3)
                 alone.append(tuple(fmu.get_reals(OUTPUT_NAMES)) + tuple(fmu.get(*BOOL_OUTPUTS)))
-            assert alone == interleaved[i], EIGHT[i]
+            assert alone == interleaved[i], EIGHT[i]  # the same code on the same inputs in one process
             for k in (0, n // 2, n - 1):
-                ref = reference({**settings[i], "v_approach": _speeds(i)[k]})
-                for name, value in zip(OUTPUT_NAMES, alone[k]):
-                    want = getattr(ref, REAL_OUTPUTS[name])
-                    assert value == want or value == pytest.approx(want, rel=1e-12), (EIGHT[i], name)
+                fmu.set(v_approach=_speeds(i)[k])
+                assert_outputs(fmu, {**settings[i], "v_approach": _speeds(i)[k]}, EIGHT[i])
     # the eight really differ
     assert len({row[0][0] for row in interleaved}) == len(settings)
 
@@ -311,10 +304,10 @@ def toy_fmu(tmp_path_factory):
     return fmu
 
 
-def test_runs_next_to_a_different_pythonfmu_fmu(impact_fmu, unzipped, toy_fmu):
+def test_runs_next_to_a_different_pythonfmu_fmu(impact_fmu, toy_fmu):
     settings = _eight_settings()[1]
     with FmuInstance(toy_fmu, "toy", parameters={"gain": 2.5}) as toy, \
-            FmuInstance(impact_fmu, "impact", unzip_dir=unzipped, parameters=settings) as impact, \
+            FmuInstance(impact_fmu, "impact", parameters=settings) as impact, \
             FmuInstance(toy_fmu, "toy2") as toy2:
         for k in range(50):
             x = 0.5 + 0.1 * k
@@ -347,52 +340,36 @@ STATE_CASES = {
 
 
 @pytest.mark.parametrize("case", list(STATE_CASES))
-def test_state_get_set_and_serialize_round_trip_exactly(impact_fmu, unzipped, case):
+def test_state_get_set_and_serialize_round_trip_exactly(any_impact_fmu, unzipped, case):
     settings = STATE_CASES[case]
-    with FmuInstance(impact_fmu, "state", unzip_dir=unzipped, parameters=settings) as fmu, \
-            FmuInstance(impact_fmu, "other", unzip_dir=unzipped) as other:
+    if settings.get("zener_method") == 4 and "native" in any_impact_fmu.parts:
+        pytest.skip("zener_method = 4 (ode) is the Python FMU's only")
+    with FmuInstance(any_impact_fmu, "state", unzip_dir=unzipped, parameters=settings) as fmu, \
+            FmuInstance(any_impact_fmu, "other", unzip_dir=unzipped) as other:
         fmu.do_step(0.0, 0.5)
         before = _snapshot(fmu)
         state = fmu.slave.getFMUstate()
         blob = fmu.slave.serializeFMUstate(state)
         assert 0 < len(blob) < 10_000
 
-        fmu.set(**_eight_settings()[6], v_approach=4.0, plasticity=1)  # change everything
+        fmu.set(**_eight_settings()[7], v_approach=4.0, plasticity=1)  # change everything
         fmu.do_step(0.5, 0.5)
         changed = _snapshot(fmu)
         assert changed != before
 
-        fmu.slave.setFMUstate(state)  # in memory
+        fmu.slave.setFMUstate(state)  # in memory: back to t = 0.5
         assert _snapshot(fmu) == before
-        fmu.do_step(1.0, 0.5)
+        fmu.do_step(0.5, 0.5)
         assert_outputs(fmu, settings, case)
 
-        copy = fmu.slave.deSerializeFMUstate(blob)  # serialized, into a different fresh instance
+        copy = other.slave.deSerializeFMUstate(blob)  # serialized, into a different fresh instance
         other.slave.setFMUstate(copy)
         assert _snapshot(other) == before
-        other.do_step(0.0, 0.5)
+        other.do_step(0.5, 0.5)
         assert_outputs(other, settings, case)
-        assert fmu.slave.serializeFMUstate(copy) == blob  # and again, byte for byte
-        fmu.slave.freeFMUstate(copy)
+        assert other.slave.serializeFMUstate(copy) == blob  # and again, byte for byte
+        other.slave.freeFMUstate(copy)
         fmu.slave.freeFMUstate(state)
-
-
-def test_state_captured_while_invalid_restores_the_complaint(impact_fmu, unzipped):
-    with FmuInstance(impact_fmu, "state", unzip_dir=unzipped) as fmu:
-        good = fmu.slave.getFMUstate()
-        fmu.set(**{"plate.t": NAN})
-        bad_blob = fmu.slave.serializeFMUstate(fmu.slave.getFMUstate())
-        fmu.slave.setFMUstate(good)
-        fmu.do_step(0.0, 0.1)
-        assert_outputs(fmu, {}, "good state")
-        fmu.slave.setFMUstate(fmu.slave.deSerializeFMUstate(bad_blob))
-        assert fmu.messages[-1] == (FMI_ERROR, _message_for("plate.t", NAN, INPUTS["plate.t"][1]))
-        with pytest.raises(FmiStatusError) as err:
-            fmu.do_step(0.1, 0.1)
-        assert err.value.status == FMI_DISCARD
-        fmu.slave.setFMUstate(good)
-        fmu.do_step(0.2, 0.1)
-        assert_outputs(fmu, {}, "good state again")
 
 
 # --- a long run -------------------------------------------------------------------------------------
@@ -406,17 +383,18 @@ def _rss_kib() -> int:
 
 @pytest.mark.slow
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc/self/status")
-def test_one_million_steps_unchanged_results_flat_memory(impact_fmu, unzipped, record_property):
+def test_one_million_steps_unchanged_results_flat_memory(any_impact_fmu, unzipped, record_property):
     """1e6 x (fmi2SetReal v, fmi2DoStep, fmi2GetReal e, v_rebound), v cycling through four values so
     that every step evaluates the model; raw FMI calls through fmpy's bindings (no per-call arrays)."""
     from fmpy.fmi2 import fmi2Real, fmi2ValueReference
 
     speeds = [2.3, 0.05, 11.0, 0.7]
-    with FmuInstance(impact_fmu, "long", unzip_dir=unzipped, parameters=_eight_settings()[0]) as fmu:
+    with FmuInstance(any_impact_fmu, "long", unzip_dir=unzipped, parameters=_eight_settings()[0]) as fmu:
         expected = []
-        for v in speeds:
-            ref = reference({**_eight_settings()[0], "v_approach": v})
-            expected.append((ref.e, ref.v_rebound))
+        for v in speeds:  # the FMU's own first answers, checked against the package within conditioning
+            fmu.set(v_approach=v)
+            assert_outputs(fmu, {**_eight_settings()[0], "v_approach": v})
+            expected.append(tuple(fmu.get_reals(["e", "v_rebound"])))
         s = fmu.slave
         set_real, get_real, do_step, c = s.fmi2SetReal, s.fmi2GetReal, s.fmi2DoStep, s.component
         vr_in = (fmi2ValueReference * 1)(fmu.vr("v_approach"))
@@ -428,11 +406,9 @@ def test_one_million_steps_unchanged_results_flat_memory(impact_fmu, unzipped, r
             wrong = 0
             for k in range(first, first + count):
                 value[0] = speeds[k & 3]
-                set_real(c, vr_in, 1, value)
-                do_step(c, k * h, h, 1)
-                get_real(c, vr_out, 2, out)
+                status = set_real(c, vr_in, 1, value) | do_step(c, k * h, h, 1) | get_real(c, vr_out, 2, out)
                 e, v_reb = expected[k & 3]
-                if out[0] != e or out[1] != v_reb:
+                if status != 0 or out[0] != e or out[1] != v_reb:
                     wrong += 1
             return wrong
 

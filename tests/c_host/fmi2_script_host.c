@@ -25,6 +25,8 @@
  *   SERIALIZED <slot> <bytes>
  *   INSTANCE <slot> <name>    or INSTANTIATE_FAILED (then exit code 3)
  *
+ *   LIBPYTHON <0|1>           at the end: whether a libpython is mapped into the process
+ *
  * Exit codes: 0 script done, 1 usage/script error, 2 dlopen/dlsym failure, 3 fmi2Instantiate
  * returned NULL.
  *
@@ -257,6 +259,14 @@ int main(int argc, char **argv)
         }
     }
     for (int s = 0; s < nslots; s++) free(blob[s]);
+    {
+        FILE *maps = fopen("/proc/self/maps", "r");
+        int python = 0;
+        while (maps && fgets(line, sizeof line, maps))
+            python |= strstr(line, "libpython") != NULL;
+        if (maps) fclose(maps);
+        printf("LIBPYTHON %d\n", python);
+    }
     dlclose(lib);
     return 0;
 }
