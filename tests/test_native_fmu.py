@@ -1,8 +1,7 @@
 """The native SpherePlateImpact.fmu (C front + C physics, no Python at run time) is the same
 component as the pythonfmu one: the same interface, variable by variable, and the package's numbers.
 
-The interface test runs everywhere. The tests of the built FMU need the generic C FMI front
-(fmu_src/restitution/fmu/cfront/, issue 11) and gcc; they skip saying which is missing. Numbers are
+The interface test runs everywhere. The tests of the built FMU need gcc (they skip saying so). Numbers are
 compared with restitution.agreement's per-case tolerances (derived from each output's conditioning),
 never bit for bit: the C uses libm, the package numpy and CPython's math.
 """
@@ -18,8 +17,8 @@ import pytest
 
 import restitution as r
 from restitution.agreement import disagreements, tolerances
-from restitution.fmu.native.build_native import (GENERATION_TOOL, NativeBuildSkipped, build_native_one,
-                                                 front_files, native_model_description)
+from restitution.fmu.native.build_native import (GENERATION_TOOL, NativeBuildSkipped, front_files,
+                                                 native_model_description)
 
 from test_hard_cases import FMU_FLAGS, FMU_REALS, params_for
 
@@ -71,8 +70,8 @@ needs_front = pytest.mark.skipif(_front_missing() is not None or shutil.which("g
 
 
 @pytest.fixture(scope="module")
-def native_fmu(impact_fmu, tmp_path_factory):
-    return build_native_one("SpherePlateImpact", impact_fmu.parent, impact_fmu)
+def native_fmu(native_impact_fmu):
+    return native_impact_fmu
 
 
 @needs_front
