@@ -126,9 +126,21 @@ int main(int argc, char **argv)
         perror(argv[1]);
         return 1;
     }
-    char lib_path[PATH_MAX + 256], resources[PATH_MAX + 64];
+    char lib_path[PATH_MAX + 256], resources[3 * PATH_MAX + 64];
     snprintf(lib_path, sizeof lib_path, "%s/binaries/linux64/%s.so", dir, argv[2]);
-    snprintf(resources, sizeof resources, "file://%s/resources", dir);
+    {   /* file:// URI of <dir>/resources, percent-encoded as RFC 3986 asks (unreserved bytes and '/' as is) */
+        size_t k = (size_t)snprintf(resources, sizeof resources, "file://");
+        char raw[PATH_MAX + 16];
+        snprintf(raw, sizeof raw, "%s/resources", dir);
+        for (const unsigned char *p = (const unsigned char *)raw; *p && k + 4 < sizeof resources; p++) {
+            if ((*p >= 'a' && *p <= 'z') || (*p >= 'A' && *p <= 'Z') || (*p >= '0' && *p <= '9') ||
+                strchr("-._~/", *p))
+                resources[k++] = (char)*p;
+            else
+                k += (size_t)snprintf(resources + k, sizeof resources - k, "%%%02X", *p);
+        }
+        resources[k] = '\0';
+    }
     lib = dlopen(lib_path, RTLD_LAZY | RTLD_LOCAL);
     if (!lib) {
         fprintf(stderr, "fmi2_script_host: dlopen failed: %s\n", dlerror());

@@ -606,7 +606,8 @@ static int hex_value(char ch)
 
 /* fmuResourceLocation (file:///p, file:/p, file://localhost/p, percent-encoded) -> the path p in
  * `path` (room for strlen(uri) + 1 bytes). Returns NULL, or why it is not a file URI one can decode.
- * Windows drive paths (file:///C:/x) lose their leading slash. */
+ * Windows drive paths (file:///C:/x) lose their leading slash. A '%' not followed by two hex digits
+ * is taken literally (hosts that do not encode their paths exist); an encoded NUL is refused. */
 static const char *decode_resource_location(const char *uri, char *path)
 {
     const char *p = uri;
@@ -622,10 +623,10 @@ static const char *decode_resource_location(const char *uri, char *path)
     if (((p[1] >= 'A' && p[1] <= 'Z') || (p[1] >= 'a' && p[1] <= 'z')) && p[2] == ':')
         p++; /* /C:/... */
     for (; *p; p++) {
-        if (*p == '%') {
-            int hi = hex_value(p[1]), lo = hi < 0 ? -1 : hex_value(p[2]);
-            if (hi < 0 || lo < 0 || (hi == 0 && lo == 0))
-                return "it has an invalid percent escape";
+        int hi = *p == '%' ? hex_value(p[1]) : -1, lo = hi < 0 ? -1 : hex_value(p[2]);
+        if (hi >= 0 && lo >= 0) {
+            if (hi == 0 && lo == 0)
+                return "it encodes a NUL character";
             path[n++] = (char)(hi * 16 + lo);
             p += 2;
         } else {
