@@ -1,20 +1,29 @@
-"""Cost of one impact in the native C physics against the Python package and, when they can be
-built, the native FMU against the pythonfmu FMU; every ratio is measured in this one run.
+#!/usr/bin/env python
+"""What one impact costs in the native SpherePlateImpact FMU: write docs/native_cost.md.
 
-    .venv/bin/python build_scripts/bench_native.py [--cases N]
+    .venv/bin/python build_scripts/bench_native.py [--quick] [--out DIR]
 
-* C physics: ``rst_impact`` in a compiled C loop (clock_gettime), v changing every call so nothing
-  is cached, for each Zener method the C implements;
-* package: ``restitution.impact`` with Python floats (the pythonfmu FMU's evaluation), same cases;
-* FMUs through fmpy ``FMU2Slave`` (set v_approach, doStep, get every Real and Boolean output): the
-  native FMU (``DIR/native/SpherePlateImpact.fmu``) against the pythonfmu one, when the native
-  FMU builds here (it needs the C FMI front; otherwise this part says so and is skipped).
+builds, in a scratch directory, the pythonfmu FMU (behind the C guard), the native FMU, a *floor*
+FMU (the same C front and generated interface table with a backend that does nothing) and two C
+programs, then measures, every ratio in this one run:
 
-Medians of ``--repeats`` runs. Numbers depend on the machine; the ratios are what to read.
+1. one impact (set v_approach, doStep, get all 11 Real and 6 Boolean outputs) through fmpy's
+   ``FMU2Slave``, raw calls: native against the floor (goal <= 1.5x), and the pythonfmu FMU;
+2. the same in a plain C host (``env -i PATH=/usr/bin:/bin``): pythonfmu against native (goal native
+   >= 30x faster), the native FMU's absolute figure (goal < 1 us), the floor, and the floor's four
+   calls one by one (where the front's time goes);
+3. the C physics (``rst_impact``) against the package's scalar ``restitution.impact``.
+
+Prints the headline next to the goals and writes DIR/native_cost.md (DIR defaults to docs/).
+``--quick`` (used by tests/test_bench_native.py) measures 3 short repeats; the full run takes about a
+minute. Split by job: bench_native_build.py (the FMUs and C programs), bench_native_timing.py
+(interleaved batches), bench_native_page.py (the page).
 """
 from __future__ import annotations
 
 import argparse
+import datetime
+import os
 import platform
 import statistics
 import subprocess
@@ -24,128 +33,91 @@ import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
+for _p in (ROOT / "fmu_src", ROOT / "build_scripts"):
+    if str(_p) not in sys.path:
+        sys.path.insert(0, str(_p))
 
-_LOOP = r"""
-#define _POSIX_C_SOURCE 199309L
-#include <stdio.h>
-#include <stdlib.h>
-#include <time.h>
-#include "rst_physics.h"
-int main(int argc, char **argv)
-{
-    long n;
-    int method;
-    if (argc != 3)
-        return 2;
-    n = atol(argv[1]);
-    method = atoi(argv[2]);
-    rst_impact_inputs in = {1.0, 207e9, 0.30, 2.0e9, 7861.0, 6.35e-3, 69e9, 0.33, 0.290e9, 2700.0, 6.35e-3,
-                            1, 1, 2, 2, 1e-6, 1e-10};
-    rst_impact_result out;
-    struct timespec t0, t1;
-    double sink = 0.0;
-    long i;
-    in.zener_method = method;
-    clock_gettime(CLOCK_MONOTONIC, &t0);
-    for (i = 0; i < n; i++) {
-        in.v = 0.1 + 1e-6 * (double)(i % 1000000);
-        rst_impact(&in, &out);
-        sink += out.e + out.t_contact;
+import bench_native_build as build  # noqa: E402
+import bench_native_page as page  # noqa: E402
+import bench_native_timing as timing  # noqa: E402
+
+#: name -> (repeats, CPU seconds per batch)
+CONFIGS = {"full": (11, 0.2), "quick": (3, 0.02)}
+
+
+def machine() -> dict:
+    cpu = platform.processor() or platform.machine()
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                cpu = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    versions = [f"Python {platform.python_version()}"]
+    try:
+        import fmpy
+
+        versions.append(f"fmpy {fmpy.__version__}")
+    except ImportError:
+        pass
+    try:
+        gcc = subprocess.run(["gcc", "-dumpfullversion"], capture_output=True, text=True).stdout.strip()
+        versions.append(f"gcc {gcc}")
+    except OSError:
+        pass
+    return {"cpu": cpu, "cores": os.cpu_count(), "versions": ", ".join(versions), "platform": platform.platform(),
+            "load_start": os.getloadavg()[0]}
+
+
+def run(quick: bool = False, out_dir: Path | None = None, verbose: bool = True) -> dict:
+    """Build, measure, write ``out_dir/native_cost.md`` (default docs/); returns the results."""
+    say = print if verbose else (lambda *a, **k: None)
+    name = "quick" if quick else "full"
+    reps, seconds = CONFIGS[name]
+    out_dir = Path(out_dir) if out_dir is not None else ROOT / "docs"
+    start = time.monotonic()
+    res = {"config": {"name": name, "reps": reps, "seconds": seconds}, "machine": machine(),
+           "date": datetime.date.today().isoformat(), "step": timing.STEP}
+    say(f"machine: {res['machine']['cpu']}, {res['machine']['cores']} cores, load {res['machine']['load_start']:.1f}")
+    with tempfile.TemporaryDirectory(prefix="bench_native-") as tmp:
+        say("building the FMUs (pythonfmu, native, floor) and the C hosts ...")
+        built = build.build_all(Path(tmp), log=lambda message: say(message, file=sys.stderr))
+        _, reals, bools = timing._interfaces(built.model_description)
+        res["n_reals"], res["n_bools"] = len(reals), len(bools)
+        say("fmpy round trips ...")
+        res["fmpy"] = timing.fmpy_round_trips(built, page.FMU_ROWS, reps, seconds)
+        say("C host round trips ...")
+        res["c_host"] = timing.c_host_round_trips(built, page.FMU_ROWS, reps, seconds)
+        say("C host, the floor's calls one by one ...")
+        res["calls"] = timing.c_host_round_trips(built, ("floor",), reps, seconds / 2, each_call=True)
+        say("C physics against the package ...")
+        res["physics"] = timing.physics_against_package(built, reps, seconds / 2)
+    fm, ch, ph = res["fmpy"], res["c_host"], res["physics"]
+    native = ch.batches["native"]
+    res["headline"] = {
+        "native_over_floor_fmpy": (fm.ratio("native", "floor"), fm.spread("native", "floor")),
+        "python_over_native_c_host": (ch.ratio("pythonfmu", "native"), ch.spread("pythonfmu", "native")),
+        "native_c_host": (statistics.median(native), (min(native), max(native))),
+        "package_over_c_physics": (ph.ratio("package exact", "C exact"), ph.spread("package exact", "C exact")),
     }
-    clock_gettime(CLOCK_MONOTONIC, &t1);
-    printf("%.6e %g\n", ((double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec)) / (double)n, sink);
-    return 0;
-}
-"""
-METHODS = {"exact": 1, "paper_fit": 2, "linear": 3}
-
-
-def c_loop_seconds(tmp: Path, n: int, repeats: int) -> dict:
-    from restitution.fmu.native.compile import CFLAGS, prepare_sources
-
-    src = prepare_sources(tmp / "src")
-    (src / "loop.c").write_text(_LOOP)
-    exe = tmp / "loop"
-    subprocess.run(["gcc", *CFLAGS, "-o", str(exe), str(src / "loop.c"), str(src / "rst_physics.c"), "-lm"],
-                   check=True)
-    return {m: statistics.median(float(subprocess.run([str(exe), str(n), str(code)], check=True, capture_output=True,
-                                                      text=True).stdout.split()[0]) for _ in range(repeats))
-            for m, code in METHODS.items()}
-
-
-def package_seconds(n: int, repeats: int) -> dict:
-    import restitution as r
-
-    sphere = r.Sphere(r.MATERIALS["s2_tool_steel"], d=6.35e-3).params()
-    plate = r.Plate(r.MATERIALS["al_6061"], t=6.35e-3).params()
-    out = {}
-    for method in METHODS:
-        runs = []
-        for _ in range(repeats):
-            t0 = time.perf_counter()
-            for i in range(n):
-                r.impact(0.1 + 1e-6 * i, **sphere, **plate, zener_method=method, validate=False)
-            runs.append((time.perf_counter() - t0) / n)
-        out[method] = statistics.median(runs)
-    return out
-
-
-def fmu_round_trip_seconds(fmu: Path, n: int, repeats: int) -> float:
-    from fmpy import extract, read_model_description
-    from fmpy.fmi2 import FMU2Slave
-
-    md = read_model_description(str(fmu))
-    vr = {v.name: v.valueReference for v in md.modelVariables}
-    reals = [v.valueReference for v in md.modelVariables if v.causality == "output" and v.type == "Real"]
-    bools = [v.valueReference for v in md.modelVariables if v.causality == "output" and v.type == "Boolean"]
-    slave = FMU2Slave(guid=md.guid, unzipDirectory=extract(str(fmu)), modelIdentifier=md.coSimulation.modelIdentifier,
-                      instanceName="bench")
-    slave.instantiate()
-    slave.setupExperiment(startTime=0.0)
-    slave.enterInitializationMode()
-    slave.exitInitializationMode()
-    runs, t, h = [], 0.0, 1e-3
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        for i in range(n):
-            slave.setReal([vr["v_approach"]], [0.1 + 1e-6 * i])
-            slave.doStep(t, h)
-            t += h
-            slave.getReal(reals)
-            slave.getBoolean(bools)
-        runs.append((time.perf_counter() - t0) / n)
-    slave.terminate()
-    slave.freeInstance()
-    return statistics.median(runs)
+    res["machine"]["load_end"] = os.getloadavg()[0]
+    res["duration"] = time.monotonic() - start
+    out_dir.mkdir(parents=True, exist_ok=True)
+    target = out_dir / "native_cost.md"
+    target.write_text(page.render(res), encoding="utf-8")
+    say("")
+    say(page.console(res))
+    say(f"\nwrote {target}")
+    return res
 
 
 def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--cases", type=int, default=20000)
-    parser.add_argument("--repeats", type=int, default=5)
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[1])
+    parser.add_argument("--quick", action="store_true", help="3 short repeats (a test run; the page says so)")
+    parser.add_argument("--out", type=Path, default=None, help="directory of native_cost.md (default: docs/)")
     args = parser.parse_args(argv)
-    print(f"machine: {platform.processor() or platform.machine()}, Python {platform.python_version()}")
-    with tempfile.TemporaryDirectory() as tmp:
-        tmp = Path(tmp)
-        c = c_loop_seconds(tmp, max(args.cases * 50, 10**6), args.repeats)
-        py = package_seconds(args.cases, args.repeats)
-        print(f"{'method':<10} {'C physics':>12} {'package':>12} {'package / C':>12}")
-        for m in METHODS:
-            print(f"{m:<10} {c[m] * 1e9:>9.1f} ns {py[m] * 1e6:>9.2f} us {py[m] / c[m]:>11.0f}x")
-        try:
-            from restitution.fmu.build import build_one
-            from restitution.fmu.native.build_native import NativeBuildSkipped, build_native_one
-
-            python_fmu = build_one("SpherePlateImpact", tmp / "fmus")
-            native_fmu = build_native_one("SpherePlateImpact", tmp / "fmus", python_fmu)
-        except Exception as exc:  # noqa: BLE001 - report and keep the physics numbers
-            print(f"FMU round trips skipped: {type(exc).__name__}: {exc}")
-            return 0
-        n = max(args.cases // 4, 1000)
-        native = fmu_round_trip_seconds(native_fmu, n, args.repeats)
-        python = fmu_round_trip_seconds(python_fmu, n, args.repeats)
-        print(f"fmpy round trip (setReal v, doStep, getReal + getBoolean of all outputs): native {native * 1e6:.2f} us, "
-              f"pythonfmu {python * 1e6:.2f} us, pythonfmu / native = {python / native:.1f}x")
+    run(quick=args.quick, out_dir=args.out)
     return 0
 
 

@@ -1,0 +1,170 @@
+"""The page build_scripts/bench_native.py writes (docs/native_cost.md) and the table it prints."""
+from __future__ import annotations
+
+import math
+
+from bench_native_timing import METHODS
+
+#: The goals of issue 12: key -> (what is measured, goal text, test on the measured value). Ratios are
+#: medians over the repeats of the ratio within a repeat; the absolute figure a median of batches.
+TARGETS = {
+    "native_over_floor_fmpy": (
+        "native / floor (the C front with a do-nothing backend, same variables), one impact through fmpy",
+        "<= 1.5x", lambda x: x <= 1.5),
+    "python_over_native_c_host": (
+        "pythonfmu / native, one impact in a plain C host", ">= 30x", lambda x: x >= 30.0),
+    "native_c_host": (
+        "native, one impact in a plain C host (absolute)", "< 1 us", lambda x: x < 1e-6),
+    "package_over_c_physics": (
+        "package scalar `impact` / C physics `rst_impact`, one impact (`exact`)", "none (was ~50x)", None),
+}
+#: Rows of each section (the test checks every one is on the page).
+FMU_ROWS = ("native", "floor", "pythonfmu")
+CALLS = ("fmi2SetReal", "fmi2DoStep", "fmi2GetReal", "fmi2GetBoolean")
+
+
+def fmt_time(seconds: float) -> str:
+    if not math.isfinite(seconds):
+        return str(seconds)
+    if seconds < 1e-6:
+        return f"{seconds * 1e9:.0f} ns"
+    if seconds < 1e-3:
+        return f"{seconds * 1e6:.2f} us"
+    return f"{seconds * 1e3:.2f} ms"
+
+
+def fmt_ratio(x: float) -> str:
+    return f"{x:.2f}x" if x < 10 else f"{x:.1f}x" if x < 100 else f"{x:.0f}x"
+
+
+def _spread(lo_hi) -> str:
+    return f"{fmt_ratio(lo_hi[0])} – {fmt_ratio(lo_hi[1])}"
+
+
+def headline_rows(res: dict) -> list[tuple[str, str, str, str, str]]:
+    """(target, measured, range over repeats, goal, met) per target."""
+    rows = []
+    for key, (text, goal, test) in TARGETS.items():
+        value, spread = res["headline"][key]
+        measured = fmt_time(value) if key == "native_c_host" else fmt_ratio(value)
+        span = "" if spread is None else (f"{fmt_time(spread[0])} – {fmt_time(spread[1])}" if key == "native_c_host"
+                                          else _spread(spread))
+        met = "—" if test is None else ("yes" if test(value) else "**no**")
+        rows.append((text, measured, span, goal, met))
+    return rows
+
+
+def console(res: dict) -> str:
+    """The headline as printed: the measured values next to the goals."""
+    rows = headline_rows(res)
+    width = max(len(r[0]) for r in rows)
+    lines = [f"{'target':<{width}}  {'measured':>9}  {'range over repeats':>19}  {'goal':>15}  met"]
+    lines += [f"{t:<{width}}  {m:>9}  {s:>19}  {g:>15}  {ok.strip('*')}" for t, m, s, g, ok in rows]
+    return "\n".join(lines)
+
+
+def _table(header: list[str], rows: list[list[str]], align: str) -> list[str]:
+    out = ["| " + " | ".join(header) + " |", "|" + "|".join("---:" if a == "r" else "---" for a in align) + "|"]
+    out += ["| " + " | ".join(row) + " |" for row in rows]
+    return out
+
+
+def _fmu_table(series, reference: str, note: dict) -> list[str]:
+    rows = []
+    for label in FMU_ROWS:
+        if label not in series.batches:
+            continue
+        ratio = "1" if label == reference else fmt_ratio(series.ratio(label, reference))
+        span = "" if label == reference else _spread(series.spread(label, reference))
+        rows.append([f"{label} ({note[label]})", fmt_time(series.median(label)), ratio, span])
+    return _table(["FMU", "per impact (median)", f"/ {reference}", "range over repeats"], rows, "lrrr")
+
+
+FMU_NOTE = {"native": "C front + C physics", "floor": "C front, backend does nothing",
+            "pythonfmu": "C guard + pythonfmu + the package"}
+
+
+def render(res: dict) -> str:
+    m, cfg = res["machine"], res["config"]
+    lines = [
+        "# What the native FMU costs",
+        "",
+        f"Measured by `build_scripts/bench_native.py` on {res['date']} ({res['duration']:.0f} s, "
+        f"{cfg['name']} run). Generated: rerun it to measure your machine:",
+        "",
+        "```sh",
+        ".venv/bin/python build_scripts/bench_native.py   # writes docs/native_cost.md; --quick for a short run",
+        "```",
+        "",
+        f"Machine: {m['cpu']}, {m['cores']} cores; {m['versions']}; {m['platform']}.",
+        "",
+        f"**A shared machine**: other jobs ran alongside (load average {m['load_start']:.1f} at the start, "
+        f"{m['load_end']:.1f} at the end, on {m['cores']} cores); they share the caches and cores, so absolute "
+        "times move from batch to batch (the ranges below show by how much). Each comparison runs its variants "
+        f"in turn, batch by batch ({cfg['reps']} repeats, the first variant rotating, {cfg['seconds']:g} s of CPU "
+        "time per batch after an untimed tenth of that); a time is the median of its batches, a ratio the median "
+        "over the repeats of the ratio within one repeat. Times are CPU time of the timing thread "
+        "(`time.thread_time`, `CLOCK_THREAD_CPUTIME_ID`), not wall time: every FMU here computes in the "
+        "caller's thread. **Ratios are the headline.**",
+        "",
+        "One impact = one round trip: `fmi2SetReal` of `v_approach` (a new value every time, so the model is "
+        f"evaluated), `fmi2DoStep` ({res['step']:g} s), `fmi2GetReal` of all {res['n_reals']} Real outputs and "
+        f"`fmi2GetBoolean` of all {res['n_bools']} Boolean outputs, `exact` method, S2 tool steel on Al 6061 "
+        "(the start values).",
+        "",
+        "## Headline",
+        "",
+        *_table(["target", "measured", "range over repeats", "goal", "met"],
+                [list(r) for r in headline_rows(res)], "lrrrl"),
+        "",
+        "## Through fmpy",
+        "",
+        "fmpy's `FMU2Slave` in this Python process, its raw FMI functions called with preallocated ctypes "
+        "arrays (as `tests/test_fmu_robustness.py`'s million-step test calls them). The *floor* is an FMU "
+        "with the same modelDescription built from the same C front (`fmu_src/restitution/fmu/cfront/`), the "
+        "same generated interface table and the same compiler flags as the native FMU, with a backend that "
+        "does nothing (every hook returns at once, outputs are constants: `bench_native_build.FLOOR_GLUE`): "
+        "native / floor is what the physics and its glue add to what the front and fmpy cost.",
+        "",
+        *_fmu_table(res["fmpy"], "floor", FMU_NOTE),
+        "",
+        "## In a plain C host",
+        "",
+        "A C timing host (`bench_native_build.TIMING_HOST`: dlopen of the FMU binary, the four calls in a loop, "
+        "`clock_gettime`) run under `env -i PATH=/usr/bin:/bin` as `tests/test_c_host_impact.py` runs its "
+        "host, all three FMUs instantiated in the one process; the pythonfmu FMU's guard starts the "
+        "interpreter recorded in `resources/python_env.txt`.",
+        "",
+        *_fmu_table(res["c_host"], "native", FMU_NOTE),
+        "",
+        f"native / floor in the C host: {fmt_ratio(res['c_host'].ratio('native', 'floor'))} "
+        f"(range {_spread(res['c_host'].spread('native', 'floor'))}).",
+        "",
+        "### Each call alone (the floor: the C front's own cost)",
+        "",
+        "The floor FMU in the same host, each of the four calls made alone in its own batches (the values "
+        "set and the times stepped as in the round trip).",
+        "",
+        *_table(["call", "per call (median)", "share of their sum"],
+                _call_rows(res["calls"]), "lrr"),
+        "",
+        "## The C physics against the package",
+        "",
+        "`rst_impact` in a compiled C loop (`bench_native_build.PHYSICS_LOOP`, v changing every call) against "
+        "the package's scalar `restitution.impact` with Python floats (`validate=False`; what the pythonfmu "
+        "FMU evaluates per step), per Zener method the C implements.",
+        "",
+        *_table(["Zener method", "C physics per impact", "package scalar call", "package / C", "range over repeats"],
+                [[meth, fmt_time(res["physics"].median(f"C {meth}")),
+                  fmt_time(res["physics"].median(f"package {meth}")),
+                  fmt_ratio(res["physics"].ratio(f"package {meth}", f"C {meth}")),
+                  _spread(res["physics"].spread(f"package {meth}", f"C {meth}"))] for meth in METHODS], "lrrrr"),
+        "",
+    ]
+    return "\n".join(lines)
+
+
+def _call_rows(series) -> list[list[str]]:
+    medians = {call: series.median(f"floor/{call}") for call in CALLS}
+    total = sum(medians.values())
+    return [[f"`{call}`", fmt_time(medians[call]), f"{100 * medians[call] / total:.0f} %"] for call in CALLS]
