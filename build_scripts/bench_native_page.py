@@ -138,7 +138,9 @@ def render(res: dict) -> str:
         *_fmu_table(res["c_host"], "native", FMU_NOTE),
         "",
         f"native / floor in the C host: {fmt_ratio(res['c_host'].ratio('native', 'floor'))} "
-        f"(range {_spread(res['c_host'].spread('native', 'floor'))}).",
+        f"(range {_spread(res['c_host'].spread('native', 'floor'))}): the floor's time is "
+        f"{100 / res['c_host'].ratio('native', 'floor'):.0f} % of the native FMU's, so that share of one impact "
+        "is the C front (and the host's loop), the rest the physics and its glue.",
         "",
         "### Each call alone (the floor: the C front's own cost)",
         "",
