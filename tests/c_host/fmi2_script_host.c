@@ -17,6 +17,12 @@
  *   step S T H                fmi2DoStep(S, T, H, noSetFMUStatePriorToCurrentPoint = true)
  *   get_state S | set_state S | free_state S                (one stored state per slot)
  *   serialize S | deserialize S   via the slot's byte buffer (size, serialize, deserialize)
+ *   deserialize_file S PATH   fmi2DeSerializeFMUstate of the bytes of a file (hostile states)
+ *   set_foreign_state S       fmi2SetFMUstate with a pointer that is no state of the FMU's
+ *   instantiate_bad KIND      fmi2Instantiate with one bad argument (null_name, empty_name, wrong_guid,
+ *                             null_guid, null_callbacks, null_logger, null_alloc, model_exchange,
+ *                             bad_uri); prints BAD_INSTANCE <KIND> <NULL|NONNULL> (a non-NULL one is freed)
+ *   get_string S VR | set_string S VR      String calls (this FMU has no String variable)
  *
  * Output (stdout, line-buffered):
  *   LOG <instance> <status> <category>: <message>      every logger callback
@@ -75,6 +81,7 @@ typedef fmi2Status (*SetStateT)(fmi2Component, fmi2FMUstate);
 typedef fmi2Status (*StateSizeT)(fmi2Component, fmi2FMUstate, size_t *);
 typedef fmi2Status (*SerializeT)(fmi2Component, fmi2FMUstate, fmi2Byte[], size_t);
 typedef fmi2Status (*DeserializeT)(fmi2Component, const fmi2Byte[], size_t, fmi2FMUstate *);
+typedef fmi2Status (*StringT)(fmi2Component, const fmi2ValueReference[], size_t, fmi2String[]);
 
 #define MAX_SLOTS 16
 #define MAX_VRS 256
@@ -166,6 +173,8 @@ int main(int argc, char **argv)
     StateSizeT state_size = (StateSizeT)sym("fmi2SerializedFMUstateSize");
     SerializeT serialize = (SerializeT)sym("fmi2SerializeFMUstate");
     DeserializeT deserialize = (DeserializeT)sym("fmi2DeSerializeFMUstate");
+    StringT get_string = (StringT)sym("fmi2GetString");
+    StringT set_string = (StringT)sym("fmi2SetString");
 
     fmi2CallbackFunctions cb = {logger, calloc, free, NULL, NULL};
     fmi2Component inst[MAX_SLOTS] = {0};
@@ -189,6 +198,30 @@ int main(int argc, char **argv)
             }
             printf("INSTANCE %d %s\n", nslots, name);
             nslots++;
+            continue;
+        }
+        if (!strcmp(cmd, "instantiate_bad")) {
+            char *kind = strtok_r(NULL, " \t\r\n", &save);
+            fmi2CallbackFunctions no_logger = {NULL, calloc, free, NULL, NULL};
+            fmi2CallbackFunctions no_alloc = {logger, NULL, free, NULL, NULL};
+            const char *name = "bad", *guid = argv[3], *uri = resources;
+            const fmi2CallbackFunctions *callbacks = &cb;
+            fmi2Type type = fmi2CoSimulation;
+            fmi2Component c;
+            if (!kind) return 1;
+            if (!strcmp(kind, "null_name")) name = NULL;
+            else if (!strcmp(kind, "empty_name")) name = "";
+            else if (!strcmp(kind, "wrong_guid")) guid = "{00000000-0000-0000-0000-000000000000}";
+            else if (!strcmp(kind, "null_guid")) guid = NULL;
+            else if (!strcmp(kind, "null_callbacks")) callbacks = NULL;
+            else if (!strcmp(kind, "null_logger")) callbacks = &no_logger;
+            else if (!strcmp(kind, "null_alloc")) callbacks = &no_alloc;
+            else if (!strcmp(kind, "model_exchange")) type = fmi2ModelExchange;
+            else if (!strcmp(kind, "bad_uri")) uri = "file:///nonexistent/%00/resources";
+            else return 1;
+            c = instantiate(name, type, guid, uri, callbacks, 0, 1);
+            printf("BAD_INSTANCE %s %s\n", kind, c ? "NONNULL" : "NULL");
+            if (c) free_instance(c);
             continue;
         }
         char *slot_text = strtok_r(NULL, " \t\r\n", &save);
@@ -260,6 +293,19 @@ int main(int argc, char **argv)
             }
             report(cmd, s, st);
             printf("SERIALIZED %d %zu\n", s, blob_size[s]);
+        } else if (!strcmp(cmd, "deserialize_file") && a) {
+            FILE *f = fopen(a, "rb");
+            static fmi2Byte bytes[1 << 16];
+            size_t n = f ? fread(bytes, 1, sizeof bytes, f) : 0;
+            if (f) fclose(f);
+            report(cmd, s, deserialize(c, bytes, n, &state[s]));
+        } else if (!strcmp(cmd, "set_foreign_state")) {
+            double not_a_state[64] = {0};
+            report(cmd, s, set_state(c, (fmi2FMUstate)not_a_state));
+        } else if ((!strcmp(cmd, "get_string") || !strcmp(cmd, "set_string")) && a) {
+            fmi2ValueReference vr = (fmi2ValueReference)strtoul(a, NULL, 10);
+            fmi2String text[1] = {"text"};
+            report(cmd, s, (cmd[0] == 'g' ? get_string : set_string)(c, &vr, 1, text));
         } else if (!strcmp(cmd, "deserialize")) {
             /* the bytes of slot a (default: s) into slot s's state */
             int from = a ? atoi(a) : s;

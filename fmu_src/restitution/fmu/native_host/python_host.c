@@ -564,7 +564,7 @@ static int init_legacy(const shim_config *cfg, rst_instance *inst)
 static int ensure_ready(rst_instance *inst, const char *resource_dir)
 {
     char bindir[PATH_MAX] = "", cfg_a[PATH_MAX + 64] = "", cfg_b[PATH_MAX + 64] = "";
-    char res_dir[PATH_MAX] = "";
+    char res_dir[PATH_MAX + 64] = "";
     shim_config cfg;
     int have_cfg = 0;
 

@@ -1,0 +1,218 @@
+"""The C front under AddressSanitizer, UndefinedBehaviorSanitizer and LeakSanitizer, with hostile calls.
+
+The native FMUs (front + backend + physics, from their own sources/) and the guard in front of
+pythonfmu (front + pythonfmu backend + Python loader) are recompiled with
+``-fsanitize=address,undefined -fno-sanitize-recover=all`` and driven by the plain C host
+(tests/c_host/fmi2_script_host.c, sanitized too) through a script of hostile calls generated from
+the interface table: every variable set to NaN, infinities, values just outside its range and the
+wrong type; unknown value references; String calls; calls in the wrong mode; bad step sizes and
+times; garbage, truncated, flipped and foreign serialized states; a pointer that is no state;
+fmi2Instantiate with each bad argument; instances freed with states still allocated. Any memory
+error, undefined behaviour or leak (native FMUs: the process ends with every instance freed)
+makes the sanitizer exit non-zero with a report, which the test shows.
+"""
+from __future__ import annotations
+
+import math
+import shutil
+import subprocess
+import sys
+import zipfile
+from pathlib import Path
+
+import pytest
+
+from restitution.fmu.interface import variables
+
+ROOT = Path(__file__).resolve().parents[1]
+SANITIZE = ["-g", "-O1", "-fno-omit-frame-pointer", "-fsanitize=address,undefined", "-fno-sanitize-recover=all"]
+
+pytestmark = [
+    pytest.mark.skipif(not sys.platform.startswith("linux"), reason="Linux sanitizers"),
+    pytest.mark.skipif(shutil.which("gcc") is None, reason="gcc not available"),
+]
+
+
+def _fmi2_headers():
+    from restitution.fmu.native.build_native import fmi2_include_dir
+
+    return fmi2_include_dir()
+
+
+@pytest.fixture(scope="module")
+def host(tmp_path_factory):
+    exe = tmp_path_factory.mktemp("asan_host") / "fmi2_script_host"
+    subprocess.run(["gcc", *SANITIZE, "-Wall", "-Wextra", "-Werror", "-o", str(exe),
+                    str(ROOT / "tests" / "c_host" / "fmi2_script_host.c"), "-ldl"], check=True)
+    return exe
+
+
+def _unpack(fmu, dest):
+    with zipfile.ZipFile(fmu) as z:
+        z.extractall(dest)
+    return dest
+
+
+def _sanitized_native(fmu, model, dest):
+    """The native FMU unpacked, its Linux binary rebuilt from its own sources/ with the sanitizers."""
+    unpacked = _unpack(fmu, dest)
+    sources = sorted(str(p) for p in (unpacked / "sources").glob("*.c"))
+    subprocess.run(["gcc", "-std=c99", *SANITIZE, "-Wall", "-Wextra", "-Werror", "-pedantic", "-ffp-contract=off",
+                    "-shared", "-fPIC", "-DRST_FRONT_PTHREAD", "-pthread", f"-I{unpacked / 'sources'}",
+                    f"-I{_fmi2_headers()}", "-o", str(unpacked / "binaries" / "linux64" / f"{model}.so"), *sources, "-lm"],
+                   check=True, capture_output=True, text=True)
+    return unpacked
+
+
+def _sanitized_guard(fmu, model, dest):
+    """The pythonfmu FMU unpacked, its guard rebuilt with the sanitizers."""
+    from restitution.fmu.interface import c_header
+    from restitution.fmu.native_host import make_standalone as ms
+
+    unpacked = _unpack(fmu, dest)
+    real = unpacked / "binaries" / "linux64" / f"{model}{ms.REAL_SUFFIX}.so"
+    headers = dest.parent / f"{model}_guard_headers"
+    headers.mkdir()
+    ms.write_guard_headers(headers, (unpacked / "modelDescription.xml").read_text(encoding="utf-8"), c_header(model))
+    info = ms.describe_interpreter(sys.executable)
+    cmd = ms.guard_command(unpacked / "binaries" / "linux64" / f"{model}.so", headers, real.name, "gcc",
+                           info["include"], real.read_bytes(), extra_flags=SANITIZE)
+    subprocess.run(cmd, check=True, capture_output=True, text=True)
+    return unpacked
+
+
+def _hostile_script(model, state_files, other_model_state):
+    rows = variables(model)
+    n = len(rows)
+    kinds = {"Real": "real", "Integer": "integer", "Boolean": "boolean"}
+    lines = [f"instantiate_bad {kind}" for kind in ("null_name", "empty_name", "wrong_guid", "null_guid",
+                                                   "null_callbacks", "null_logger", "null_alloc",
+                                                   "model_exchange", "bad_uri")]
+    lines += ["instantiate hostile", "instantiate spare",
+              # wrong mode: before initialization
+              "step 0 0.0 0.1", "get_real 0 0", "exit_init 0", "terminate 0", "get_state 0", "serialize 0",
+              "setup 0 0.0", "setup 0 1.0", "enter_init 0"]
+    for v in rows:
+        kind = kinds[v.type]
+        for wrong in kinds.values():
+            if wrong != kind:
+                lines.append(f"get_{wrong} 0 {v.vr}")
+                lines.append(f"set_{wrong} 0 {v.vr} 1" if wrong != "real" else f"set_real 0 {v.vr} 1.5")
+        if v.causality in ("parameter", "input") and v.type == "Real":
+            low, high = v.interval[0], v.interval[1]
+            for bad in ("nan", "inf", "-inf", repr(math.nextafter(low, -math.inf)),
+                        repr(math.nextafter(high, math.inf)) if math.isfinite(high) else "1e308", "-1e308"):
+                lines.append(f"set_real 0 {v.vr} {bad}")
+        if v.causality in ("parameter", "input") and v.type == "Integer":
+            for bad in (-2147483648, 2147483647, int(v.interval[0]) - 1, int(v.interval[1]) + 1):
+                lines.append(f"set_integer 0 {v.vr} {bad}")
+        if v.causality in ("output", "local"):
+            lines.append(f"set_{kind} 0 {v.vr} 0")
+    for vr in (n, n + 1, 2 ** 31, 2 ** 32 - 1):
+        lines += [f"get_real 0 {vr}", f"set_real 0 {vr} 1.0", f"get_integer 0 {vr}", f"get_boolean 0 {vr}",
+                  f"get_string 0 {vr}", f"set_string 0 {vr}"]
+    lines += ["get_string 0 0", "set_string 0 0", "exit_init 0",
+              "step 0 0.0 nan", "step 0 0.0 -1", "step 0 0.0 0", "step 0 nan 0.1", "step 0 0.0 inf",
+              "step 0 0.0 0.1", "step 0 0.0 0.1", "step 0 1.0 0.1", "step 0 0.1 1e308",
+              "get_real 0 " + " ".join(str(v.vr) for v in rows if v.type == "Real"),
+              "get_state 0", "serialize 0", "get_state 0", "set_state 0", "deserialize 0 0", "set_state 0"]
+    for path in state_files:
+        lines.append(f"deserialize_file 0 {path}")
+    lines += [f"deserialize_file 0 {other_model_state}", "set_foreign_state 0",
+              "setup 1 0.0", "enter_init 1", "exit_init 1", "get_state 1", "serialize 1",
+              "deserialize 0 1", "set_state 0", "step 0 0.0 0.1",  # another instance's bytes: fine, same model
+              "terminate 0", "step 0 0.1 0.1", "terminate 0", "get_real 0 0", "reset 0", "get_real 0 0",
+              "setup 0 0.0", "enter_init 0", "exit_init 0", "step 0 0.0 0.1", "get_state 0",
+              "free 0", "free 1"]  # freed with their states still allocated: the front frees them
+    return lines
+
+
+def _state_files(directory, blob_source):
+    """Hostile serialized states: garbage, empty, truncated and flipped versions of a real one."""
+    directory.mkdir()
+    real = blob_source.read_bytes()
+    cases = {"empty": b"", "garbage": bytes(range(256)) * 4, "header": real[:12], "truncated": real[:-1],
+             "half": real[:len(real) // 2], "huge_length": real[:12] + b"\xff\xff\xff\xff" + real[16:],
+             "flipped": bytes(b ^ 0x55 if i == len(real) // 3 else b for i, b in enumerate(real))}
+    files = []
+    for name, data in cases.items():
+        path = directory / name
+        path.write_bytes(data)
+        files.append(path)
+    return files
+
+
+def _serialized_state(unpacked, model, directory):
+    """A genuine serialized state of ``model``, written by fmpy into ``directory``."""
+    from fmpy import read_model_description
+    from fmpy.fmi2 import FMU2Slave
+
+    md = read_model_description(str(unpacked / "modelDescription.xml"))
+    slave = FMU2Slave(guid=md.guid, unzipDirectory=str(unpacked), modelIdentifier=model, instanceName="blob")
+    slave.instantiate()
+    slave.setupExperiment(startTime=0.0)
+    slave.enterInitializationMode()
+    slave.exitInitializationMode()
+    blob = bytes(slave.serializeFMUstate(slave.getFMUstate()))
+    slave.terminate()
+    slave.freeInstance()
+    path = directory / f"{model}.state"
+    path.write_bytes(blob)
+    return path
+
+
+@pytest.fixture(scope="module")
+def genuine_states(built_fmus, tmp_path_factory):
+    """Serialized states of both models, written by the (unsanitized) native FMUs in this process."""
+    out = tmp_path_factory.mktemp("states")
+    paths = {}
+    for model in ("SpherePlateImpact", "BouncingBall"):
+        fmu = built_fmus / "native" / f"{model}.fmu"
+        if not fmu.is_file():
+            pytest.skip("native FMUs not built here")
+        paths[model] = _serialized_state(_unpack(fmu, out / model), model, out)
+    return paths
+
+
+def _run(host, unpacked, model, script, leaks: bool):
+    from fmpy import read_model_description
+
+    guid = read_model_description(str(unpacked / "modelDescription.xml")).guid
+    env = {"PATH": "/usr/bin:/bin",
+           "ASAN_OPTIONS": f"detect_leaks={int(leaks)}:abort_on_error=0:exitcode=99",
+           "UBSAN_OPTIONS": "print_stacktrace=1:halt_on_error=1:exitcode=98"}
+    return subprocess.run(["env", "-i", *(f"{k}={v}" for k, v in env.items()), str(host), str(unpacked), model, guid],
+                          input="\n".join(script) + "\n", capture_output=True, text=True, timeout=600)
+
+
+def _assert_clean(proc, script):
+    report = proc.stderr[-6000:]
+    assert proc.returncode == 0, f"exit {proc.returncode}\n{report}"
+    for marker in ("ERROR: AddressSanitizer", "runtime error:", "ERROR: LeakSanitizer"):
+        assert marker not in proc.stderr, report
+    statuses = [line.split() for line in proc.stdout.splitlines() if line.startswith("STATUS ")]
+    assert len(statuses) > len(script) // 2  # the script ran to its end
+    assert not any(s[3] == "Fatal" for s in statuses)
+    bad = [line for line in proc.stdout.splitlines() if line.startswith("BAD_INSTANCE")]
+    assert len(bad) == 9 and all(line.endswith(" NULL") for line in bad), bad
+
+
+@pytest.mark.parametrize("model", ["SpherePlateImpact", "BouncingBall"])
+def test_native_fmu_hostile_calls_under_sanitizers(built_fmus, host, genuine_states, model, tmp_path):
+    fmu = built_fmus / "native" / f"{model}.fmu"
+    unpacked = _sanitized_native(fmu, model, tmp_path / "fmu")
+    other = genuine_states["BouncingBall" if model == "SpherePlateImpact" else "SpherePlateImpact"]
+    script = _hostile_script(model, _state_files(tmp_path / "states", genuine_states[model]), other)
+    _assert_clean(_run(host, unpacked, model, script, leaks=True), script)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("model", ["SpherePlateImpact", "BouncingBall"])
+def test_guard_hostile_calls_under_sanitizers(built_fmus, host, genuine_states, model, tmp_path):
+    """The guard in a plain C host that starts Python: memory errors and undefined behaviour only
+    (the embedded interpreter is never finalized, so its memory is left to the process exit)."""
+    fmu = built_fmus / f"{model}.fmu"
+    unpacked = _sanitized_guard(fmu, model, tmp_path / "fmu")
+    other = genuine_states["BouncingBall" if model == "SpherePlateImpact" else "SpherePlateImpact"]
+    script = _hostile_script(model, _state_files(tmp_path / "states", genuine_states[model]), other)
+    _assert_clean(_run(host, unpacked, model, script, leaks=False), script)
