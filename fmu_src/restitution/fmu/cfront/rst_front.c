@@ -376,7 +376,6 @@ static int check_set(rst_instance *inst, const char *function, fmi2ValueReferenc
         return 0;
     }
     var = &inst->model->variables[vr];
-    describe_value(type, value, text, sizeof text);
     if (var->type != type) {
         rst_log(inst, fmi2Error, "%s: %s (value reference %u) is a %s variable, not %s", function, var->name, vr,
                 type_name(var->type), type_name(type));
@@ -392,6 +391,7 @@ static int check_set(rst_instance *inst, const char *function, fmi2ValueReferenc
         return 0;
     }
     if (!in_range(var, value)) {
+        describe_value(type, value, text, sizeof text);
         rst_log(inst, fmi2Error, "%s = %s is outside the allowed range: %s", var->name, text,
                 var->range_text ? var->range_text : "finite");
         return 0;
@@ -892,9 +892,9 @@ fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint, fmi2R
     char t_text[40], h_text[40], want[40];
     ENTER("fmi2DoStep", RST_STEP_COMPLETE)
     (void)noSetFMUStatePriorToCurrentPoint;
-    rst_format_double(t, t_text, sizeof t_text);
-    rst_format_double(h, h_text, sizeof h_text);
     if (!isfinite(t) || !isfinite(h) || !(h > 0.0) || !isfinite(t + h)) {
+        rst_format_double(t, t_text, sizeof t_text);
+        rst_format_double(h, h_text, sizeof h_text);
         rst_log(inst, fmi2Error, "fmi2DoStep: currentCommunicationPoint = %s, communicationStepSize = %s: the step "
                 "size must be finite and > 0, the time finite", t_text, h_text);
         LEAVE(fmi2Error);
@@ -902,6 +902,7 @@ fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint, fmi2R
     if (inst->has_time) {
         double scale = fabs(inst->next_time) > fabs(h) ? fabs(inst->next_time) : fabs(h);
         if (fabs(t - inst->next_time) > TIME_RTOL * scale) {
+            rst_format_double(t, t_text, sizeof t_text);
             rst_format_double(inst->next_time, want, sizeof want);
             rst_log(inst, fmi2Error, "fmi2DoStep: currentCommunicationPoint = %s does not continue the previous "
                     "step, which ended at %s (a step cannot be skipped or repeated without fmi2SetFMUstate)",
