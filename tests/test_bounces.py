@@ -17,7 +17,6 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
-from fmpy import extract
 
 import restitution as r
 from restitution.agreement import disagreements, tolerances

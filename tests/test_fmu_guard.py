@@ -24,7 +24,6 @@ from __future__ import annotations
 
 import math
 import os
-import shutil
 import signal
 import subprocess
 import sys
@@ -32,7 +31,6 @@ import textwrap
 import time
 from pathlib import Path
 
-import numpy as np
 import pytest
 from fmpy import extract
 

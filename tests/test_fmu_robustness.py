@@ -14,7 +14,6 @@ also next to a different pythonfmu FMU.
 """
 from __future__ import annotations
 
-import ctypes
 import gc
 import math
 import struct
