@@ -1,0 +1,69 @@
+#!/usr/bin/env bash
+# System packages some tests need beyond Python, gcc and the lock:
+#   gcc-mingw-w64-x86-64  the native FMUs' binaries/win64 (x86_64-w64-mingw32-gcc)
+#   wine64, wine          running win64 programs (tests/test_native_win64.py)
+#   libtbb12              the ecos engine of the ecospy wheel (tests/test_native_hosts.py)
+#   cmake                 fmpy's rebuild of a native FMU from its sources/ (tests/test_native_fmu.py)
+#
+#   bash build_scripts/system_packages.sh
+#
+# As root on a Debian/Ubuntu machine (apt-get), the missing ones are installed quietly. Otherwise, or if
+# the installation fails, it prints one line per missing package saying which tests will skip. It never
+# fails: the tests that need a missing package skip and say why. .ci/run calls it before the tests.
+set -u
+
+declare -A SKIPS=(
+    [gcc-mingw-w64-x86-64]="tests/test_native_win64.py skips, and the native FMUs are built without binaries/win64"
+    [wine64]="tests/test_native_win64.py skips (no Wine to run the win64 physics driver and FMU host)"
+    [libtbb12]="the ecos tests of tests/test_native_hosts.py skip (ecos needs libtbb.so.12)"
+    [cmake]="tests/test_native_fmu.py::test_rebuilt_from_sources_by_fmpy skips (fmpy's rebuild uses cmake)"
+)
+ORDER=(gcc-mingw-w64-x86-64 wine64 libtbb12 cmake)
+
+have_lib() {
+    local ldconfig
+    ldconfig=$(command -v ldconfig || echo /sbin/ldconfig)
+    [ -x "$ldconfig" ] && "$ldconfig" -p 2>/dev/null | grep -q "$1"
+}
+
+present() {  # what the tests look for, not the package database
+    case "$1" in
+        gcc-mingw-w64-x86-64) command -v x86_64-w64-mingw32-gcc >/dev/null ;;
+        wine64) command -v wine64 >/dev/null || command -v wine >/dev/null || [ -x /usr/lib/wine/wine64 ] ;;
+        libtbb12) have_lib 'libtbb\.so\.12 ' ;;
+        cmake) command -v cmake >/dev/null ;;
+    esac
+}
+
+missing() {
+    local p
+    for p in "${ORDER[@]}"; do
+        present "$p" || echo "$p"
+    done
+}
+
+todo=$(missing)
+if [ -z "$todo" ]; then
+    echo "system_packages: all present (${ORDER[*]})"
+    exit 0
+fi
+
+if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null; then
+    packages=$todo
+    case " $(echo $todo) " in *" wine64 "*) packages="$todo wine" ;; esac  # wine: the 'wine' command
+    echo "system_packages: installing $(echo $packages) (apt-get)"
+    export DEBIAN_FRONTEND=noninteractive
+    log=$(mktemp)
+    if ! { timeout 600 apt-get -qq -o DPkg::Lock::Timeout=120 update >"$log" 2>&1 &&
+           timeout 1200 apt-get -qq -y -o DPkg::Lock::Timeout=120 install $packages >>"$log" 2>&1; }; then
+        echo "system_packages: apt-get failed; its last lines:"
+        tail -n 5 "$log" | sed 's/^/    /'
+    fi
+    rm -f "$log"
+    todo=$(missing)
+fi
+
+for p in $todo; do
+    echo "system_packages: $p missing: ${SKIPS[$p]}"
+done
+exit 0
