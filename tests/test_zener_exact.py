@@ -15,7 +15,7 @@ from scipy.integrate import solve_ivp
 from scipy.special import beta
 
 from restitution.zener_exact import (E_INF, LAMBDA_TABLE_MAX, TAU0_LAMBDA0, _asym,
-                                     zener_exact)
+                                     zener_exact, zener_exact_solution)
 from restitution.zener_ode import solve_zener_ode, solve_zener_ode_array
 
 TAU0_HERTZ = 2.0 * (5.0 / 4.0) ** 0.4 * 0.4 * beta(0.4, 0.5)  # closed form at lambda = 0
@@ -178,6 +178,9 @@ def test_large_lambda_form(lam):
     e, t = zener_exact(lam)
     assert rel(e, e_ref) <= 1e-8 and rel(t, t_ref) <= 1e-8
     assert e == pytest.approx(E_INF * lam**-5, rel=1e-14)
+    # the deficit 1 - e_ze (~1e-11 below 1 here): to rounding of 1, from the scalar and the array path
+    for d in (zener_exact_solution(lam)[1], zener_exact_solution(np.array([lam]))[1][0]):
+        assert d <= 1.0 and abs(d - (1.0 - e_ref)) <= 1e-15, (lam, d)
     u = lam ** (-5.0 / 3.0)
     assert t == pytest.approx(lam * (5.0 * math.log(lam) - 0.359367056648 + 3.0 * u), rel=1e-8)
 
@@ -226,16 +229,22 @@ def test_invalid_message_names_value():
 
 
 # (h) ----------------------------------------------------------------------------------------
-# The table's pieces are built once at import. Rebuilding them here, at test time, from the data
-# file through the same functions, and checking the rebuilt interpolant against the independent
-# solves, tests the loader and the Hermite construction themselves (a mutation tool switches
-# mutants on per call, after import, so the import-time build is out of its reach otherwise).
-def _rebuilt_pieces(monkeypatch, table):
+# Everything the method reads from its data file (the pieces, h, the table end, the large-lambda
+# constants) is built once at import, by _tables. Rebuilding it here, at test time, from the data
+# file, installing it in the module and checking the rebuilt method against the independent solves
+# tests the loader and the construction themselves (a mutation tool switches mutants on per call,
+# after import, so the import-time build is out of its reach otherwise).
+_TABLE_GLOBALS = ("_H", "_INV_H", "LAMBDA_TABLE_MAX", "E_INF", "TAU0_LAMBDA0", "_U_MAX", "_G_CHEB", "_COEF",
+                  "_COEF_ARR")
+
+
+def _rebuilt(monkeypatch, table):
     import restitution.zener_exact as ze
 
-    coef, coef_arr = ze._build_pieces(table)
-    monkeypatch.setattr(ze, "_COEF", coef)
-    monkeypatch.setattr(ze, "_COEF_ARR", coef_arr)
+    built = ze._tables(table)
+    assert len(built) == len(_TABLE_GLOBALS)
+    for name, value in zip(_TABLE_GLOBALS, built):
+        monkeypatch.setattr(ze, name, value)
     return ze
 
 
@@ -244,7 +253,13 @@ def test_table_rebuilt_at_test_time_matches_independent_solution(monkeypatch, re
 
     table = ze._load_table()
     assert {"k", "e", "de", "tau0", "dtau0", "h"} <= set(table)
-    ze = _rebuilt_pieces(monkeypatch, table)
+    ze = _rebuilt(monkeypatch, table)
+    # the documented layout: nodes on lambda = k/128 up to lambda = 100; the constants as the closed forms
+    # and the independent solves give them
+    assert ze._H == 1.0 / 128.0 and ze._INV_H * ze._H == 1.0 and ze.LAMBDA_TABLE_MAX == 100.0
+    assert abs(ze.TAU0_LAMBDA0 / TAU0_HERTZ - 1.0) <= 1e-12
+    e10 = reference(10.0)[0]  # e_ze lambda^5 = E_INF to < 1e-13 from lambda = 4 (module doc)
+    assert rel(ze.E_INF, e10 * 1e5) <= 1e-9
     lams = np.array(sorted(ref_values))
     e_arr, d_arr, t_arr = ze.zener_exact_solution(lams)
     for i, lam in enumerate(lams):
@@ -257,6 +272,26 @@ def test_table_rebuilt_at_test_time_matches_independent_solution(monkeypatch, re
             assert abs(got[1] - (1.0 - e_ref)) <= 1e-8 * max(e_ref, 1e-3), (lam, got[1], 1.0 - e_ref)
     tiny = 1e-9
     assert rel(ze.zener_exact_solution(tiny)[1], 1.7301733 * tiny) < 1e-6
+    # above the table: the large-lambda form with the rebuilt constants, scalar and array paths
+    big = [150.0, 1000.0, 1e4]
+    e_big, d_big, t_big = ze.zener_exact_solution(np.array(big + [50.0]))
+    for i, lam in enumerate(big):
+        e_ref, t_ref = reference(lam)
+        for e, d, t in (ze.zener_exact_solution(lam), (e_big[i], d_big[i], t_big[i])):
+            assert rel(e, e_ref) <= 1e-8 and rel(t, t_ref) <= 1e-8, (lam, e, t, e_ref, t_ref)
+    assert rel(e_big[3], reference(50.0)[0]) <= 1e-8  # the table's share of a mixed array
+
+
+def test_table_must_end_at_lambda_100():
+    """zener_exact_solution's fast path has lambda = 100 written out: a data file that ends elsewhere is refused,
+    with a message naming the file and both ends."""
+    import restitution.zener_exact as ze
+
+    good = ze._load_table()
+    for end in (50.0, 100.5):
+        with pytest.raises(RuntimeError, match=r"^zener_table\.npz: expected a table up to lambda = 100, got "
+                                               + str(end).replace(".", r"\.") + "$"):
+            ze._tables(dict(good, lam_table_max=np.float64(end)))
 
 
 def test_table_with_a_bad_node_layout_is_refused():
@@ -272,4 +307,4 @@ def test_table_with_a_bad_node_layout_is_refused():
     assert ends_at_table_max[-1] * good["h"] == 100.0  # the table has a node at lambda = 100
     for broken_k in (k + 1, k[::-1], k[:-200], swapped, repeated, ends_at_table_max):
         with pytest.raises(RuntimeError, match="bad node layout"):
-            ze._build_pieces(dict(good, k=broken_k))
+            ze._tables(dict(good, k=broken_k))

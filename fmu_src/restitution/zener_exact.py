@@ -75,30 +75,18 @@ def _hermite(k, f, df, h):
             (2.0 * (f0 - f1) + d0 + d1) / w**3)
 
 
-_T = _load_table()
-_H = float(_T["h"])
-_INV_H = 1.0 / _H
-#: Upper end of the tabulated range of lambda [1]; above it the large-lambda form is used.
-LAMBDA_TABLE_MAX = float(_T["lam_table_max"])
-#: lim lambda^5 e_ze for lambda -> inf [1] (the large-lambda form e_ze = E_INF lambda^-5).
-E_INF = float(_T["asym_E_inf"])
-#: tau0 at lambda = 0: 2 (5/4)^(2/5) (2/5) B(2/5, 1/2) [1].
-TAU0_LAMBDA0 = float(_T["tau0"][0])
-_U_MAX = float(_T["asym_u_max"])
-_G_CHEB = [float(c) for c in _T["asym_g_cheb"]]
-
-
-def _build_pieces(T):
+def _build_pieces(T, h, lam_max):
+    """(pieces per fine cell as tuples, the same as an array) from the table T, node spacing h, table end lam_max."""
     k = T["k"]
-    if k[0] != 0 or np.any(np.diff(k) <= 0) or k[-1] * _H <= LAMBDA_TABLE_MAX:
+    if k[0] != 0 or np.any(np.diff(k) <= 0) or k[-1] * h <= lam_max:
         raise RuntimeError(f"{_DATA_NAME}: bad node layout")
     # one row per piece: (k_j, a0..a3 for e_ze, c0..c3 for 1 - e_ze, b0..b3 for tau0).
     # The deficit's pieces are c0 = 1 - a0 (exact: a0 >= 0.5 on every piece where it matters,
     # Sterbenz) and c_i = -a_i, so 1 - e_ze is interpolated directly: at small lambda it is
     # t (|a1| + ...) with full relative accuracy instead of the difference of two numbers near 1.
-    a = _hermite(k, T["e"], T["de"], _H)
+    a = _hermite(k, T["e"], T["de"], h)
     rows = np.stack((k[:-1],) + a + (1.0 - a[0], -a[1], -a[2], -a[3])
-                    + _hermite(k, T["tau0"], T["dtau0"], _H), axis=1)
+                    + _hermite(k, T["tau0"], T["dtau0"], h), axis=1)
     cell_to_piece = np.repeat(np.arange(len(rows)), np.diff(k))  # fine cell -> piece
     # scalar path: a list over fine cells whose entries share the piece tuples (small, and
     # an index costs one multiply and int()); array path: the same rows, expanded
@@ -106,8 +94,25 @@ def _build_pieces(T):
     return [pieces[j] for j in cell_to_piece.tolist()], np.ascontiguousarray(rows[cell_to_piece])
 
 
-_COEF, _COEF_ARR = _build_pieces(_T)
-del _T
+def _tables(T):
+    """Everything the evaluation reads, from the arrays T of data/zener_table.npz: (h, 1/h,
+    LAMBDA_TABLE_MAX, E_INF, TAU0_LAMBDA0, u_max, the Chebyshev coefficients of g, the pieces per fine
+    cell as tuples and as an array). Called once, at import; the tests call it again on the data file
+    and check what it builds against independent solves (a mutation tool switches its mutants on per
+    call, after import, so this is how the build is reached)."""
+    h = float(T["h"])
+    lam_max = float(T["lam_table_max"])
+    if lam_max != 100.0:  # the literal in zener_exact_solution's fast path must match the table
+        raise RuntimeError(f"{_DATA_NAME}: expected a table up to lambda = 100, got {lam_max}")
+    coef, coef_arr = _build_pieces(T, h, lam_max)
+    return (h, 1.0 / h, lam_max, float(T["asym_E_inf"]), float(T["tau0"][0]), float(T["asym_u_max"]),
+            [float(c) for c in T["asym_g_cheb"]], coef, coef_arr)
+
+
+# LAMBDA_TABLE_MAX: upper end of the tabulated range of lambda [1]; above it the large-lambda form is used.
+# E_INF: lim lambda^5 e_ze for lambda -> inf [1] (the large-lambda form e_ze = E_INF lambda^-5).
+# TAU0_LAMBDA0: tau0 at lambda = 0, 2 (5/4)^(2/5) (2/5) B(2/5, 1/2) [1].
+(_H, _INV_H, LAMBDA_TABLE_MAX, E_INF, TAU0_LAMBDA0, _U_MAX, _G_CHEB, _COEF, _COEF_ARR) = _tables(_load_table())
 
 
 def _bad_lambda(value, where=""):
@@ -250,7 +255,3 @@ def zener_exact_solution(lam):
     if isinstance(lam, (np.ndarray, list, tuple)) or np.ndim(lam) != 0:
         return _array(lam)
     return _scalar_general(lam)  # other scalars: int, numpy's, Fraction, Decimal; errors
-
-
-if LAMBDA_TABLE_MAX != 100.0:  # the literal in the fast path must match the table
-    raise RuntimeError(f"{_DATA_NAME}: expected a table up to lambda = 100, got {LAMBDA_TABLE_MAX}")
