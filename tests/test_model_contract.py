@@ -339,6 +339,38 @@ def test_no_suggestion_when_nothing_is_close():
         MATERIALS["unobtainium"]
 
 
+def test_suggestions_are_few_and_closest_first():
+    """suggest_material's contract (its docstring): at most two names close in spelling, closest first; else at
+    most three presets whose full name has every word of three letters or more, words split at underscores."""
+    from restitution.materials import suggest_material
+
+    # 'al_110' is close in spelling to three keys (al_110_h16, al_1100_h16, al_6061): two are offered
+    assert suggest_material("al_110", MATERIALS) == " (did you mean 'al_110_h16' or 'al_1100_h16'?)"
+    # no key is close in spelling; the words, split at the underscore, name tungsten carbide in reverse order
+    assert suggest_material("carbide_tungsten", MATERIALS) == " (did you mean 'tungsten_carbide'?)"
+    # "440" (three letters) counts: only the 440C stainless steel, not every steel
+    assert suggest_material("steel 440", MATERIALS) == " (did you mean 'stainless_440c'?)"
+    # five presets are steels by name: three are offered, each a steel
+    text = suggest_material("steel", MATERIALS)
+    offered = text.removeprefix(" (did you mean ").removesuffix("?)").split(" or ")
+    steels = [key for key, mat in MATERIALS.items() if "steel" in mat.name.lower()]
+    assert len(steels) == 5 and len(offered) == 3 and all(o.strip("'") in steels for o in offered), text
+
+
+def test_one_impact_in_floats_reuses_the_material_step():
+    """The material-only step (Eqs. 1-6) of a float impact is memoised: a second impact with the same
+    materials at another speed does not recompute it (what a co-simulation pays per step). The count is
+    taken after the first impact: whether that one found the step cached depends on what ran before in
+    the process (a mutation tool forks its test runs from a process that has run them already)."""
+    from restitution.model import _material_terms_cached
+
+    first = r.impact(1.0, **PARAMS)
+    hits = _material_terms_cached.cache_info().hits
+    second = r.impact(2.0, **PARAMS)
+    assert _material_terms_cached.cache_info().hits == hits + 1
+    assert first.V_c == second.V_c and first.eps_y == second.eps_y
+
+
 def test_plate_wave_speed_is_the_thin_plate_longitudinal_speed():
     """The plate wave speed of Eq. (12), sqrt(E' / rho) with E' = E / (1 - nu^2), is the thin-plate
     longitudinal wave speed: ~5.35 km/s in aluminium and ~5.4 km/s in steel (Graff, Wave Motion in Elastic

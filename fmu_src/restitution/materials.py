@@ -92,11 +92,15 @@ class MaterialTable(dict):
 
 def suggest_material(name, materials) -> str:
     """" (did you mean 'a' or 'b'?)" for an unknown material ``name`` among ``materials`` (a mapping
-    of short names to :class:`Material`, or just names), or "" when nothing is close."""
+    of short names to :class:`Material`, or just names), or "" when nothing is close.
+
+    At most two names close in spelling (difflib's similarity >= 0.6, its default cutoff), closest
+    first; if none, at most three presets whose full name contains every word of ``name`` that has
+    three letters or more (underscores separate words), in the order of ``materials``."""
     import difflib
 
     query = str(name).lower()
-    close = difflib.get_close_matches(query, list(materials), n=2, cutoff=0.6)
+    close = difflib.get_close_matches(query, list(materials), n=2)
     if not close and hasattr(materials, "items"):
         words = [w for w in query.replace("_", " ").split() if len(w) >= 3]
         close = [key for key, mat in materials.items()

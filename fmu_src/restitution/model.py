@@ -156,15 +156,15 @@ def impact(v, sphere_E, sphere_nu, sphere_Sy, sphere_rho, sphere_d,
             and plate_rho.__class__ is float and plate_t.__class__ is float):
         # one impact in Python floats (the FMU's case; spelt out: a generator costs 10 % of the call)
         scalar = True
-    elif is_scalar(v) and all(is_scalar(x) for x in params):
-        scalar = True
-        v, params = float(v), tuple(map(float, params))
     else:
-        # No up-front broadcast: what depends on the parameters only is computed once per
-        # distinct parameter value (a scalar parameter stays a scalar), not once per case.
-        scalar = False
-        v = np.asarray(v, dtype=float)
-        params = tuple(np.asarray(x, dtype=float) for x in params)
+        scalar = is_scalar(v) and all(is_scalar(x) for x in params)
+        if scalar:
+            v, params = float(v), tuple(map(float, params))
+        else:
+            # No up-front broadcast: what depends on the parameters only is computed once per
+            # distinct parameter value (a scalar parameter stays a scalar), not once per case.
+            v = np.asarray(v, dtype=float)
+            params = tuple(np.asarray(x, dtype=float) for x in params)
     return _pipeline(v, params, scalar, restitution_model, zener_method, plasticity, plate_waves,
                      effect_tolerance, ode_rtol)
 
@@ -205,7 +205,7 @@ def _pipeline(v, params, scalar, restitution_model, zener_method, plasticity, pl
 
     moving = v > 0.0
     T = where(moving, time_scale(m_a, k, where(moving, v, 1.0)), math.inf)
-    t_contact = where(moving, contact_duration(where(moving, T, 0.0), tau0), 0.0)
+    t_contact = where(moving, contact_duration(T, tau0), 0.0)  # T tau0 = inf where not moving: replaced
 
     # --- Fusion, Eqs. (17)-(20)
     e = apparent_restitution(e_ep, e_ze)
