@@ -156,3 +156,55 @@ def test_state_round_trip(any_impact_fmu):
         fmu.slave.setFMUstate(fmu.slave.deSerializeFMUstate(blob))
         assert fmu.get_reals(list(REAL_OUTPUTS)) == before
         fmu.slave.freeFMUstate(state)
+
+
+def test_an_undocumented_non_finite_output_is_an_evaluation_failure(impact_fmu, monkeypatch):
+    """A NaN (or -inf) the interface does not document makes the outputs NaN and valid false, is logged
+    with the inputs, and fmi2DoStep returns fmi2Discard; +inf in m_eff for e_ze = 1 is documented."""
+    import dataclasses
+
+    import sphere_plate_impact_slave as slave_module  # the module the FMU imported in this process
+
+    real_impact = slave_module.impact
+    broken = {"tau0": math.nan}
+    monkeypatch.setattr(slave_module, "impact",
+                        lambda *a, **k: dataclasses.replace(real_impact(*a, **k), **broken))
+    with FmuInstance(impact_fmu) as fmu:
+        fmu.set(v_approach=2.0)
+        assert all(math.isnan(x) for x in fmu.get_reals(list(REAL_OUTPUTS)))
+        assert fmu.get("valid") == [False]
+        failure = fmu.messages[-1]
+        assert failure[0] == 3 and "evaluation failed for v_approach = 2.0" in failure[1]
+        assert "non-finite output zener.tau0 = nan" in failure[1]
+        with pytest.raises(FmiStatusError) as err:
+            fmu.do_step(step_size=1e-3)
+        assert err.value.status == 2  # fmi2Discard
+    broken.clear()  # the documented infinity passes: a half-space
+    with FmuInstance(impact_fmu) as fmu:
+        fmu.set(v_approach=2.0, plate_waves=0)
+        fmu.do_step(step_size=1e-3)
+        assert fmu.get("plate.m_eff") == [math.inf] and fmu.get("valid") == [True]
+
+
+def test_the_slaves_own_states_are_validated(tmp_path):
+    """Without the C guard (pythonfmu's own binaries, e.g. win64), the slave still refuses a state
+    that is not its own or holds a value the setters would refuse, logs why and changes nothing."""
+    from bouncing_ball_slave import BouncingBall
+    from sphere_plate_impact_slave import SpherePlateImpact
+
+    slave = SpherePlateImpact(instance_name="direct")
+    good = slave._fmu_state_to_bytes(slave._get_fmu_state())
+    slave.vars[next(vr for vr, v in slave.vars.items() if v.name == "plate.t")].setter(3e-3)
+    crafted = SpherePlateImpact._fmu_state_from_bytes(good)
+    crafted["values"]["plate.t"] = -6.35e-3
+    code = SpherePlateImpact._fmu_state_from_bytes(good)
+    code["values"]["zener_method"] = 2.5
+    ball_state = BouncingBall(instance_name="ball")._get_fmu_state()
+    for bad in (SpherePlateImpact._fmu_state_from_bytes(b"\x00garbage"), crafted, code, ball_state,
+                {"schema": crafted["schema"], "values": {}}, [1, 2, 3]):
+        n = len(slave.log_queue)
+        slave._set_fmu_state(bad)
+        assert slave._values["plate.t"] == 3e-3, bad
+        assert len(slave.log_queue) == n + 1 and slave.log_queue[-1].status == 3, bad
+    slave._set_fmu_state(SpherePlateImpact._fmu_state_from_bytes(good))
+    assert slave._values["plate.t"] == 6.35e-3
