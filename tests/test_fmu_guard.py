@@ -39,6 +39,7 @@ from restitution.agreement import disagreements, tolerances
 from restitution.fmu.interface import variables
 
 from fmi_child import run_child
+from toy_fmu import build_toy_fmu
 
 FMI_OK, FMI_WARNING, FMI_DISCARD, FMI_ERROR, FMI_FATAL = range(5)
 CRASHES = (-signal.SIGSEGV, -signal.SIGABRT, -signal.SIGBUS, 128 + signal.SIGSEGV, 128 + signal.SIGABRT)
@@ -184,16 +185,7 @@ class GuardToyRaising(Fmi2Slave):
 
 @pytest.fixture(scope="module")
 def raising_fmu(tmp_path_factory):
-    from restitution.fmu.native_host.make_standalone import make_standalone
-
-    work = tmp_path_factory.mktemp("toy")
-    script = work / f"{TOY_MODULE}.py"
-    script.write_text(textwrap.dedent(TOY_SOURCE))
-    subprocess.run([sys.executable, "-m", "pythonfmu", "build", "-f", str(script), "-d", str(work)],
-                   check=True, cwd=work, capture_output=True)
-    fmu = work / "GuardToyRaising.fmu"
-    make_standalone(fmu)
-    return fmu
+    return build_toy_fmu(tmp_path_factory.mktemp("toy"), TOY_MODULE, TOY_SOURCE, "GuardToyRaising")
 
 
 def test_fatal_is_latched_and_never_reaches_freed_memory(raising_fmu, tmp_path):

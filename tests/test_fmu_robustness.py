@@ -17,9 +17,7 @@ from __future__ import annotations
 import gc
 import math
 import struct
-import subprocess
 import sys
-import textwrap
 import time
 from types import SimpleNamespace
 
@@ -30,6 +28,8 @@ import restitution as r
 from restitution.agreement import disagreements, tolerances
 from restitution.cosim import FmiStatusError, FmuInstance, impact_fmu_parameters
 from restitution.model import DOMAIN
+
+from toy_fmu import build_toy_fmu
 
 FMI_OK, FMI_DISCARD, FMI_ERROR, FMI_FATAL = 0, 2, 3, 4
 
@@ -288,19 +288,7 @@ class RobustnessToyGainCounter(Fmi2Slave):
 
 @pytest.fixture(scope="module")
 def toy_fmu(tmp_path_factory):
-    work = tmp_path_factory.mktemp("toy")
-    script = work / f"{TOY_MODULE}.py"
-    script.write_text(textwrap.dedent(TOY_SOURCE))
-    subprocess.run([sys.executable, "-m", "pythonfmu", "build", "-f", str(script), "-d", str(work)],
-                   check=True, cwd=work, capture_output=True)
-    fmu = work / "RobustnessToyGainCounter.fmu"
-    # A plain pythonfmu 0.7 binary frees its static PyState twice at process exit, which can
-    # abort the whole test process after the last test; the project's loader (the shim every
-    # project FMU carries) neutralises that, so the toy gets it too.
-    from restitution.fmu.native_host.make_standalone import make_standalone
-
-    make_standalone(fmu)
-    return fmu
+    return build_toy_fmu(tmp_path_factory.mktemp("toy"), TOY_MODULE, TOY_SOURCE, "RobustnessToyGainCounter")
 
 
 def test_runs_next_to_a_different_pythonfmu_fmu(impact_fmu, toy_fmu):
