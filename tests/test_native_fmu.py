@@ -14,6 +14,8 @@ from xml.etree import ElementTree as ET
 
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 import restitution as r
 from restitution.agreement import disagreements, tolerances
@@ -21,6 +23,7 @@ from restitution.fmu.native.build_native import (GENERATION_TOOL, NativeBuildSki
                                                  native_model_description)
 
 from test_hard_cases import FMU_FLAGS, FMU_REALS, params_for
+from test_properties import CASES  # the declared domain, drawn log-uniformly
 
 INTERFACE_ATTRIBUTES = ("name", "valueReference", "causality", "variability", "initial", "description")
 TYPE_ATTRIBUTES = ("unit", "start", "min", "max", "declaredType")
@@ -156,3 +159,39 @@ def test_rebuilt_from_sources_by_fmpy(native_fmu, tmp_path):
     assert v_star == pytest.approx(86.9, abs=0.05)  # Green (2022) Sec. 7 checkpoint
     expected = r.impact(2.3, **params_for("s2/al6061")).e
     assert e == pytest.approx(expected, rel=1e-12, abs=1e-14)
+
+
+# --- a hypothesis search of the declared domain, through the native FMU itself -------------------------
+FMU_CODES = {"restitution_model": {m: i + 1 for i, m in enumerate(r.RESTITUTION_MODELS)},
+             "zener_method": {"exact": 1, "paper_fit": 2, "linear": 3},
+             "plasticity": {m: i for i, m in enumerate(r.EFFECT_MODES)},
+             "plate_waves": {m: i for i, m in enumerate(r.EFFECT_MODES)}}
+
+
+@pytest.fixture(scope="module")
+def native_instance(native_fmu):
+    from restitution.cosim import FmuInstance
+
+    with FmuInstance(native_fmu, "hypothesis") as fmu:
+        yield fmu
+
+
+@settings(max_examples=400, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow,
+                                                                                    HealthCheck.function_scoped_fixture])
+@given(CASES, st.sampled_from([0.0, 1e-6, 1e-3]))
+def test_native_fmu_equals_the_package_over_the_declared_domain(native_instance, case, effect_tolerance):
+    """Every output and flag of the native FMU equals the package's within its conditioning, for cases
+    drawn from the whole declared domain (all methods the C implements, models and effect modes)."""
+    fmu = native_instance
+    params = {k: v for k, v in case.items() if k in r.model.DOMAIN and k != "v"}
+    params.update(sphere_nu=case["sphere_nu"], plate_nu=case["plate_nu"])
+    options = {k: case[k] for k in FMU_CODES}
+    fmu.set(**_fmu_parameters(params), **{k: FMU_CODES[k][v] for k, v in options.items()},
+            effect_tolerance=effect_tolerance, v_approach=case["v"])
+    values = fmu.get(*FMU_REALS, *FMU_FLAGS)
+    got = type("R", (), {**{FMU_REALS[k]: x for k, x in zip(FMU_REALS, values)},
+                         **{FMU_FLAGS[k]: x for k, x in zip(FMU_FLAGS, values[len(FMU_REALS):])}})
+    options["effect_tolerance"] = effect_tolerance
+    expected = r.impact(case["v"], **params, **options)
+    problems = disagreements(got, expected, *tolerances(case["v"], params, **options))
+    assert not problems, (case, effect_tolerance, problems)
