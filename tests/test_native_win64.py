@@ -5,10 +5,11 @@ conditioning, never bit identity).
 * The physics: the same stdin/stdout driver as the sanitizer test of tests/test_native_physics.py,
   built with x86_64-w64-mingw32-gcc (static runtime), against restitution.impact.
 * The FMU: binaries/win64/SpherePlateImpact.dll of the native SpherePlateImpact.fmu (as built by
-  ``python -m restitution.fmu build``), loaded with LoadLibrary by a plain C host
-  (tests/c_host/fmi2_portable_host.c) cross-compiled with mingw-w64, and the same host built with gcc
+  ``python -m restitution.fmu build``), loaded with LoadLibrary by the plain C host of the other host
+  tests (tests/c_host/fmi2_script_host.c) cross-compiled with mingw-w64, and the same host built with gcc
   on binaries/linux64/SpherePlateImpact.so: the same script of FMI calls on both, every output
-  compared; one refused value (NaN) is fmi2Error with a log message, not a crash.
+  compared; one refused value (NaN) is fmi2Error with a log message, not a crash; no Python in either
+  process.
 
 Needs Debian's gcc-mingw-w64-x86-64 and wine64 (+ wine for the ``wine`` command; bash
 build_scripts/system_packages.sh installs them); skips saying which is missing. Marked slow: the first
@@ -39,7 +40,8 @@ from test_native_physics import _DRIVER, NAMES, random_cases
 MINGW = "x86_64-w64-mingw32-gcc"
 WINE = shutil.which("wine64") or shutil.which("wine") or (
     "/usr/lib/wine/wine64" if os.access("/usr/lib/wine/wine64", os.X_OK) else None)
-HOST_SOURCE = Path(__file__).resolve().parent / "c_host" / "fmi2_portable_host.c"
+HOST_SOURCE = Path(__file__).resolve().parent / "c_host" / "fmi2_script_host.c"
+MODEL = "SpherePlateImpact"
 REALS = ("e", "v_rebound", "e_ep", "V_c", "V_star", "eps_y", "e_ze", "lam", "tau0", "T", "t_contact", "m_a",
          "m_eff", "v_plate")
 FLAGS = ("plasticity_used", "plate_waves_used", "lambda_in_range", "vstar_in_range", "e_negative", "valid")
@@ -104,12 +106,12 @@ STEP = 1e-3  # [s] communication step of the script (the impact FMU does not dep
 
 
 @pytest.fixture(scope="module")
-def portable_hosts(tmp_path_factory):
-    """tests/c_host/fmi2_portable_host.c built twice: for Linux with gcc, for win64 with mingw-w64."""
+def script_hosts(tmp_path_factory):
+    """tests/c_host/fmi2_script_host.c built twice: for Linux with gcc, for win64 with mingw-w64."""
     if shutil.which("gcc") is None:
         pytest.skip("gcc missing: the Linux build of the host is the reference")
-    out = tmp_path_factory.mktemp("portable_host")
-    linux, win = out / "fmi2_portable_host", out / "fmi2_portable_host.exe"
+    out = tmp_path_factory.mktemp("script_host")
+    linux, win = out / "fmi2_script_host", out / "fmi2_script_host.exe"
     warnings = ["-O2", "-Wall", "-Wextra", "-Werror"]
     for cmd in (["gcc", *warnings, "-o", str(linux), str(HOST_SOURCE), "-ldl"],
                 [MINGW, *warnings, "-D__USE_MINGW_ANSI_STDIO=1", "-static", "-static-libgcc", "-o", str(win),
@@ -169,11 +171,11 @@ def _fmu_script(vr, types, cases):
     return script
 
 
-def _run_portable_host(cmd, script, env=None):
+def _run_script_host(cmd, script, env=None):
     """Run one host build (a child process with a timeout); its statuses, values and log lines."""
     proc = subprocess.run(cmd, input="\n".join(script) + "\n", capture_output=True, text=True, timeout=600, env=env)
     out = SimpleNamespace(returncode=proc.returncode, stdout=proc.stdout, stderr=proc.stderr, statuses=[],
-                          values=[], logs=[])
+                          values=[], logs=[], libpython=None)
     for line in proc.stdout.splitlines():
         head, _, rest = line.partition(" ")
         if head == "STATUS":
@@ -184,6 +186,8 @@ def _run_portable_host(cmd, script, env=None):
             out.values.append(bool(int(rest.split()[2])))
         elif head == "LOG":
             out.logs.append(rest)
+        elif head == "LIBPYTHON":
+            out.libpython = rest.strip() == "1"
     return out
 
 
@@ -201,28 +205,27 @@ def _groups(values, n_groups):
     return records
 
 
-def test_win64_fmu_dll_under_wine_equals_the_linux_fmu(native_impact_fmu, portable_hosts, wine_env, tmp_path):
+def test_win64_fmu_dll_under_wine_equals_the_linux_fmu(native_impact_fmu, script_hosts, wine_env, tmp_path):
     """binaries/win64/SpherePlateImpact.dll in a mingw-built C host under Wine and
     binaries/linux64/SpherePlateImpact.so in the same host built with gcc, driven by the same script:
     every fmi2 call OK but the refused NaN (fmi2Error, logged, nothing crashes, the previous value kept);
     all 17 outputs of 504 evaluations agree within restitution.agreement's tolerances; Green (2022)'s
     checkpoint (V_c = 0.0265 m/s, V* = 86.9 at 2.3 m/s) on Windows."""
-    linux_host, win_host = portable_hosts
+    linux_host, win_host = script_hosts
     unpacked = tmp_path / "fmu"
     with zipfile.ZipFile(native_impact_fmu) as z:
         z.extractall(unpacked)
-    dll = unpacked / "binaries" / "win64" / "SpherePlateImpact.dll"
+    dll = unpacked / "binaries" / "win64" / f"{MODEL}.dll"
     if not dll.is_file():
         pytest.skip(f"the native FMU has no win64 binary ({MINGW} missing when it was built)")
     guid, vr, types = _interface(native_impact_fmu)
     cases = _fmu_cases()
     script = _fmu_script(vr, types, cases)
 
-    linux = _run_portable_host([str(linux_host), str(unpacked / "binaries" / "linux64" / "SpherePlateImpact.so"), guid,
-                                (unpacked / "resources").as_uri()], script)
-    win = _run_portable_host([WINE, str(win_host), _windows_path(dll), guid,
-                              "file:///" + _windows_path(unpacked / "resources").replace("\\", "/")],
-                             script, env=wine_env)
+    # each host loads binaries/<platform>/SpherePlateImpact.<so|dll> of the unpacked FMU and passes it the
+    # percent-encoded file: URI of its resources (under Wine: file:///Z:/...)
+    linux = _run_script_host([str(linux_host), str(unpacked), MODEL, guid], script)
+    win = _run_script_host([WINE, str(win_host), _windows_path(unpacked), MODEL, guid], script, env=wine_env)
     n_reads = len(cases) * len(FMU_SPEEDS) + 1
     for name, run in (("linux64", linux), ("win64 under Wine", win)):
         assert run.returncode == 0, f"{name}: exit {run.returncode}\n{run.stdout[-2000:]}\n{run.stderr[-2000:]}"
@@ -233,6 +236,7 @@ def test_win64_fmu_dll_under_wine_equals_the_linux_fmu(native_impact_fmu, portab
         assert any(line.startswith("impact Error") and "plate.t = nan is outside the allowed range" in line
                    for line in run.logs), f"{name}: {run.logs[-5:]}"
         assert len(run.values) == n_reads * (len(FMU_REALS) + len(FMU_FLAGS)), name
+        assert run.libpython is False, f"{name}: a Python library is loaded in the native FMU's process"
     # the refused value changed nothing: the last read equals the read before it (same platform)
     per_read = len(FMU_REALS) + len(FMU_FLAGS)
     for run in (linux, win):
