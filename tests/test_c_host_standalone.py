@@ -18,7 +18,7 @@ from xml.etree import ElementTree
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
-HOST_SOURCE = ROOT / "tests" / "c_host" / "fmi2_host.c"
+HOST_SOURCE = ROOT / "tests" / "c_host" / "fmi2_script_host.c"
 MAKE_STANDALONE = ROOT / "fmu_src" / "restitution" / "fmu" / "native_host" / "make_standalone.py"
 
 pytestmark = [
@@ -72,10 +72,22 @@ def _guid(fmu: Path) -> str:
         return ElementTree.fromstring(zf.read("modelDescription.xml")).attrib["guid"]
 
 
-def _run_host(host: Path, unpacked: Path, guid: str, *args: str) -> subprocess.CompletedProcess:
+def _scenario(x: float, steps: int = 1, h: float = 1e-3) -> list[str]:
+    """The host's script: instantiate, set up at t = 0, initialise with x = `x`, then `steps` times
+    set x and step by h; read y after the last step; terminate and free."""
+    script = ["instantiate instance1", "setup 0 0.0", "enter_init 0", f"set_real 0 {VR_X} {x!r}", "exit_init 0"]
+    t = 0.0
+    for _ in range(steps):
+        script += [f"set_real 0 {VR_X} {x!r}", f"step 0 {t!r} {h!r}"]
+        t += h
+    return script + [f"get_real 0 {VR_Y}", "terminate 0", "free 0"]
+
+
+def _run_host(host: Path, unpacked: Path, guid: str, script: list[str]) -> subprocess.CompletedProcess:
     # env -i: nothing inherited (no VIRTUAL_ENV, PYTHONPATH, PYTHONHOME, LD_*)
     return subprocess.run(
-        ["env", "-i", "PATH=/usr/bin:/bin", str(host), str(unpacked), MODEL, guid, *args],
+        ["env", "-i", "PATH=/usr/bin:/bin", str(host), str(unpacked), MODEL, guid],
+        input="\n".join(script) + "\n",
         capture_output=True,
         text=True,
         timeout=120,
@@ -83,12 +95,18 @@ def _run_host(host: Path, unpacked: Path, guid: str, *args: str) -> subprocess.C
     )
 
 
-def _values(stdout: str) -> dict[int, float]:
+def _values(proc: subprocess.CompletedProcess) -> dict[int, float]:
+    """The values read ({vr: value}) of a run in which every fmi2 call succeeded (OK or Warning)
+    and the script ran to its end."""
+    statuses = [line.split() for line in proc.stdout.splitlines() if line.startswith("STATUS ")]
+    failed = [s for s in statuses if s[3] not in ("OK", "Warning")]
+    assert statuses and not failed, proc.stdout + proc.stderr
+    assert proc.stdout.rstrip().endswith("DONE"), proc.stdout + proc.stderr
     out = {}
-    for line in stdout.splitlines():
-        parts = line.split()
-        if len(parts) == 2 and parts[0].isdigit():
-            out[int(parts[0])] = float(parts[1])
+    for line in proc.stdout.splitlines():
+        if line.startswith("REAL "):
+            _, _slot, vr, value = line.split()
+            out[int(vr)] = float(value)
     return out
 
 
@@ -108,8 +126,8 @@ def built(tmp_path_factory):
     shutil.copy(plain, standalone)
     _load_make_standalone().make_standalone(standalone)
 
-    host = work / "fmi2_host"
-    subprocess.run(["gcc", "-O2", "-o", str(host), str(HOST_SOURCE), "-ldl"], check=True)
+    host = work / "fmi2_script_host"
+    subprocess.run(["gcc", "-O2", "-Wall", "-Wextra", "-Werror", "-o", str(host), str(HOST_SOURCE), "-ldl"], check=True)
     return {"work": work, "plain": plain, "fmu": standalone, "host": host, "guid": _guid(standalone)}
 
 
@@ -127,7 +145,7 @@ def test_fmu_layout(built):
 def test_plain_pythonfmu_binary_fails_in_c_host(built, tmp_path):
     """The problem being solved: without the shim, dlopen fails."""
     unpacked = _unpack(built["plain"], tmp_path / "plain")
-    proc = _run_host(built["host"], unpacked, built["guid"], f"{VR_X}=2", str(VR_Y))
+    proc = _run_host(built["host"], unpacked, built["guid"], _scenario(2.0))
     assert proc.returncode == 2
     assert "undefined symbol" in proc.stderr
 
@@ -135,9 +153,9 @@ def test_plain_pythonfmu_binary_fails_in_c_host(built, tmp_path):
 @pytest.mark.parametrize("x", [2.0, 9.0, 1e-3])
 def test_runs_in_plain_c_host(built, tmp_path, x):
     unpacked = _unpack(built["fmu"], tmp_path / "fmu")
-    proc = _run_host(built["host"], unpacked, built["guid"], "--steps", "3", f"{VR_X}={x!r}", str(VR_Y))
+    proc = _run_host(built["host"], unpacked, built["guid"], _scenario(x, steps=3))
     assert proc.returncode == 0, proc.stdout + proc.stderr
-    assert _values(proc.stdout) == {VR_Y: math.sqrt(x)}
+    assert _values(proc) == {VR_Y: math.sqrt(x)}
 
 
 def test_runs_in_fmpy(built, tmp_path):
@@ -183,7 +201,7 @@ def test_missing_libpython_gives_log_message_and_null(built, tmp_path):
         lambda text: "\n".join(f"libpython={bogus}" if line.startswith("libpython=") else line
                                for line in text.splitlines()) + "\n",
     )
-    proc = _run_host(built["host"], unpacked, built["guid"], f"{VR_X}=4", str(VR_Y))
+    proc = _run_host(built["host"], unpacked, built["guid"], _scenario(4.0))
     assert proc.returncode == 3, proc.stdout + proc.stderr  # NULL instance, no crash
     assert "INSTANTIATE_FAILED" in proc.stdout
     log = [line for line in proc.stdout.splitlines() if line.startswith("LOG ")]
@@ -196,7 +214,7 @@ def test_missing_module_gives_log_message_and_null(built, tmp_path):
         built, tmp_path,
         lambda text: text + "require=no_such_module_for_chost_test\n",
     )
-    proc = _run_host(built["host"], unpacked, built["guid"], f"{VR_X}=4", str(VR_Y))
+    proc = _run_host(built["host"], unpacked, built["guid"], _scenario(4.0))
     assert proc.returncode == 3, proc.stdout + proc.stderr
     assert any("no_such_module_for_chost_test" in line and "ModuleNotFoundError" in line
                for line in proc.stdout.splitlines() if line.startswith("LOG ")), proc.stdout
@@ -205,7 +223,7 @@ def test_missing_module_gives_log_message_and_null(built, tmp_path):
 def test_missing_config_gives_log_message_and_null(built, tmp_path):
     unpacked = _unpack(built["fmu"], tmp_path / "nocfg")
     (unpacked / "resources" / "python_env.txt").unlink()
-    proc = _run_host(built["host"], unpacked, built["guid"], f"{VR_X}=4", str(VR_Y))
+    proc = _run_host(built["host"], unpacked, built["guid"], _scenario(4.0))
     assert proc.returncode == 3, proc.stdout + proc.stderr
     assert "python_env.txt" in proc.stdout and "needs a Python interpreter" in proc.stdout
 
@@ -219,5 +237,5 @@ def test_make_standalone_is_idempotent(built, tmp_path):
         assert zf.read(f"binaries/linux64/{MODEL}_pythonfmu.so") == \
             zipfile.ZipFile(built["plain"]).read(f"binaries/linux64/{MODEL}.so")
     assert len(names) == len(set(names))
-    proc = _run_host(built["host"], _unpack(again, tmp_path / "again"), built["guid"], f"{VR_X}=2", str(VR_Y))
-    assert proc.returncode == 0 and _values(proc.stdout) == {VR_Y: math.sqrt(2.0)}
+    proc = _run_host(built["host"], _unpack(again, tmp_path / "again"), built["guid"], _scenario(2.0))
+    assert proc.returncode == 0 and _values(proc) == {VR_Y: math.sqrt(2.0)}
