@@ -239,16 +239,6 @@ static const char *type_name(rst_type type)
     return type == RST_REAL ? "Real" : type == RST_INTEGER ? "Integer" : "Boolean";
 }
 
-static const char *causality_name(rst_causality causality)
-{
-    switch (causality) {
-    case RST_PARAMETER: return "parameter";
-    case RST_INPUT: return "input";
-    case RST_OUTPUT: return "output";
-    default: return "local";
-    }
-}
-
 /* ------------------------------------------------------------------------------------------------ */
 /* Entering and leaving a call                                                                      */
 /* ------------------------------------------------------------------------------------------------ */
@@ -383,8 +373,8 @@ static int check_set(rst_instance *inst, const char *function, fmi2ValueReferenc
     }
     if (!settable(inst, var)) {
         if (var->causality == RST_OUTPUT || var->causality == RST_LOCAL)
-            rst_log(inst, fmi2Error, "%s: %s is an %s and cannot be set", function, var->name,
-                    causality_name(var->causality));
+            rst_log(inst, fmi2Error, "%s: %s is %s and cannot be set", function, var->name,
+                    var->causality == RST_OUTPUT ? "an output" : "a local variable");
         else
             rst_log(inst, fmi2Error, "%s: %s is a fixed parameter and cannot be set in %s (only before "
                     "fmi2ExitInitializationMode)", function, var->name, mode_name(inst->mode));
