@@ -17,6 +17,7 @@ import pytest
 from restitution.scene import SceneError, parse_scene, run_scene
 from restitution.scene.__main__ import main
 from restitution.scene.loader import MAX_BOUNCES
+from terminal import with_terminal_stderr
 
 PYTHON = sys.executable
 ENV = {**os.environ, "PYTHONUNBUFFERED": "1"}
@@ -224,35 +225,15 @@ def test_sigint_keeps_every_finished_drop(tmp_path, impact_fmu):
 
 
 def test_progress_in_a_terminal_ends_with_the_final_state_on_its_own_line(tmp_path, impact_fmu):
-    import fcntl
-    import pty
-    import struct
-    import termios
-
     scene = tmp_path / "s.toml"
     heights = "[" + ", ".join(f'"{0.05 + 0.005 * k:.3f} m"' for k in range(12)) + "]"
     # zener_method = ode: a couple of seconds, so a terminal may show the bar (not asserted: timing)
     scene.write_text(scene_text(heights=heights, model='[model]\nzener_method = "ode"\nplate_waves = "on"\n',
                                 v_min='"0.001 m/s"'))
-    master, slave = pty.openpty()
-    fcntl.ioctl(slave, termios.TIOCSWINSZ, struct.pack("HHHH", 24, 80, 0, 0))
-    proc = subprocess.Popen([PYTHON, "-m", "restitution.scene", "run", str(scene), "--fmu", str(impact_fmu),
-                             "--out", str(tmp_path), "--no-plot"], stdout=subprocess.PIPE, stderr=slave,
-                            stdin=subprocess.DEVNULL, text=True, env=ENV)
-    os.close(slave)
-    chunks = []
-    while True:
-        try:
-            data = os.read(master, 65536)
-        except OSError:  # EIO: the child closed the terminal
-            break
-        if not data:
-            break
-        chunks.append(data)
-    out = proc.stdout.read()
-    assert proc.wait(timeout=300) == 0
-    os.close(master)
-    err = b"".join(chunks).decode("utf-8", "replace").replace("\r\n", "\n")
+    status, out, err = with_terminal_stderr([PYTHON, "-m", "restitution.scene", "run", scene, "--fmu", impact_fmu,
+                                             "--out", tmp_path, "--no-plot"], ENV)
+    assert status == 0
+    err = err.replace("\r\n", "\n")
     shown = [line.rsplit("\r", 1)[-1] for line in err.split("\n")]  # what the terminal shows on each line
     finals = [line for line in shown if "drops done" in line]
     assert len(finals) == 1 and finals[0].startswith("s (ode): 12/12 drops done, "), err

@@ -21,6 +21,8 @@ from restitution.sweep.__main__ import main as sweep_cli
 from restitution.sweep.run import (DiskSweepResult, SizeError, SweepInterrupted, check_memory, plan_size,
                                    table_bytes)
 
+from terminal import with_terminal_stderr
+
 PYTHON = sys.executable
 ENV = {**os.environ, "PYTHONUNBUFFERED": "1"}
 ENV.pop("DASK_SCHEDULER_ADDRESS", None)
@@ -422,38 +424,10 @@ def test_summary_counts_and_cli_warns_about_out_of_range_cases(tmp_path):
     assert clean.returncode == 0 and "warning" not in clean.stderr
 
 
-def _with_terminal_stderr(cmd, cwd=None):
-    """(exit status, stdout, stderr) of ``cmd`` with stderr on a pseudo-terminal (80 columns)."""
-    import fcntl
-    import pty
-    import struct
-    import termios
-
-    master, slave = pty.openpty()
-    fcntl.ioctl(slave, termios.TIOCSWINSZ, struct.pack("HHHH", 24, 80, 0, 0))
-    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=slave, stdin=subprocess.DEVNULL, text=True,
-                            env=ENV, cwd=cwd)
-    os.close(slave)
-    chunks = []
-    while True:
-        try:
-            data = os.read(master, 65536)
-        except OSError:  # EIO: the child closed the terminal
-            break
-        if not data:
-            break
-        chunks.append(data)
-    out = proc.stdout.read()
-    proc.wait(timeout=300)
-    os.close(master)
-    return proc.returncode, out, b"".join(chunks).decode("utf-8", "replace")
-
-
 def test_progress_in_a_terminal_ends_with_the_final_state_on_its_own_line(tmp_path):
     # long enough (about 40 ode chunks) that a terminal may show the redrawn line; not asserted
-    proc = _with_terminal_stderr([PYTHON, "-m", "restitution.sweep", *SLOW_ARGS, "--scheduler", "serial",
-                                  "--out", str(tmp_path / "s.csv")])
-    rc, out, err = proc
+    rc, out, err = with_terminal_stderr([PYTHON, "-m", "restitution.sweep", *SLOW_ARGS, "--scheduler", "serial",
+                                         "--out", str(tmp_path / "s.csv")], ENV)
     assert rc == 0, err
     lines = err.replace("\r\n", "\n").split("\n")
     final = [line.rsplit("\r", 1)[-1] for line in lines if "chunks done" in line]
