@@ -195,3 +195,28 @@ def test_native_fmu_equals_the_package_over_the_declared_domain(native_instance,
     expected = r.impact(case["v"], **params, **options)
     problems = disagreements(got, expected, *tolerances(case["v"], params, **options))
     assert not problems, (case, effect_tolerance, problems)
+
+
+def test_serialized_states_move_between_the_two_implementations(impact_fmu, native_fmu):
+    """One state layout (the C front's): the pythonfmu FMU's serialized state restores into the native
+    FMU, inputs, parameters and communication point included, and back."""
+    from restitution.cosim import FmuInstance
+
+    with FmuInstance(impact_fmu, "python", parameters={"plate.t": 3e-3}) as python, \
+            FmuInstance(native_fmu, "native") as native:
+        python.set(v_approach=2.3)
+        python.do_step(step_size=0.1)
+        native.slave.setFMUstate(native.slave.deSerializeFMUstate(
+            python.slave.serializeFMUstate(python.slave.getFMUstate())))
+        assert native.get("plate.t", "v_approach") == [3e-3, 2.3]
+        native.do_step(0.1, 0.1)  # continues at the python instance's communication point
+        native.set(v_approach=1.1)
+        python.slave.setFMUstate(python.slave.deSerializeFMUstate(
+            native.slave.serializeFMUstate(native.slave.getFMUstate())))
+        assert python.get("v_approach", "plate.t") == [1.1, 3e-3]
+        python.do_step(0.2, 0.1)
+        e_python, = python.get("e")
+        e_native, = native.get("e")
+        params = {**r.Sphere(r.MATERIALS["s2_tool_steel"], 6.35e-3).params(), **r.Plate(r.MATERIALS["al_6061"], 3e-3).params()}
+        tol, _ = tolerances(1.1, params)
+        assert abs(e_python - e_native) <= float(tol["e"])
