@@ -230,7 +230,7 @@ def fnv1a(data):  # the checksum the serialized layout ends with (64-bit FNV-1a)
     return h
 
 def parse(blob):
-    # layout documented in cfront/rst_front.c: magic, format, identifier, GUID, count, mode, flags, times,
+    # layout documented in cfront/rst_state.c: magic, format, identifier, GUID, count, mode, flags, times,
     # then (vr, type, value) per state variable, then the checksum
     pos = 8
     fmt, = struct.unpack_from("<I", blob, pos); pos += 4

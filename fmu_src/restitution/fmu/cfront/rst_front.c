@@ -1,4 +1,5 @@
-/* The FMI 2.0 co-simulation front: see rst_front.h.
+/* The FMI 2.0 co-simulation front: see rst_front.h. This file: the instance's life cycle, values
+ * and steps (messages: rst_log.c; FMU states: rst_state.c).
  *
  * Which call is allowed in which mode follows the FMI 2.0 standard's co-simulation state table
  * (section 4.2.4). A call that is not allowed, or whose arguments are wrong, returns fmi2Error with a
@@ -11,73 +12,16 @@
 #define _POSIX_C_SOURCE 200809L
 #endif
 
-#include "rst_front.h"
+#include "rst_front_internal.h"
 
 #include <float.h>
 #include <math.h>
-#include <stdarg.h>
-#include <stdint.h>
 #include <stdio.h>
-#include <stdlib.h>
 #include <string.h>
-
-#ifdef RST_FRONT_PTHREAD
-#include <pthread.h>
-#endif
-
-#define RST_INSTANCE_MAGIC 0x52535446u /* "RSTF": a pointer that is not one of our instances */
-#define RST_STATE_MAGIC 0x52535453u    /* "RSTS" */
-#define RST_STATE_FORMAT 1u            /* serialized layout version (see serialize_state) */
-#define MESSAGE_SIZE 2048
 
 /* Relative tolerance of the doStep time check: a master's t differs from the previous t + h by a
  * rounding or two; a skipped or repeated step differs by about h. */
 #define TIME_RTOL 1e-9
-
-enum { CAT_WARNING = 1, CAT_DISCARD = 2, CAT_ERROR = 4, CAT_FATAL = 8, CAT_ALL = 16 };
-static const char *const CATEGORY_NAMES[] = {"logStatusWarning", "logStatusDiscard", "logStatusError",
-                                             "logStatusFatal", "logAll"};
-#define N_CATEGORIES 5
-
-#define ANY_LIVE_MODE (RST_INSTANTIATED | RST_INITIALIZATION | RST_STEP_COMPLETE | RST_STEP_FAILED | \
-                       RST_TERMINATED | RST_ERROR)
-#define GET_MODES (RST_INITIALIZATION | RST_STEP_COMPLETE | RST_STEP_FAILED | RST_TERMINATED | RST_ERROR)
-#define SET_MODES (RST_INSTANTIATED | RST_INITIALIZATION | RST_STEP_COMPLETE)
-
-typedef struct rst_state {
-    unsigned int magic;
-    struct rst_state *next;
-    rst_mode mode;
-    int has_start, has_time;
-    double start_time, next_time, last_time;
-    double values[1]; /* one per state variable of the table (allocated to size) */
-} rst_state;
-
-struct rst_instance {
-    unsigned int magic;
-    const rst_model *model;
-    char *name;
-    fmi2CallbackLogger logger;
-    fmi2CallbackAllocateMemory allocate;
-    fmi2CallbackFreeMemory release;
-    fmi2ComponentEnvironment environment;
-    int logging_on;
-    unsigned int categories;
-    rst_mode mode;
-    int has_start;      /* fmi2SetupExperiment gave the start time */
-    double start_time;
-    int has_time;       /* next_time is known: the t the next doStep must have */
-    double next_time;
-    double last_time;   /* end of the last successful step (fmi2LastSuccessfulTime) */
-    fmi2Status last_step_status;
-    size_t n_state;     /* state variables of the table */
-    rst_state *states;  /* FMU states made by this instance, to tell ours from any other pointer */
-    double *store;
-    void *backend;
-#ifdef RST_FRONT_PTHREAD
-    pthread_mutex_t lock; /* FMI 2.0 does not ask one instance to be thread-safe; this one is */
-#endif
-};
 
 /* ------------------------------------------------------------------------------------------------ */
 /* Accessors for backends                                                                           */
@@ -87,139 +31,6 @@ void *rst_backend(rst_instance *inst) { return inst->backend; }
 const char *rst_instance_name(const rst_instance *inst) { return inst->name; }
 rst_mode rst_mode_of(const rst_instance *inst) { return inst->mode; }
 double rst_start_time(const rst_instance *inst) { return inst->has_start ? inst->start_time : 0.0; }
-
-/* ------------------------------------------------------------------------------------------------ */
-/* Messages                                                                                         */
-/* ------------------------------------------------------------------------------------------------ */
-void rst_format_double(double x, char *out, size_t size)
-{
-    char buf[40], digits[24];
-    int precision, exponent = 0, n_digits = 0, i;
-    const char *p;
-    if (isnan(x)) {
-        snprintf(out, size, "nan");
-        return;
-    }
-    if (isinf(x)) {
-        snprintf(out, size, x > 0 ? "inf" : "-inf");
-        return;
-    }
-    if (x == 0.0) {
-        snprintf(out, size, signbit(x) ? "-0.0" : "0.0");
-        return;
-    }
-    /* the shortest digit string that reads back as x (what repr() uses) */
-    for (precision = 1; precision <= 17; precision++) {
-        snprintf(buf, sizeof buf, "%.*e", precision - 1, x);
-        if (strtod(buf, NULL) == x)
-            break;
-    }
-    /* buf: [-]d[<decimal point>ddd]e(+|-)XX, whatever the locale's decimal point */
-    for (p = buf; *p && *p != 'e'; p++)
-        if (*p >= '0' && *p <= '9' && n_digits < (int)sizeof digits - 1)
-            digits[n_digits++] = *p;
-    digits[n_digits] = '\0';
-    if (*p == 'e')
-        exponent = atoi(p + 1);
-    while (n_digits > 1 && digits[n_digits - 1] == '0')
-        digits[--n_digits] = '\0';
-    {
-        char text[64];
-        size_t k = 0;
-        if (x < 0)
-            text[k++] = '-';
-        if (exponent >= -4 && exponent < 16) { /* positional, always with a fractional part */
-            if (exponent < 0) {
-                text[k++] = '0';
-                text[k++] = '.';
-                for (i = 0; i < -exponent - 1; i++)
-                    text[k++] = '0';
-                for (i = 0; i < n_digits; i++)
-                    text[k++] = digits[i];
-            } else {
-                for (i = 0; i <= exponent; i++)
-                    text[k++] = i < n_digits ? digits[i] : '0';
-                text[k++] = '.';
-                if (n_digits > exponent + 1)
-                    for (i = exponent + 1; i < n_digits; i++)
-                        text[k++] = digits[i];
-                else
-                    text[k++] = '0';
-            }
-            text[k] = '\0';
-        } else { /* d[.ddd]e+XX with at least two exponent digits */
-            text[k++] = digits[0];
-            if (n_digits > 1) {
-                text[k++] = '.';
-                for (i = 1; i < n_digits; i++)
-                    text[k++] = digits[i];
-            }
-            snprintf(text + k, sizeof text - k, "e%c%02d", exponent < 0 ? '-' : '+', exponent < 0 ? -exponent : exponent);
-        }
-        snprintf(out, size, "%s", text);
-    }
-}
-
-static unsigned int category_of(fmi2Status status)
-{
-    switch (status) {
-    case fmi2Warning: return CAT_WARNING;
-    case fmi2Discard: return CAT_DISCARD;
-    case fmi2Error: return CAT_ERROR;
-    case fmi2Fatal: return CAT_FATAL;
-    default: return CAT_ALL;
-    }
-}
-
-static const char *category_name(unsigned int bit)
-{
-    int i;
-    for (i = 0; i < N_CATEGORIES; i++)
-        if (bit == (1u << i))
-            return CATEGORY_NAMES[i];
-    return "logAll";
-}
-
-/* The host's logger treats the message as a printf format: every '%' of the text is doubled. */
-static void deliver(rst_instance *inst, fmi2Status status, const char *category, const char *text)
-{
-    char escaped[2 * MESSAGE_SIZE];
-    size_t k = 0;
-    const char *p;
-    if (inst->logger == NULL)
-        return;
-    if (status == fmi2OK || status == fmi2Pending) {
-        unsigned int bit = CAT_ALL;
-        int i;
-        for (i = 0; category && i < N_CATEGORIES; i++)
-            if (strcmp(category, CATEGORY_NAMES[i]) == 0)
-                bit = 1u << i;
-        if (!inst->logging_on || !(inst->categories & bit))
-            return;
-    }
-    for (p = text; *p && k + 2 < sizeof escaped; p++) {
-        if (*p == '%')
-            escaped[k++] = '%';
-        escaped[k++] = *p;
-    }
-    escaped[k] = '\0';
-    inst->logger(inst->environment, inst->name, status, category, escaped);
-}
-
-void rst_log_text(rst_instance *inst, fmi2Status status, const char *category, const char *text)
-{
-    deliver(inst, status, category ? category : category_name(category_of(status)), text ? text : "");
-}
-
-void rst_log(rst_instance *inst, fmi2Status status, const char *format, ...)
-{
-    char message[MESSAGE_SIZE];
-    va_list args;
-    va_start(args, format);
-    vsnprintf(message, sizeof message, format, args);
-    va_end(args);
-    deliver(inst, status, category_name(category_of(status)), message);
-}
 
 static const char *mode_name(rst_mode mode)
 {
@@ -234,7 +45,7 @@ static const char *mode_name(rst_mode mode)
     }
 }
 
-static const char *type_name(rst_type type)
+const char *front_type_name(rst_type type)
 {
     return type == RST_REAL ? "Real" : type == RST_INTEGER ? "Integer" : "Boolean";
 }
@@ -242,13 +53,13 @@ static const char *type_name(rst_type type)
 /* ------------------------------------------------------------------------------------------------ */
 /* Entering and leaving a call                                                                      */
 /* ------------------------------------------------------------------------------------------------ */
-static rst_instance *as_instance(fmi2Component c)
+rst_instance *front_instance(fmi2Component c)
 {
     rst_instance *inst = (rst_instance *)c;
     return (inst != NULL && inst->magic == RST_INSTANCE_MAGIC) ? inst : NULL;
 }
 
-static void lock(rst_instance *inst)
+void front_lock(rst_instance *inst)
 {
 #ifdef RST_FRONT_PTHREAD
     pthread_mutex_lock(&inst->lock);
@@ -257,7 +68,7 @@ static void lock(rst_instance *inst)
 #endif
 }
 
-static void unlock(rst_instance *inst)
+void front_unlock(rst_instance *inst)
 {
 #ifdef RST_FRONT_PTHREAD
     pthread_mutex_unlock(&inst->lock);
@@ -267,7 +78,7 @@ static void unlock(rst_instance *inst)
 }
 
 /* Is `function` allowed in the instance's mode? Logs why not. */
-static int allowed(rst_instance *inst, const char *function, unsigned int modes)
+int front_allowed(rst_instance *inst, const char *function, unsigned int modes)
 {
     if (inst->mode == RST_FATAL) {
         rst_log(inst, fmi2Error, "%s: this instance reported fmi2Fatal earlier and cannot be used any more; "
@@ -283,7 +94,7 @@ static int allowed(rst_instance *inst, const char *function, unsigned int modes)
 }
 
 /* A backend's answer: fmi2Error puts the instance into the error mode, fmi2Fatal latches it. */
-static fmi2Status backend_status(rst_instance *inst, fmi2Status status)
+fmi2Status front_backend_status(rst_instance *inst, fmi2Status status)
 {
     if (status == fmi2Fatal)
         inst->mode = RST_FATAL;
@@ -291,24 +102,6 @@ static fmi2Status backend_status(rst_instance *inst, fmi2Status status)
         inst->mode = RST_ERROR;
     return status;
 }
-
-#define ENTER(function, modes)                          \
-    rst_instance *inst = as_instance(c);                \
-    fmi2Status status_ = fmi2OK;                        \
-    if (inst == NULL)                                   \
-        return fmi2Error;                               \
-    lock(inst);                                         \
-    if (!allowed(inst, function, modes)) {              \
-        unlock(inst);                                   \
-        return fmi2Error;                               \
-    }
-
-#define LEAVE(status)    \
-    do {                 \
-        status_ = status; \
-        unlock(inst);    \
-        return status_;  \
-    } while (0)
 
 /* ------------------------------------------------------------------------------------------------ */
 /* Values                                                                                           */
@@ -320,7 +113,7 @@ static void reset_store(rst_instance *inst)
         inst->store[i] = inst->model->variables[i].start;
 }
 
-static void describe_value(rst_type type, double value, char *out, size_t size)
+void front_describe_value(rst_type type, double value, char *out, size_t size)
 {
     if (type == RST_REAL)
         rst_format_double(value, out, size);
@@ -331,7 +124,7 @@ static void describe_value(rst_type type, double value, char *out, size_t size)
 }
 
 /* Is `value` inside the variable's declared range? (Reals: finite too.) */
-static int in_range(const rst_variable *var, double value)
+int front_in_range(const rst_variable *var, double value)
 {
     if (var->type == RST_BOOLEAN)
         return value == 0.0 || value == 1.0;
@@ -368,7 +161,7 @@ static int check_set(rst_instance *inst, const char *function, fmi2ValueReferenc
     var = &inst->model->variables[vr];
     if (var->type != type) {
         rst_log(inst, fmi2Error, "%s: %s (value reference %u) is a %s variable, not %s", function, var->name, vr,
-                type_name(var->type), type_name(type));
+                front_type_name(var->type), front_type_name(type));
         return 0;
     }
     if (!settable(inst, var)) {
@@ -380,8 +173,8 @@ static int check_set(rst_instance *inst, const char *function, fmi2ValueReferenc
                     "fmi2ExitInitializationMode)", function, var->name, mode_name(inst->mode));
         return 0;
     }
-    if (!in_range(var, value)) {
-        describe_value(type, value, text, sizeof text);
+    if (!front_in_range(var, value)) {
+        front_describe_value(type, value, text, sizeof text);
         rst_log(inst, fmi2Error, "%s = %s is outside the allowed range: %s", var->name, text,
                 var->range_text ? var->range_text : "finite");
         return 0;
@@ -403,7 +196,7 @@ static fmi2Status set_values(fmi2Component c, const char *function, rst_type typ
     for (i = 0; i < n; i++)
         inst->store[vr[i]] = values[i];
     if (inst->model->set != NULL)
-        status = backend_status(inst, inst->model->set(inst, type, vr, n, values));
+        status = front_backend_status(inst, inst->model->set(inst, type, vr, n, values));
     LEAVE(status);
 }
 
@@ -416,8 +209,8 @@ static int check_get(rst_instance *inst, const char *function, fmi2ValueReferenc
     }
     if (inst->model->variables[vr].type != type) {
         rst_log(inst, fmi2Error, "%s: %s (value reference %u) is a %s variable, not %s", function,
-                inst->model->variables[vr].name, vr, type_name(inst->model->variables[vr].type),
-                type_name(type));
+                inst->model->variables[vr].name, vr, front_type_name(inst->model->variables[vr].type),
+                front_type_name(type));
         return 0;
     }
     return 1;
@@ -444,7 +237,7 @@ static fmi2Status get_values(rst_instance *inst, const char *function, rst_type 
     }
     if (n_outputs == 0 || inst->model->get_outputs == NULL)
         return fmi2OK;
-    status = backend_status(inst, inst->model->get_outputs(inst, type, outputs, n_outputs, output_values));
+    status = front_backend_status(inst, inst->model->get_outputs(inst, type, outputs, n_outputs, output_values));
     if (status < fmi2Error)
         for (i = 0; i < n_outputs; i++)
             out[position[i]] = output_values[i];
@@ -510,7 +303,7 @@ fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t 
                     vr ? vr[i] : 0u);
         else
             rst_log(inst, fmi2Error, "fmi2GetString: %s is a %s variable, not String", inst->model->variables[vr[i]].name,
-                    type_name(inst->model->variables[vr[i]].type));
+                    front_type_name(inst->model->variables[vr[i]].type));
         LEAVE(fmi2Error);
     }
     LEAVE(fmi2OK);
@@ -519,14 +312,14 @@ fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t 
 #define SET_TYPED(function, rst_type_, convert)                                                       \
     size_t i0;                                                                                        \
     double buffer[64];                                                                                \
-    rst_instance *checked = as_instance(c);                                                           \
+    rst_instance *checked = front_instance(c);                                                           \
     if (checked == NULL)                                                                              \
         return fmi2Error;                                                                             \
     if (n > 0 && (vr == NULL || value == NULL)) {                                                     \
-        lock(checked);                                                                                \
+        front_lock(checked);                                                                                \
         rst_log(checked, fmi2Error, "%s: NULL value reference or value array for %u variables", function, \
                 (unsigned int)n);                                                                     \
-        unlock(checked);                                                                              \
+        front_unlock(checked);                                                                              \
         return fmi2Error;                                                                             \
     }                                                                                                 \
     if (n <= 64) {                                                                                    \
@@ -537,9 +330,9 @@ fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t 
         double *all = (double *)checked->allocate(n, sizeof(double));                                 \
         fmi2Status status;                                                                            \
         if (all == NULL) {                                                                            \
-            lock(checked);                                                                            \
+            front_lock(checked);                                                                            \
             rst_log(checked, fmi2Error, "%s: out of memory for %u values", function, (unsigned int)n); \
-            unlock(checked);                                                                          \
+            front_unlock(checked);                                                                          \
             return fmi2Error;                                                                         \
         }                                                                                             \
         for (i0 = 0; i0 < n; i0++)                                                                    \
@@ -634,20 +427,10 @@ static void stderr_message(const char *name, const char *message)
     fprintf(stderr, "%s [%s]: %s\n", RST_MODEL.identifier, name ? name : "?", message);
 }
 
-static void free_states(rst_instance *inst)
-{
-    while (inst->states != NULL) {
-        rst_state *next = inst->states->next;
-        inst->states->magic = 0;
-        inst->release(inst->states);
-        inst->states = next;
-    }
-}
-
 static void free_memory(rst_instance *inst)
 {
     fmi2CallbackFreeMemory release = inst->release;
-    free_states(inst);
+    front_free_states(inst);
 #ifdef RST_FRONT_PTHREAD
     pthread_mutex_destroy(&inst->lock);
 #endif
@@ -691,7 +474,7 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
     inst->release = functions->freeMemory;
     inst->environment = functions->componentEnvironment;
     inst->logging_on = loggingOn != fmi2False;
-    inst->categories = CAT_WARNING | CAT_DISCARD | CAT_ERROR | CAT_FATAL | CAT_ALL;
+    inst->categories = RST_ALL_CATEGORIES;
     inst->mode = RST_INSTANTIATED;
     inst->last_step_status = fmi2OK;
     inst->name = (char *)inst->allocate(strlen(instanceName) + 1, 1);
@@ -752,44 +535,14 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
 
 void fmi2FreeInstance(fmi2Component c)
 {
-    rst_instance *inst = as_instance(c);
+    rst_instance *inst = front_instance(c);
     if (inst == NULL)
         return;
-    lock(inst);
+    front_lock(inst);
     if (inst->model->free_instance != NULL)
         inst->model->free_instance(inst);
-    unlock(inst);
+    front_unlock(inst);
     free_memory(inst);
-}
-
-fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn, size_t nCategories,
-                               const fmi2String categories[])
-{
-    size_t i;
-    unsigned int bits = 0;
-    int k;
-    ENTER("fmi2SetDebugLogging", ANY_LIVE_MODE)
-    if (nCategories > 0 && categories == NULL) {
-        rst_log(inst, fmi2Error, "fmi2SetDebugLogging: %u categories but a NULL array", (unsigned int)nCategories);
-        LEAVE(fmi2Error);
-    }
-    for (i = 0; i < nCategories; i++) {
-        int found = 0;
-        for (k = 0; categories[i] != NULL && k < N_CATEGORIES; k++)
-            if (strcmp(categories[i], CATEGORY_NAMES[k]) == 0) {
-                bits |= 1u << k;
-                found = 1;
-            }
-        if (!found) {
-            rst_log(inst, fmi2Error, "fmi2SetDebugLogging: unknown log category %s (this FMU has logStatusWarning, "
-                    "logStatusDiscard, logStatusError, logStatusFatal and logAll)",
-                    categories[i] ? categories[i] : "(NULL)");
-            LEAVE(fmi2Error);
-        }
-    }
-    inst->logging_on = loggingOn != fmi2False;
-    inst->categories = nCategories > 0 ? bits : (CAT_WARNING | CAT_DISCARD | CAT_ERROR | CAT_FATAL | CAT_ALL);
-    LEAVE(fmi2OK);
 }
 
 fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined, fmi2Real tolerance,
@@ -809,7 +562,7 @@ fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined, fm
         LEAVE(fmi2Error);
     }
     if (inst->model->setup_experiment != NULL) {
-        fmi2Status s = backend_status(inst, inst->model->setup_experiment(inst, toleranceDefined, tolerance,
+        fmi2Status s = front_backend_status(inst, inst->model->setup_experiment(inst, toleranceDefined, tolerance,
                                                                             startTime, stopTimeDefined, stopTime));
         if (s >= fmi2Error)
             LEAVE(s);
@@ -825,7 +578,7 @@ fmi2Status fmi2EnterInitializationMode(fmi2Component c)
     fmi2Status status = fmi2OK;
     ENTER("fmi2EnterInitializationMode", RST_INSTANTIATED)
     if (inst->model->enter_initialization != NULL)
-        status = backend_status(inst, inst->model->enter_initialization(inst));
+        status = front_backend_status(inst, inst->model->enter_initialization(inst));
     if (status < fmi2Error)
         inst->mode = RST_INITIALIZATION;
     LEAVE(status);
@@ -836,7 +589,7 @@ fmi2Status fmi2ExitInitializationMode(fmi2Component c)
     fmi2Status status = fmi2OK;
     ENTER("fmi2ExitInitializationMode", RST_INITIALIZATION)
     if (inst->model->exit_initialization != NULL)
-        status = backend_status(inst, inst->model->exit_initialization(inst));
+        status = front_backend_status(inst, inst->model->exit_initialization(inst));
     if (status < fmi2Error) {
         inst->mode = RST_STEP_COMPLETE;
         inst->has_time = inst->has_start;
@@ -851,7 +604,7 @@ fmi2Status fmi2Terminate(fmi2Component c)
     fmi2Status status = fmi2OK;
     ENTER("fmi2Terminate", RST_STEP_COMPLETE | RST_STEP_FAILED)
     if (inst->model->terminate != NULL)
-        status = backend_status(inst, inst->model->terminate(inst));
+        status = front_backend_status(inst, inst->model->terminate(inst));
     if (status < fmi2Error)
         inst->mode = RST_TERMINATED;
     LEAVE(status);
@@ -867,7 +620,7 @@ fmi2Status fmi2Reset(fmi2Component c)
     inst->start_time = inst->next_time = inst->last_time = 0.0;
     inst->last_step_status = fmi2OK;
     if (inst->model->reset != NULL)
-        status = backend_status(inst, inst->model->reset(inst));
+        status = front_backend_status(inst, inst->model->reset(inst));
     LEAVE(status);
 }
 
@@ -901,7 +654,7 @@ fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint, fmi2R
         }
     }
     if (inst->model->do_step != NULL)
-        status = backend_status(inst, inst->model->do_step(inst, t, h));
+        status = front_backend_status(inst, inst->model->do_step(inst, t, h));
     inst->last_step_status = status;
     if (status <= fmi2Warning) {
         inst->has_time = 1;
@@ -1002,412 +755,3 @@ fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReferenc
     LEAVE(fmi2Error);
 }
 
-/* ------------------------------------------------------------------------------------------------ */
-/* FMU states                                                                                       */
-/* ------------------------------------------------------------------------------------------------ */
-static rst_state *find_state(rst_instance *inst, const void *pointer)
-{
-    rst_state *s;
-    for (s = inst->states; s != NULL; s = s->next)
-        if ((const void *)s == pointer)
-            return s;
-    return NULL;
-}
-
-static rst_state *new_state(rst_instance *inst)
-{
-    rst_state *s = (rst_state *)inst->allocate(1, sizeof(rst_state) + (inst->n_state ? inst->n_state - 1 : 0) *
-                                                                     sizeof(double));
-    if (s == NULL)
-        return NULL;
-    s->magic = RST_STATE_MAGIC;
-    s->next = inst->states;
-    inst->states = s;
-    return s;
-}
-
-static void unlink_state(rst_instance *inst, rst_state *state)
-{
-    rst_state **link;
-    for (link = &inst->states; *link != NULL; link = &(*link)->next)
-        if (*link == state) {
-            *link = state->next;
-            state->magic = 0;
-            inst->release(state);
-            return;
-        }
-}
-
-/* `*pointer`: NULL (a new state) or one of ours (overwritten). Logs and returns NULL otherwise. */
-static rst_state *target_state(rst_instance *inst, const char *function, fmi2FMUstate *pointer)
-{
-    rst_state *s;
-    if (pointer == NULL) {
-        rst_log(inst, fmi2Error, "%s: the FMUstate pointer is NULL", function);
-        return NULL;
-    }
-    if (*pointer == NULL) {
-        s = new_state(inst);
-        if (s == NULL)
-            rst_log(inst, fmi2Error, "%s: out of memory", function);
-        return s;
-    }
-    s = find_state(inst, *pointer);
-    if (s == NULL)
-        rst_log(inst, fmi2Error, "%s: *FMUstate is neither NULL nor a state of this instance", function);
-    return s;
-}
-
-fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *FMUstate)
-{
-    rst_state *s;
-    size_t i, k = 0;
-    fmi2Status status = fmi2OK;
-    ENTER("fmi2GetFMUstate", ANY_LIVE_MODE)
-    if (inst->model->save_state != NULL) {
-        status = backend_status(inst, inst->model->save_state(inst));
-        if (status >= fmi2Error)
-            LEAVE(status);
-    }
-    s = target_state(inst, "fmi2GetFMUstate", FMUstate);
-    if (s == NULL)
-        LEAVE(fmi2Error);
-    s->mode = inst->mode;
-    s->has_start = inst->has_start;
-    s->has_time = inst->has_time;
-    s->start_time = inst->start_time;
-    s->next_time = inst->next_time;
-    s->last_time = inst->last_time;
-    for (i = 0; i < inst->model->n_variables; i++)
-        if (inst->model->variables[i].state)
-            s->values[k++] = inst->store[i];
-    *FMUstate = s;
-    LEAVE(status);
-}
-
-/* Is every value of a snapshot one this instance could hold? (A deserialized state passes here
- * before it becomes a state; checks as fmi2SetXXX would, plus the types of the other variables.) */
-static int check_snapshot(rst_instance *inst, const char *function, const rst_state *s)
-{
-    size_t i, k = 0;
-    char text[40];
-    if (!(s->mode & (ANY_LIVE_MODE)) || !isfinite(s->start_time) || !isfinite(s->next_time) ||
-        !isfinite(s->last_time)) {
-        rst_log(inst, fmi2Error, "%s: the state's mode or times are invalid", function);
-        return 0;
-    }
-    for (i = 0; i < inst->model->n_variables; i++) {
-        const rst_variable *var = &inst->model->variables[i];
-        double value;
-        if (!var->state)
-            continue;
-        value = s->values[k++];
-        describe_value(var->type, value, text, sizeof text);
-        if (var->causality == RST_INPUT || var->causality == RST_PARAMETER) {
-            if (!in_range(var, value) ||
-                (var->type == RST_INTEGER && value != floor(value))) {
-                rst_log(inst, fmi2Error, "%s: the state has %s = %s, outside the allowed range: %s", function,
-                        var->name, text, var->range_text ? var->range_text : "finite");
-                return 0;
-            }
-            if (inst->model->accept != NULL && inst->model->accept(inst, var, value) != fmi2OK)
-                return 0;
-        } else if ((var->type == RST_BOOLEAN && value != 0.0 && value != 1.0) ||
-                   (var->type == RST_INTEGER &&
-                    !(value == floor(value) && value >= -2147483648.0 && value <= 2147483647.0))) {
-            rst_log(inst, fmi2Error, "%s: the state has %s = %s, not a valid %s", function, var->name, text,
-                    type_name(var->type));
-            return 0;
-        }
-    }
-    return 1;
-}
-
-fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate FMUstate)
-{
-    rst_state *s;
-    size_t i, k = 0;
-    fmi2Status status = fmi2OK;
-    ENTER("fmi2SetFMUstate", ANY_LIVE_MODE)
-    s = find_state(inst, FMUstate);
-    if (s == NULL) {
-        rst_log(inst, fmi2Error, "fmi2SetFMUstate: the FMUstate is not a state of this instance (states are made by "
-                "fmi2GetFMUstate or fmi2DeSerializeFMUstate of the same instance)");
-        LEAVE(fmi2Error);
-    }
-    for (i = 0; i < inst->model->n_variables; i++)
-        if (inst->model->variables[i].state)
-            inst->store[i] = s->values[k++];
-    inst->mode = s->mode;
-    inst->has_start = s->has_start;
-    inst->has_time = s->has_time;
-    inst->start_time = s->start_time;
-    inst->next_time = s->next_time;
-    inst->last_time = s->last_time;
-    inst->last_step_status = fmi2OK;
-    if (inst->model->restore_state != NULL)
-        status = backend_status(inst, inst->model->restore_state(inst));
-    LEAVE(status);
-}
-
-fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate *FMUstate)
-{
-    rst_state *s;
-    ENTER("fmi2FreeFMUstate", ANY_LIVE_MODE)
-    if (FMUstate == NULL || *FMUstate == NULL)
-        LEAVE(fmi2OK); /* nothing to free */
-    s = find_state(inst, *FMUstate);
-    if (s == NULL) {
-        rst_log(inst, fmi2Error, "fmi2FreeFMUstate: the FMUstate is not a state of this instance");
-        LEAVE(fmi2Error);
-    }
-    unlink_state(inst, s);
-    *FMUstate = NULL;
-    LEAVE(fmi2OK);
-}
-
-/* Serialized layout (little-endian whatever the platform):
- *   "RSTFMUST" | u32 format | u32 len + model identifier | u32 len + GUID | u32 number of state variables
- *   | u32 mode | u32 has_start | u32 has_time | f64 start_time | f64 next_time | f64 last_time
- *   | per state variable: u32 value reference, u32 type, f64 value | u64 FNV-1a of everything before. */
-#define SERIAL_MAGIC "RSTFMUST"
-
-static size_t serialized_size(const rst_instance *inst)
-{
-    return 8 + 4 + 4 + strlen(inst->model->identifier) + 4 + strlen(inst->model->guid) + 4 + 3 * 4 + 3 * 8 +
-           inst->n_state * (4 + 4 + 8) + 8;
-}
-
-static void put_u32(unsigned char **p, uint32_t x)
-{
-    int i;
-    for (i = 0; i < 4; i++)
-        *(*p)++ = (unsigned char)(x >> (8 * i));
-}
-
-static void put_u64(unsigned char **p, uint64_t x)
-{
-    int i;
-    for (i = 0; i < 8; i++)
-        *(*p)++ = (unsigned char)(x >> (8 * i));
-}
-
-static void put_f64(unsigned char **p, double x)
-{
-    uint64_t bits;
-    memcpy(&bits, &x, sizeof bits);
-    put_u64(p, bits);
-}
-
-static void put_text(unsigned char **p, const char *text)
-{
-    size_t n = strlen(text);
-    put_u32(p, (uint32_t)n);
-    memcpy(*p, text, n);
-    *p += n;
-}
-
-static uint64_t fnv1a(const unsigned char *bytes, size_t n)
-{
-    uint64_t hash = 14695981039346656037ull;
-    size_t i;
-    for (i = 0; i < n; i++) {
-        hash ^= bytes[i];
-        hash *= 1099511628211ull;
-    }
-    return hash;
-}
-
-fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate FMUstate, size_t *size)
-{
-    ENTER("fmi2SerializedFMUstateSize", ANY_LIVE_MODE)
-    if (size == NULL || find_state(inst, FMUstate) == NULL) {
-        rst_log(inst, fmi2Error, "fmi2SerializedFMUstateSize: %s", size == NULL ? "size is NULL"
-                : "the FMUstate is not a state of this instance");
-        LEAVE(fmi2Error);
-    }
-    *size = serialized_size(inst);
-    LEAVE(fmi2OK);
-}
-
-fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate FMUstate, fmi2Byte serializedState[], size_t size)
-{
-    rst_state *s;
-    unsigned char *p;
-    size_t i, k = 0;
-    ENTER("fmi2SerializeFMUstate", ANY_LIVE_MODE)
-    s = find_state(inst, FMUstate);
-    if (s == NULL || serializedState == NULL || size < serialized_size(inst)) {
-        rst_log(inst, fmi2Error, "fmi2SerializeFMUstate: %s",
-                s == NULL ? "the FMUstate is not a state of this instance"
-                : serializedState == NULL ? "the byte array is NULL"
-                : "the byte array is smaller than fmi2SerializedFMUstateSize says");
-        LEAVE(fmi2Error);
-    }
-    p = (unsigned char *)serializedState;
-    memcpy(p, SERIAL_MAGIC, 8);
-    p += 8;
-    put_u32(&p, RST_STATE_FORMAT);
-    put_text(&p, inst->model->identifier);
-    put_text(&p, inst->model->guid);
-    put_u32(&p, (uint32_t)inst->n_state);
-    put_u32(&p, (uint32_t)s->mode);
-    put_u32(&p, (uint32_t)s->has_start);
-    put_u32(&p, (uint32_t)s->has_time);
-    put_f64(&p, s->start_time);
-    put_f64(&p, s->next_time);
-    put_f64(&p, s->last_time);
-    for (i = 0; i < inst->model->n_variables; i++)
-        if (inst->model->variables[i].state) {
-            put_u32(&p, (uint32_t)i);
-            put_u32(&p, (uint32_t)inst->model->variables[i].type);
-            put_f64(&p, s->values[k++]);
-        }
-    put_u64(&p, fnv1a((const unsigned char *)serializedState, (size_t)(p - (unsigned char *)serializedState)));
-    LEAVE(fmi2OK);
-}
-
-/* A reader that never goes past the end of the bytes. */
-typedef struct {
-    const unsigned char *p, *end;
-    int ok;
-} reader;
-
-static uint64_t get_uint(reader *r, int n_bytes)
-{
-    uint64_t x = 0;
-    int i;
-    if (!r->ok || r->end - r->p < n_bytes) {
-        r->ok = 0;
-        return 0;
-    }
-    for (i = 0; i < n_bytes; i++)
-        x |= (uint64_t)(*r->p++) << (8 * i);
-    return x;
-}
-
-static double get_f64(reader *r)
-{
-    uint64_t bits = get_uint(r, 8);
-    double x;
-    memcpy(&x, &bits, sizeof x);
-    return x;
-}
-
-static int get_text_equal(reader *r, const char *expected)
-{
-    uint64_t n = get_uint(r, 4);
-    size_t m = strlen(expected);
-    int equal;
-    if (!r->ok || n > (uint64_t)(r->end - r->p)) {
-        r->ok = 0;
-        return 0;
-    }
-    equal = n == m && memcmp(r->p, expected, m) == 0;
-    r->p += n;
-    return equal;
-}
-
-fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte serializedState[], size_t size,
-                                   fmi2FMUstate *FMUstate)
-{
-    reader r;
-    rst_state *s, *target;
-    size_t i, k = 0;
-    double *values;
-    rst_state head;
-    uint32_t format, mode;
-    const char *problem = NULL;
-    ENTER("fmi2DeSerializeFMUstate", ANY_LIVE_MODE)
-    if (serializedState == NULL || FMUstate == NULL) {
-        rst_log(inst, fmi2Error, "fmi2DeSerializeFMUstate: NULL %s", serializedState == NULL ? "bytes" : "FMUstate pointer");
-        LEAVE(fmi2Error);
-    }
-    if (*FMUstate != NULL && find_state(inst, *FMUstate) == NULL) {
-        rst_log(inst, fmi2Error, "fmi2DeSerializeFMUstate: *FMUstate is neither NULL nor a state of this instance");
-        LEAVE(fmi2Error);
-    }
-    values = (double *)inst->allocate(inst->n_state ? inst->n_state : 1, sizeof(double));
-    if (values == NULL) {
-        rst_log(inst, fmi2Error, "fmi2DeSerializeFMUstate: out of memory");
-        LEAVE(fmi2Error);
-    }
-    r.p = (const unsigned char *)serializedState;
-    r.end = r.p + size;
-    r.ok = 1;
-    memset(&head, 0, sizeof head);
-    if (size < 8 + 8 || memcmp(r.p, SERIAL_MAGIC, 8) != 0)
-        problem = "these bytes are not a serialized state of this FMU (no RSTFMUST header)";
-    else {
-        uint64_t expected = fnv1a(r.p, size - 8);
-        r.p += size - 8;
-        if (get_uint(&r, 8) != expected)
-            problem = "the checksum does not match (truncated or corrupted bytes)";
-    }
-    if (problem == NULL) {
-        r.p = (const unsigned char *)serializedState + 8;
-        r.end = (const unsigned char *)serializedState + size - 8;
-        format = (uint32_t)get_uint(&r, 4);
-        if (r.ok && format != RST_STATE_FORMAT)
-            problem = "the state was written in another format version";
-        else if (!get_text_equal(&r, inst->model->identifier) && r.ok)
-            problem = "the state belongs to another model";
-        else if (!get_text_equal(&r, inst->model->guid) && r.ok)
-            problem = "the state belongs to another build of this model (GUID differs)";
-        else if (get_uint(&r, 4) != inst->n_state && r.ok)
-            problem = "the state has another number of variables";
-        else {
-            mode = (uint32_t)get_uint(&r, 4);
-            head.mode = (rst_mode)mode;
-            head.has_start = get_uint(&r, 4) != 0;
-            head.has_time = get_uint(&r, 4) != 0;
-            head.start_time = get_f64(&r);
-            head.next_time = get_f64(&r);
-            head.last_time = get_f64(&r);
-            for (i = 0; r.ok && problem == NULL && i < inst->model->n_variables; i++) {
-                if (!inst->model->variables[i].state)
-                    continue;
-                if (get_uint(&r, 4) != i || get_uint(&r, 4) != (uint64_t)inst->model->variables[i].type)
-                    problem = "the state's variable list differs from this FMU's";
-                values[k++] = get_f64(&r);
-            }
-            if (r.ok && problem == NULL && r.p != r.end)
-                problem = "the state has trailing bytes";
-        }
-        if (!r.ok && problem == NULL)
-            problem = "the state is truncated";
-    }
-    if (problem != NULL) {
-        rst_log(inst, fmi2Error, "fmi2DeSerializeFMUstate: %s; nothing was changed", problem);
-        inst->release(values);
-        LEAVE(fmi2Error);
-    }
-    /* the values as a snapshot, checked like fmi2SetXXX before it may become a state */
-    s = (rst_state *)inst->allocate(1, sizeof(rst_state) + (inst->n_state ? inst->n_state - 1 : 0) * sizeof(double));
-    if (s == NULL) {
-        inst->release(values);
-        rst_log(inst, fmi2Error, "fmi2DeSerializeFMUstate: out of memory");
-        LEAVE(fmi2Error);
-    }
-    *s = head;
-    memcpy(s->values, values, inst->n_state * sizeof(double));
-    inst->release(values);
-    if (!check_snapshot(inst, "fmi2DeSerializeFMUstate", s)) {
-        inst->release(s);
-        LEAVE(fmi2Error);
-    }
-    target = target_state(inst, "fmi2DeSerializeFMUstate", FMUstate);
-    if (target == NULL) {
-        inst->release(s);
-        LEAVE(fmi2Error);
-    }
-    {
-        rst_state *next = target->next;
-        memcpy(target, s, sizeof(rst_state) + (inst->n_state ? inst->n_state - 1 : 0) * sizeof(double));
-        target->magic = RST_STATE_MAGIC;
-        target->next = next;
-    }
-    inst->release(s);
-    *FMUstate = target;
-    LEAVE(fmi2OK);
-}

@@ -44,7 +44,7 @@ from xml.etree import ElementTree
 HERE = Path(__file__).resolve().parent
 FRONT = HERE.parent / "cfront"
 #: The guard's C sources: the front, then this directory's backend and Python loader.
-GUARD_SOURCES = (FRONT / "rst_front.c", HERE / "pythonfmu_backend.c", HERE / "python_host.c")
+GUARD_SOURCES = (*sorted(FRONT.glob("*.c")), HERE / "pythonfmu_backend.c", HERE / "python_host.c")
 CONFIG_NAME = "python_env.txt"  # must match PYHOST_CONFIG_NAME in python_host.c
 REAL_SUFFIX = "_pythonfmu"
 

@@ -1,0 +1,177 @@
+/* The front's messages: formatting values as Python's repr() does, log categories, delivery to the
+ * host's logger, fmi2SetDebugLogging. */
+#include "rst_front_internal.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define MESSAGE_SIZE 2048
+
+enum { CAT_WARNING = 1, CAT_DISCARD = 2, CAT_ERROR = 4, CAT_FATAL = 8, CAT_ALL = 16 };
+static const char *const CATEGORY_NAMES[] = {"logStatusWarning", "logStatusDiscard", "logStatusError",
+                                             "logStatusFatal", "logAll"};
+#define N_CATEGORIES 5
+
+void rst_format_double(double x, char *out, size_t size)
+{
+    char buf[40], digits[24];
+    int precision, exponent = 0, n_digits = 0, i;
+    const char *p;
+    if (isnan(x)) {
+        snprintf(out, size, "nan");
+        return;
+    }
+    if (isinf(x)) {
+        snprintf(out, size, x > 0 ? "inf" : "-inf");
+        return;
+    }
+    if (x == 0.0) {
+        snprintf(out, size, signbit(x) ? "-0.0" : "0.0");
+        return;
+    }
+    /* the shortest digit string that reads back as x (what repr() uses) */
+    for (precision = 1; precision <= 17; precision++) {
+        snprintf(buf, sizeof buf, "%.*e", precision - 1, x);
+        if (strtod(buf, NULL) == x)
+            break;
+    }
+    /* buf: [-]d[<decimal point>ddd]e(+|-)XX, whatever the locale's decimal point */
+    for (p = buf; *p && *p != 'e'; p++)
+        if (*p >= '0' && *p <= '9' && n_digits < (int)sizeof digits - 1)
+            digits[n_digits++] = *p;
+    digits[n_digits] = '\0';
+    if (*p == 'e')
+        exponent = atoi(p + 1);
+    while (n_digits > 1 && digits[n_digits - 1] == '0')
+        digits[--n_digits] = '\0';
+    {
+        char text[64];
+        size_t k = 0;
+        if (x < 0)
+            text[k++] = '-';
+        if (exponent >= -4 && exponent < 16) { /* positional, always with a fractional part */
+            if (exponent < 0) {
+                text[k++] = '0';
+                text[k++] = '.';
+                for (i = 0; i < -exponent - 1; i++)
+                    text[k++] = '0';
+                for (i = 0; i < n_digits; i++)
+                    text[k++] = digits[i];
+            } else {
+                for (i = 0; i <= exponent; i++)
+                    text[k++] = i < n_digits ? digits[i] : '0';
+                text[k++] = '.';
+                if (n_digits > exponent + 1)
+                    for (i = exponent + 1; i < n_digits; i++)
+                        text[k++] = digits[i];
+                else
+                    text[k++] = '0';
+            }
+            text[k] = '\0';
+        } else { /* d[.ddd]e+XX with at least two exponent digits */
+            text[k++] = digits[0];
+            if (n_digits > 1) {
+                text[k++] = '.';
+                for (i = 1; i < n_digits; i++)
+                    text[k++] = digits[i];
+            }
+            snprintf(text + k, sizeof text - k, "e%c%02d", exponent < 0 ? '-' : '+', exponent < 0 ? -exponent : exponent);
+        }
+        snprintf(out, size, "%s", text);
+    }
+}
+
+static unsigned int category_of(fmi2Status status)
+{
+    switch (status) {
+    case fmi2Warning: return CAT_WARNING;
+    case fmi2Discard: return CAT_DISCARD;
+    case fmi2Error: return CAT_ERROR;
+    case fmi2Fatal: return CAT_FATAL;
+    default: return CAT_ALL;
+    }
+}
+
+static const char *category_name(unsigned int bit)
+{
+    int i;
+    for (i = 0; i < N_CATEGORIES; i++)
+        if (bit == (1u << i))
+            return CATEGORY_NAMES[i];
+    return "logAll";
+}
+
+/* The host's logger treats the message as a printf format: every '%' of the text is doubled. */
+static void deliver(rst_instance *inst, fmi2Status status, const char *category, const char *text)
+{
+    char escaped[2 * MESSAGE_SIZE];
+    size_t k = 0;
+    const char *p;
+    if (inst->logger == NULL)
+        return;
+    if (status == fmi2OK || status == fmi2Pending) {
+        unsigned int bit = CAT_ALL;
+        int i;
+        for (i = 0; category && i < N_CATEGORIES; i++)
+            if (strcmp(category, CATEGORY_NAMES[i]) == 0)
+                bit = 1u << i;
+        if (!inst->logging_on || !(inst->categories & bit))
+            return;
+    }
+    for (p = text; *p && k + 2 < sizeof escaped; p++) {
+        if (*p == '%')
+            escaped[k++] = '%';
+        escaped[k++] = *p;
+    }
+    escaped[k] = '\0';
+    inst->logger(inst->environment, inst->name, status, category, escaped);
+}
+
+void rst_log_text(rst_instance *inst, fmi2Status status, const char *category, const char *text)
+{
+    deliver(inst, status, category ? category : category_name(category_of(status)), text ? text : "");
+}
+
+void rst_log(rst_instance *inst, fmi2Status status, const char *format, ...)
+{
+    char message[MESSAGE_SIZE];
+    va_list args;
+    va_start(args, format);
+    vsnprintf(message, sizeof message, format, args);
+    va_end(args);
+    deliver(inst, status, category_name(category_of(status)), message);
+}
+
+fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn, size_t nCategories,
+                               const fmi2String categories[])
+{
+    size_t i;
+    unsigned int bits = 0;
+    int k;
+    ENTER("fmi2SetDebugLogging", ANY_LIVE_MODE)
+    if (nCategories > 0 && categories == NULL) {
+        rst_log(inst, fmi2Error, "fmi2SetDebugLogging: %u categories but a NULL array", (unsigned int)nCategories);
+        LEAVE(fmi2Error);
+    }
+    for (i = 0; i < nCategories; i++) {
+        int found = 0;
+        for (k = 0; categories[i] != NULL && k < N_CATEGORIES; k++)
+            if (strcmp(categories[i], CATEGORY_NAMES[k]) == 0) {
+                bits |= 1u << k;
+                found = 1;
+            }
+        if (!found) {
+            rst_log(inst, fmi2Error, "fmi2SetDebugLogging: unknown log category %s (this FMU has logStatusWarning, "
+                    "logStatusDiscard, logStatusError, logStatusFatal and logAll)",
+                    categories[i] ? categories[i] : "(NULL)");
+            LEAVE(fmi2Error);
+        }
+    }
+    inst->logging_on = loggingOn != fmi2False;
+    inst->categories = nCategories > 0 ? bits : RST_ALL_CATEGORIES;
+    LEAVE(fmi2OK);
+}
+

@@ -1,0 +1,408 @@
+/* The front's FMU states: snapshots of the store's state variables, the communication point and the
+ * mode; fmi2Get/Set/FreeFMUstate and their serialization (versioned, checksummed, little-endian),
+ * every restored value checked as fmi2SetXXX would. */
+#include "rst_front_internal.h"
+
+#include <math.h>
+#include <stdint.h>
+#include <string.h>
+
+#define RST_STATE_FORMAT 1u /* serialized layout version (see fmi2SerializeFMUstate) */
+
+void front_free_states(rst_instance *inst)
+{
+    while (inst->states != NULL) {
+        rst_state *next = inst->states->next;
+        inst->states->magic = 0;
+        inst->release(inst->states);
+        inst->states = next;
+    }
+}
+
+/* ------------------------------------------------------------------------------------------------ */
+/* FMU states                                                                                       */
+/* ------------------------------------------------------------------------------------------------ */
+/* The size of one state of this instance: the struct and its n_state values. */
+static size_t state_bytes(const rst_instance *inst)
+{
+    return sizeof(rst_state) + (inst->n_state ? inst->n_state - 1 : 0) * sizeof(double);
+}
+
+static rst_state *find_state(rst_instance *inst, const void *pointer)
+{
+    rst_state *s;
+    for (s = inst->states; s != NULL; s = s->next)
+        if ((const void *)s == pointer)
+            return s;
+    return NULL;
+}
+
+static rst_state *new_state(rst_instance *inst)
+{
+    rst_state *s = (rst_state *)inst->allocate(1, state_bytes(inst));
+    if (s == NULL)
+        return NULL;
+    s->magic = RST_STATE_MAGIC;
+    s->next = inst->states;
+    inst->states = s;
+    return s;
+}
+
+static void unlink_state(rst_instance *inst, rst_state *state)
+{
+    rst_state **link;
+    for (link = &inst->states; *link != NULL; link = &(*link)->next)
+        if (*link == state) {
+            *link = state->next;
+            state->magic = 0;
+            inst->release(state);
+            return;
+        }
+}
+
+/* `*pointer`: NULL (a new state) or one of ours (overwritten). Logs and returns NULL otherwise. */
+static rst_state *target_state(rst_instance *inst, const char *function, fmi2FMUstate *pointer)
+{
+    rst_state *s;
+    if (pointer == NULL) {
+        rst_log(inst, fmi2Error, "%s: the FMUstate pointer is NULL", function);
+        return NULL;
+    }
+    if (*pointer == NULL) {
+        s = new_state(inst);
+        if (s == NULL)
+            rst_log(inst, fmi2Error, "%s: out of memory", function);
+        return s;
+    }
+    s = find_state(inst, *pointer);
+    if (s == NULL)
+        rst_log(inst, fmi2Error, "%s: *FMUstate is neither NULL nor a state of this instance", function);
+    return s;
+}
+
+fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *FMUstate)
+{
+    rst_state *s;
+    size_t i, k = 0;
+    fmi2Status status = fmi2OK;
+    ENTER("fmi2GetFMUstate", ANY_LIVE_MODE)
+    if (inst->model->save_state != NULL) {
+        status = front_backend_status(inst, inst->model->save_state(inst));
+        if (status >= fmi2Error)
+            LEAVE(status);
+    }
+    s = target_state(inst, "fmi2GetFMUstate", FMUstate);
+    if (s == NULL)
+        LEAVE(fmi2Error);
+    s->mode = inst->mode;
+    s->has_start = inst->has_start;
+    s->has_time = inst->has_time;
+    s->start_time = inst->start_time;
+    s->next_time = inst->next_time;
+    s->last_time = inst->last_time;
+    for (i = 0; i < inst->model->n_variables; i++)
+        if (inst->model->variables[i].state)
+            s->values[k++] = inst->store[i];
+    *FMUstate = s;
+    LEAVE(status);
+}
+
+/* Is every value of a snapshot one this instance could hold? (A deserialized state passes here
+ * before it becomes a state; checks as fmi2SetXXX would, plus the types of the other variables.) */
+static int check_snapshot(rst_instance *inst, const char *function, const rst_state *s)
+{
+    size_t i, k = 0;
+    char text[40];
+    if (!(s->mode & (ANY_LIVE_MODE)) || !isfinite(s->start_time) || !isfinite(s->next_time) ||
+        !isfinite(s->last_time)) {
+        rst_log(inst, fmi2Error, "%s: the state's mode or times are invalid", function);
+        return 0;
+    }
+    for (i = 0; i < inst->model->n_variables; i++) {
+        const rst_variable *var = &inst->model->variables[i];
+        double value;
+        if (!var->state)
+            continue;
+        value = s->values[k++];
+        front_describe_value(var->type, value, text, sizeof text);
+        if (var->causality == RST_INPUT || var->causality == RST_PARAMETER) {
+            if (!front_in_range(var, value) ||
+                (var->type == RST_INTEGER && value != floor(value))) {
+                rst_log(inst, fmi2Error, "%s: the state has %s = %s, outside the allowed range: %s", function,
+                        var->name, text, var->range_text ? var->range_text : "finite");
+                return 0;
+            }
+            if (inst->model->accept != NULL && inst->model->accept(inst, var, value) != fmi2OK)
+                return 0;
+        } else if ((var->type == RST_BOOLEAN && value != 0.0 && value != 1.0) ||
+                   (var->type == RST_INTEGER &&
+                    !(value == floor(value) && value >= -2147483648.0 && value <= 2147483647.0))) {
+            rst_log(inst, fmi2Error, "%s: the state has %s = %s, not a valid %s", function, var->name, text,
+                    front_type_name(var->type));
+            return 0;
+        }
+    }
+    return 1;
+}
+
+fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate FMUstate)
+{
+    rst_state *s;
+    size_t i, k = 0;
+    fmi2Status status = fmi2OK;
+    ENTER("fmi2SetFMUstate", ANY_LIVE_MODE)
+    s = find_state(inst, FMUstate);
+    if (s == NULL) {
+        rst_log(inst, fmi2Error, "fmi2SetFMUstate: the FMUstate is not a state of this instance (states are made by "
+                "fmi2GetFMUstate or fmi2DeSerializeFMUstate of the same instance)");
+        LEAVE(fmi2Error);
+    }
+    for (i = 0; i < inst->model->n_variables; i++)
+        if (inst->model->variables[i].state)
+            inst->store[i] = s->values[k++];
+    inst->mode = s->mode;
+    inst->has_start = s->has_start;
+    inst->has_time = s->has_time;
+    inst->start_time = s->start_time;
+    inst->next_time = s->next_time;
+    inst->last_time = s->last_time;
+    inst->last_step_status = fmi2OK;
+    if (inst->model->restore_state != NULL)
+        status = front_backend_status(inst, inst->model->restore_state(inst));
+    LEAVE(status);
+}
+
+fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate *FMUstate)
+{
+    rst_state *s;
+    ENTER("fmi2FreeFMUstate", ANY_LIVE_MODE)
+    if (FMUstate == NULL || *FMUstate == NULL)
+        LEAVE(fmi2OK); /* nothing to free */
+    s = find_state(inst, *FMUstate);
+    if (s == NULL) {
+        rst_log(inst, fmi2Error, "fmi2FreeFMUstate: the FMUstate is not a state of this instance");
+        LEAVE(fmi2Error);
+    }
+    unlink_state(inst, s);
+    *FMUstate = NULL;
+    LEAVE(fmi2OK);
+}
+
+/* Serialized layout (little-endian whatever the platform):
+ *   "RSTFMUST" | u32 format | u32 len + model identifier | u32 len + GUID | u32 number of state variables
+ *   | u32 mode | u32 has_start | u32 has_time | f64 start_time | f64 next_time | f64 last_time
+ *   | per state variable: u32 value reference, u32 type, f64 value | u64 FNV-1a of everything before. */
+#define SERIAL_MAGIC "RSTFMUST"
+
+static size_t serialized_size(const rst_instance *inst)
+{
+    return 8 + 4 + 4 + strlen(inst->model->identifier) + 4 + strlen(inst->model->guid) + 4 + 3 * 4 + 3 * 8 +
+           inst->n_state * (4 + 4 + 8) + 8;
+}
+
+static void put_u32(unsigned char **p, uint32_t x)
+{
+    int i;
+    for (i = 0; i < 4; i++)
+        *(*p)++ = (unsigned char)(x >> (8 * i));
+}
+
+static void put_u64(unsigned char **p, uint64_t x)
+{
+    int i;
+    for (i = 0; i < 8; i++)
+        *(*p)++ = (unsigned char)(x >> (8 * i));
+}
+
+static void put_f64(unsigned char **p, double x)
+{
+    uint64_t bits;
+    memcpy(&bits, &x, sizeof bits);
+    put_u64(p, bits);
+}
+
+static void put_text(unsigned char **p, const char *text)
+{
+    size_t n = strlen(text);
+    put_u32(p, (uint32_t)n);
+    memcpy(*p, text, n);
+    *p += n;
+}
+
+static uint64_t fnv1a(const unsigned char *bytes, size_t n)
+{
+    uint64_t hash = 14695981039346656037ull;
+    size_t i;
+    for (i = 0; i < n; i++) {
+        hash ^= bytes[i];
+        hash *= 1099511628211ull;
+    }
+    return hash;
+}
+
+fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate FMUstate, size_t *size)
+{
+    ENTER("fmi2SerializedFMUstateSize", ANY_LIVE_MODE)
+    if (size == NULL || find_state(inst, FMUstate) == NULL) {
+        rst_log(inst, fmi2Error, "fmi2SerializedFMUstateSize: %s", size == NULL ? "size is NULL"
+                : "the FMUstate is not a state of this instance");
+        LEAVE(fmi2Error);
+    }
+    *size = serialized_size(inst);
+    LEAVE(fmi2OK);
+}
+
+fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate FMUstate, fmi2Byte serializedState[], size_t size)
+{
+    rst_state *s;
+    unsigned char *p;
+    size_t i, k = 0;
+    ENTER("fmi2SerializeFMUstate", ANY_LIVE_MODE)
+    s = find_state(inst, FMUstate);
+    if (s == NULL || serializedState == NULL || size < serialized_size(inst)) {
+        rst_log(inst, fmi2Error, "fmi2SerializeFMUstate: %s",
+                s == NULL ? "the FMUstate is not a state of this instance"
+                : serializedState == NULL ? "the byte array is NULL"
+                : "the byte array is smaller than fmi2SerializedFMUstateSize says");
+        LEAVE(fmi2Error);
+    }
+    p = (unsigned char *)serializedState;
+    memcpy(p, SERIAL_MAGIC, 8);
+    p += 8;
+    put_u32(&p, RST_STATE_FORMAT);
+    put_text(&p, inst->model->identifier);
+    put_text(&p, inst->model->guid);
+    put_u32(&p, (uint32_t)inst->n_state);
+    put_u32(&p, (uint32_t)s->mode);
+    put_u32(&p, (uint32_t)s->has_start);
+    put_u32(&p, (uint32_t)s->has_time);
+    put_f64(&p, s->start_time);
+    put_f64(&p, s->next_time);
+    put_f64(&p, s->last_time);
+    for (i = 0; i < inst->model->n_variables; i++)
+        if (inst->model->variables[i].state) {
+            put_u32(&p, (uint32_t)i);
+            put_u32(&p, (uint32_t)inst->model->variables[i].type);
+            put_f64(&p, s->values[k++]);
+        }
+    put_u64(&p, fnv1a((const unsigned char *)serializedState, (size_t)(p - (unsigned char *)serializedState)));
+    LEAVE(fmi2OK);
+}
+
+/* A reader that never goes past the end of the bytes. */
+typedef struct {
+    const unsigned char *p, *end;
+    int ok;
+} reader;
+
+static uint64_t get_uint(reader *r, int n_bytes)
+{
+    uint64_t x = 0;
+    int i;
+    if (!r->ok || r->end - r->p < n_bytes) {
+        r->ok = 0;
+        return 0;
+    }
+    for (i = 0; i < n_bytes; i++)
+        x |= (uint64_t)(*r->p++) << (8 * i);
+    return x;
+}
+
+static double get_f64(reader *r)
+{
+    uint64_t bits = get_uint(r, 8);
+    double x;
+    memcpy(&x, &bits, sizeof x);
+    return x;
+}
+
+static int get_text_equal(reader *r, const char *expected)
+{
+    uint64_t n = get_uint(r, 4);
+    size_t m = strlen(expected);
+    int equal;
+    if (!r->ok || n > (uint64_t)(r->end - r->p)) {
+        r->ok = 0;
+        return 0;
+    }
+    equal = n == m && memcmp(r->p, expected, m) == 0;
+    r->p += n;
+    return equal;
+}
+
+/* Reads serialized bytes into the snapshot `s` (room for n_state values); NULL, or what is wrong. */
+static const char *read_snapshot(const rst_instance *inst, const fmi2Byte bytes[], size_t size, rst_state *s)
+{
+    reader r;
+    size_t i, k = 0;
+    r.p = (const unsigned char *)bytes;
+    r.end = r.p + size;
+    r.ok = 1;
+    if (size < 8 + 8 || memcmp(r.p, SERIAL_MAGIC, 8) != 0)
+        return "these bytes are not a serialized state of this FMU (no RSTFMUST header)";
+    r.p += size - 8;
+    if (get_uint(&r, 8) != fnv1a((const unsigned char *)bytes, size - 8))
+        return "the checksum does not match (truncated or corrupted bytes)";
+    r.p = (const unsigned char *)bytes + 8;
+    r.end = (const unsigned char *)bytes + size - 8;
+    if (get_uint(&r, 4) != RST_STATE_FORMAT && r.ok)
+        return "the state was written in another format version";
+    if (!get_text_equal(&r, inst->model->identifier) && r.ok)
+        return "the state belongs to another model";
+    if (!get_text_equal(&r, inst->model->guid) && r.ok)
+        return "the state belongs to another build of this model (GUID differs)";
+    if (get_uint(&r, 4) != inst->n_state && r.ok)
+        return "the state has another number of variables";
+    s->mode = (rst_mode)get_uint(&r, 4);
+    s->has_start = get_uint(&r, 4) != 0;
+    s->has_time = get_uint(&r, 4) != 0;
+    s->start_time = get_f64(&r);
+    s->next_time = get_f64(&r);
+    s->last_time = get_f64(&r);
+    for (i = 0; r.ok && i < inst->model->n_variables; i++) {
+        if (!inst->model->variables[i].state)
+            continue;
+        if (get_uint(&r, 4) != i || get_uint(&r, 4) != (uint64_t)inst->model->variables[i].type)
+            return r.ok ? "the state's variable list differs from this FMU's" : "the state is truncated";
+        s->values[k++] = get_f64(&r);
+    }
+    if (!r.ok)
+        return "the state is truncated";
+    return r.p == r.end ? NULL : "the state has trailing bytes";
+}
+
+fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte serializedState[], size_t size,
+                                   fmi2FMUstate *FMUstate)
+{
+    rst_state *s, *target;
+    const char *problem;
+    ENTER("fmi2DeSerializeFMUstate", ANY_LIVE_MODE)
+    if (serializedState == NULL || FMUstate == NULL) {
+        rst_log(inst, fmi2Error, "fmi2DeSerializeFMUstate: NULL %s", serializedState == NULL ? "bytes" : "FMUstate pointer");
+        LEAVE(fmi2Error);
+    }
+    if (*FMUstate != NULL && find_state(inst, *FMUstate) == NULL) {
+        rst_log(inst, fmi2Error, "fmi2DeSerializeFMUstate: *FMUstate is neither NULL nor a state of this instance");
+        LEAVE(fmi2Error);
+    }
+    s = (rst_state *)inst->allocate(1, state_bytes(inst));
+    if (s == NULL) {
+        rst_log(inst, fmi2Error, "fmi2DeSerializeFMUstate: out of memory");
+        LEAVE(fmi2Error);
+    }
+    problem = read_snapshot(inst, serializedState, size, s);
+    if (problem != NULL)
+        rst_log(inst, fmi2Error, "fmi2DeSerializeFMUstate: %s; nothing was changed", problem);
+    /* checked like fmi2SetXXX before it may become a state */
+    if (problem != NULL || !check_snapshot(inst, "fmi2DeSerializeFMUstate", s) ||
+        (target = target_state(inst, "fmi2DeSerializeFMUstate", FMUstate)) == NULL) {
+        inst->release(s);
+        LEAVE(fmi2Error);
+    }
+    s->magic = RST_STATE_MAGIC;
+    s->next = target->next;
+    memcpy(target, s, state_bytes(inst));
+    inst->release(s);
+    *FMUstate = target;
+    LEAVE(fmi2OK);
+}
