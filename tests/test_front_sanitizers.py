@@ -58,7 +58,7 @@ def _sanitized_native(fmu, model, dest):
     unpacked = _unpack(fmu, dest)
     sources = sorted(str(p) for p in (unpacked / "sources").glob("*.c"))
     subprocess.run(["gcc", "-std=c99", *SANITIZE, "-Wall", "-Wextra", "-Werror", "-pedantic", "-ffp-contract=off",
-                    "-shared", "-fPIC", "-DRST_FRONT_PTHREAD", "-pthread", f"-I{unpacked / 'sources'}",
+                    "-shared", "-fPIC", "-pthread", f"-I{unpacked / 'sources'}",
                     f"-I{_fmi2_headers()}", "-o", str(unpacked / "binaries" / "linux64" / f"{model}.so"), *sources, "-lm"],
                    check=True, capture_output=True, text=True)
     return unpacked

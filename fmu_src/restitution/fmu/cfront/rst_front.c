@@ -8,10 +8,6 @@
  * A backend that reports fmi2Error puts the instance into the error mode (fmi2Reset, fmi2SetFMUstate
  * or fmi2FreeInstance leave it); fmi2Fatal latches it for good.
  */
-#if defined(RST_FRONT_PTHREAD) && !defined(_POSIX_C_SOURCE)
-#define _POSIX_C_SOURCE 200809L
-#endif
-
 #include "rst_front_internal.h"
 
 #include <float.h>
@@ -61,20 +57,24 @@ rst_instance *front_instance(fmi2Component c)
 
 void front_lock(rst_instance *inst)
 {
-#ifdef RST_FRONT_PTHREAD
+#if defined(RST_LOCK_PTHREAD)
     pthread_mutex_lock(&inst->lock);
-#else
-    (void)inst;
+#elif defined(RST_LOCK_WIN32)
+    AcquireSRWLockExclusive(&inst->lock);
 #endif
+    inst->in_call = 1;
 }
 
 void front_unlock(rst_instance *inst)
 {
-#ifdef RST_FRONT_PTHREAD
+    rst_message *messages = front_take_messages(inst);
+    inst->in_call = 0;
+#if defined(RST_LOCK_PTHREAD)
     pthread_mutex_unlock(&inst->lock);
-#else
-    (void)inst;
+#elif defined(RST_LOCK_WIN32)
+    ReleaseSRWLockExclusive(&inst->lock);
 #endif
+    front_deliver_messages(inst, messages);
 }
 
 /* Is `function` allowed in the instance's mode? Logs why not. */
@@ -216,8 +216,8 @@ static int check_get(rst_instance *inst, const char *function, fmi2ValueReferenc
     return 1;
 }
 
-/* Reads `n` (at most 64) variables of `type` into `out`: inputs, parameters and locals from the
- * store, outputs from the backend in one call. */
+/* Reads `n` (at most 64) variables of `type` into `out`: inputs and parameters from the store, outputs
+ * and locals (what the model computes) from the backend in one call. */
 static fmi2Status get_values(rst_instance *inst, const char *function, rst_type type, const fmi2ValueReference vr[],
                              size_t n, double *out)
 {
@@ -230,7 +230,8 @@ static fmi2Status get_values(rst_instance *inst, const char *function, rst_type 
         if (!check_get(inst, function, vr[i], type))
             return fmi2Error;
         out[i] = inst->store[vr[i]];
-        if (inst->model->variables[vr[i]].causality == RST_OUTPUT) {
+        if (inst->model->variables[vr[i]].causality == RST_OUTPUT ||
+            inst->model->variables[vr[i]].causality == RST_LOCAL) {
             position[n_outputs] = i;
             outputs[n_outputs++] = vr[i];
         }
@@ -431,7 +432,8 @@ static void free_memory(rst_instance *inst)
 {
     fmi2CallbackFreeMemory release = inst->release;
     front_free_states(inst);
-#ifdef RST_FRONT_PTHREAD
+    front_deliver_messages(inst, front_take_messages(inst));
+#if defined(RST_LOCK_PTHREAD)
     pthread_mutex_destroy(&inst->lock);
 #endif
     inst->magic = 0;
@@ -493,8 +495,11 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
     memset(inst->backend, 0, model->backend_size ? model->backend_size : 1);
     for (i = 0; i < model->n_variables; i++)
         inst->n_state += model->variables[i].state != 0;
-#ifdef RST_FRONT_PTHREAD
+    inst->pending_end = &inst->pending;
+#if defined(RST_LOCK_PTHREAD)
     pthread_mutex_init(&inst->lock, NULL);
+#elif defined(RST_LOCK_WIN32)
+    InitializeSRWLock(&inst->lock);
 #endif
     inst->magic = RST_INSTANCE_MAGIC;
     reset_store(inst);

@@ -21,6 +21,19 @@
 #include "fmi2Functions.h"
 #include "rst_variable.h"
 
+#include "rst_prefix.h"
+#if defined(FMI2_FUNCTION_PREFIX)
+#define RST_MODEL RST_PREFIXED(RST_MODEL)
+#define rst_store RST_PREFIXED(rst_store)
+#define rst_backend RST_PREFIXED(rst_backend)
+#define rst_instance_name RST_PREFIXED(rst_instance_name)
+#define rst_mode_of RST_PREFIXED(rst_mode_of)
+#define rst_start_time RST_PREFIXED(rst_start_time)
+#define rst_log RST_PREFIXED(rst_log)
+#define rst_log_text RST_PREFIXED(rst_log_text)
+#define rst_format_double RST_PREFIXED(rst_format_double)
+#endif
+
 typedef struct rst_instance rst_instance;
 
 /* The FMI 2.0 co-simulation modes, as bits (sets of modes describe where a call is allowed).
@@ -60,7 +73,7 @@ typedef struct {
     /* New values for inputs or parameters of one type: already checked and in the store. */
     fmi2Status (*set)(rst_instance *inst, rst_type type, const fmi2ValueReference vr[], size_t n,
                       const double values[]);
-    /* Output values: the backend writes them to `values`. NULL: the front reads the store. */
+    /* Values of outputs and locals: the backend writes them to `values`. NULL: the front reads the store. */
     fmi2Status (*get_outputs)(rst_instance *inst, rst_type type, const fmi2ValueReference vr[], size_t n,
                               double values[]);
     /* fmi2DoStep from `t` [s] over `h` [s] (checked: h > 0, finite, t continues the previous step). */

@@ -104,12 +104,15 @@ static const char *category_name(unsigned int bit)
     return "logAll";
 }
 
-/* The host's logger treats the message as a printf format: every '%' of the text is doubled. */
+/* The host's logger treats the message as a printf format: every '%' of the text is doubled. During a
+ * call (the instance locked) the message waits until the call has released the lock
+ * (front_unlock); otherwise, in fmi2Instantiate and fmi2FreeInstance, it goes to the logger at once. */
 static void deliver(rst_instance *inst, fmi2Status status, const char *category, const char *text)
 {
     char escaped[2 * MESSAGE_SIZE];
-    size_t k = 0;
+    size_t k = 0, n_category;
     const char *p;
+    rst_message *message;
     if (inst->logger == NULL)
         return;
     if (status == fmi2OK || status == fmi2Pending) {
@@ -127,7 +130,44 @@ static void deliver(rst_instance *inst, fmi2Status status, const char *category,
         escaped[k++] = *p;
     }
     escaped[k] = '\0';
-    inst->logger(inst->environment, inst->name, status, category, escaped);
+    if (!inst->in_call) {
+        inst->logger(inst->environment, inst->name, status, category, escaped);
+        return;
+    }
+    n_category = strlen(category);
+    message = (rst_message *)inst->allocate(1, sizeof *message + k + n_category + 1);
+    if (message == NULL)
+        return; /* out of memory: the call's status still tells the host what happened */
+    memcpy(message->text, escaped, k + 1);
+    memcpy(message->text + k + 1, category, n_category + 1);
+    message->category = message->text + k + 1;
+    message->status = status;
+    message->next = NULL;
+    *inst->pending_end = message;
+    inst->pending_end = &message->next;
+}
+
+rst_message *front_take_messages(rst_instance *inst)
+{
+    rst_message *messages = inst->pending;
+    inst->pending = NULL;
+    inst->pending_end = &inst->pending;
+    return messages;
+}
+
+/* Called without the lock: the logger may call this instance again. */
+void front_deliver_messages(rst_instance *inst, rst_message *messages)
+{
+    fmi2CallbackLogger logger = inst->logger;
+    fmi2ComponentEnvironment environment = inst->environment;
+    fmi2CallbackFreeMemory release = inst->release;
+    const char *name = inst->name;
+    while (messages != NULL) {
+        rst_message *next = messages->next;
+        logger(environment, name, messages->status, messages->category, messages->text);
+        release(messages);
+        messages = next;
+    }
 }
 
 void rst_log_text(rst_instance *inst, fmi2Status status, const char *category, const char *text)

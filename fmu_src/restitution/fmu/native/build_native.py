@@ -41,8 +41,8 @@ FMI2_HEADERS = ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h")
 INTERFACE_HEADER = "rst_{model}_interface.h"
 MODEL_INFO_HEADER = "rst_model_info.h"
 COMPILERS = {  # platform folder -> (compiler, extra flags, binary suffix)
-    # the front locks each instance with pthreads on Linux (one instance called from two threads)
-    "linux64": ("gcc", ("-fPIC", "-fvisibility=hidden", "-DRST_FRONT_PTHREAD", "-pthread"), ".so"),
+    # the front locks each instance (pthreads here, whatever the build command; -pthread for glibc < 2.34)
+    "linux64": ("gcc", ("-fPIC", "-fvisibility=hidden", "-pthread"), ".so"),
     "win64": ("x86_64-w64-mingw32-gcc", ("-static", "-static-libgcc"), ".dll"),
 }
 GENERATION_TOOL = "restitution native build (C99 front + native physics)"
@@ -93,12 +93,14 @@ def write_sources(model: str, directory: Path) -> list[str]:
 
 def write_backend(model: str, directory: Path) -> None:
     """The backend's C files and the interface header they include (generated from the slave's
-    VARIABLES, with the row type it needs, cfront/rst_variable.h)."""
+    VARIABLES, with the row type it needs, cfront/rst_variable.h, and the prefixing of external
+    names, cfront/rst_prefix.h)."""
     from ..interface import c_header
 
     for name in BACKENDS[model]:
         shutil.copyfile(HERE / name, directory / name)
-    shutil.copyfile(FRONT / "rst_variable.h", directory / "rst_variable.h")
+    for header in ("rst_variable.h", "rst_prefix.h"):
+        shutil.copyfile(FRONT / header, directory / header)
     (directory / INTERFACE_HEADER.format(model=model)).write_text(c_header(model), encoding="utf-8")
 
 

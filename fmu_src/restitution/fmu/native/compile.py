@@ -16,6 +16,8 @@ HERE = Path(__file__).resolve().parent
 #: The hand-written C sources of the physics (the table header is generated, see :func:`prepare_sources`).
 PHYSICS_SOURCES = ("rst_physics.h", "rst_physics.c")
 TABLE_HEADER = "rst_zener_table.h"
+#: The front's header that prefixes every external name when FMI2_FUNCTION_PREFIX is defined.
+PREFIX_HEADER = "rst_prefix.h"
 #: C99, every warning an error; no contraction of a*b+c into an FMA, so the C rounds as the Python does.
 CFLAGS = ("-std=c99", "-O2", "-Wall", "-Wextra", "-Werror", "-pedantic", "-ffp-contract=off")
 
@@ -30,6 +32,7 @@ def prepare_sources(directory: Path) -> Path:
     directory.mkdir(parents=True, exist_ok=True)
     for name in PHYSICS_SOURCES:
         shutil.copyfile(HERE / name, directory / name)
+    shutil.copyfile(HERE.parent / "cfront" / PREFIX_HEADER, directory / PREFIX_HEADER)
     (directory / TABLE_HEADER).write_text(zener_table_header(), encoding="ascii")
     return directory
 

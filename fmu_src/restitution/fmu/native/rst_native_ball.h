@@ -7,6 +7,14 @@
 #ifndef RST_NATIVE_BALL_H
 #define RST_NATIVE_BALL_H
 
+#include "rst_prefix.h"
+#if defined(FMI2_FUNCTION_PREFIX)
+#define rst_ball_bind RST_PREFIXED(rst_ball_bind)
+#define rst_ball_clear RST_PREFIXED(rst_ball_clear)
+#define rst_ball_initialize RST_PREFIXED(rst_ball_initialize)
+#define rst_ball_do_step RST_PREFIXED(rst_ball_do_step)
+#endif
+
 #include <stddef.h>
 
 enum {

@@ -9,6 +9,13 @@
 #ifndef RST_NATIVE_IMPACT_H
 #define RST_NATIVE_IMPACT_H
 
+#include "rst_prefix.h"
+#if defined(FMI2_FUNCTION_PREFIX)
+#define rst_impact_bind RST_PREFIXED(rst_impact_bind)
+#define rst_impact_accept RST_PREFIXED(rst_impact_accept)
+#define rst_impact_evaluate RST_PREFIXED(rst_impact_evaluate)
+#endif
+
 #include <stddef.h>
 
 #define RST_IMPACT_N_INPUTS 17  /* v_approach, the 10 material/geometry parameters, 4 codes, 2 tolerances */

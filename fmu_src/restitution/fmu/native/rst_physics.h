@@ -11,6 +11,12 @@
 #ifndef RST_PHYSICS_H
 #define RST_PHYSICS_H
 
+#include "rst_prefix.h"
+#if defined(FMI2_FUNCTION_PREFIX)
+#define rst_impact RST_PREFIXED(rst_impact)
+#define rst_zener_solution RST_PREFIXED(rst_zener_solution)
+#endif
+
 #ifdef __cplusplus
 extern "C" {
 #endif

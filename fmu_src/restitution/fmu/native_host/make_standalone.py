@@ -199,7 +199,7 @@ def _pystate_offset(binary: bytes) -> Optional[int]:
 
 #: The guard is C99 with the GNU extensions its Linux-only loader needs (dladdr, dlinfo, __thread).
 GUARD_CFLAGS = ("-std=gnu99", "-O2", "-Wall", "-Wextra", "-Werror", "-shared", "-fPIC", "-fvisibility=hidden",
-                "-DRST_FRONT_PTHREAD")
+                "-pthread")
 
 
 def _fmi2_headers() -> Path:
