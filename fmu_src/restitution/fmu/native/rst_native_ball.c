@@ -11,6 +11,9 @@
 /* bouncing_ball_slave.TIME_TOLERANCE [s]: a contact this close after the end of a step belongs to it. */
 #define TIME_TOLERANCE 1e-12
 #define CONTACT_MODE_WAIT 1
+/* bouncing_ball_slave.MAX_IMPACTS and MAX_TRAIN */
+#define MAX_IMPACTS 2147483647.0
+#define MAX_TRAIN 1e18
 
 static const char *const SLOT_NAMES[RST_BALL_N_SLOTS] = {
     "h0", "g", "v_min", "contact_mode", "e",
@@ -68,10 +71,16 @@ static void rebound(const rst_ball_binding *binding, double *values, double t)
     }
 }
 
+/* flight_duration: time [s] from the start of a free flight to its contact with the plate. */
+static double flight_duration(double h_start, double v_start, double g)
+{
+    return (v_start + sqrt(v_start * v_start + 2.0 * g * h_start)) / g;
+}
+
 /* _update_outputs: height [m], velocity [m/s] and approach speed [m/s] at time t [s]. */
 static void update_outputs(const rst_ball_binding *binding, double *values, double t)
 {
-    double g, dt, h;
+    double g, dt, h, duration;
     if (AT(RST_BALL_AT_REST) != 0.0) {
         AT(RST_BALL_H) = AT(RST_BALL_V) = AT(RST_BALL_V_APPROACH) = 0.0;
         return;
@@ -85,10 +94,74 @@ static void update_outputs(const rst_ball_binding *binding, double *values, doub
     g = AT(RST_BALL_G);
     dt = t - AT(RST_BALL_T_START);
     dt = dt >= 0.0 ? dt : 0.0;
+    duration = flight_duration(AT(RST_BALL_H_START), AT(RST_BALL_V_START), g);
+    dt = dt <= duration ? dt : duration;
     h = AT(RST_BALL_H_START) + AT(RST_BALL_V_START) * dt - 0.5 * g * dt * dt;
     AT(RST_BALL_H) = h >= 0.0 ? h : 0.0;
     AT(RST_BALL_V) = AT(RST_BALL_V_START) - g * dt;
     AT(RST_BALL_V_APPROACH) = -AT(RST_BALL_V) >= 0.0 ? -AT(RST_BALL_V) : 0.0;
+}
+
+/* _impact: the last of `count` contacts, at time t [s] with approach speed v [m/s]. */
+static void impact(const rst_ball_binding *binding, double *values, double t, double v, double count)
+{
+    double impacts = AT(RST_BALL_IMPACTS) + count;
+    AT(RST_BALL_IMPACTS) = impacts <= MAX_IMPACTS ? impacts : MAX_IMPACTS;
+    AT(RST_BALL_T_IMPACT) = t;
+    AT(RST_BALL_V_IMPACT) = v;
+    AT(RST_BALL_IN_CONTACT) = 1.0;
+}
+
+/* bounce_train: the bounces from the plate at t0 [s] with speed u > 0 [m/s], COR 0 < e <= 1 each
+ * time, gravity g [m/s2], rest below v_min [m/s]; the number n of impacts at or before `limit` [s],
+ * the time [s] and approach speed [m/s] of the last. See the slave's docstring for the series. */
+typedef struct {
+    double t0, u, e, c;
+} train;
+
+static double train_time(const train *tr, double j)
+{
+    return tr->t0 + tr->c * (tr->e == 1.0 ? j : -expm1(j * log(tr->e)) / (1.0 - tr->e));
+}
+
+static double train_speed(const train *tr, double j) { return tr->u * pow(tr->e, j - 1.0); }
+
+static double bounce_train(double t0, double u, double e, double g, double v_min, double limit, double *t_last,
+                           double *v_last)
+{
+    train tr;
+    double rest = MAX_TRAIN, x, n;
+    int k;
+    tr.t0 = t0, tr.u = u, tr.e = e, tr.c = 2.0 * u / g;
+    if (e < 1.0) {
+        rest = floor(log(v_min / u) / log(e)) + 1.0;
+        rest = rest >= 1.0 ? rest : 1.0;
+        rest = rest <= MAX_TRAIN ? rest : MAX_TRAIN;
+        for (k = 0; k < 4; k++)
+            if (rest > 1.0 && e * train_speed(&tr, rest - 1.0) < v_min)
+                rest -= 1.0;
+        for (k = 0; k < 4; k++)
+            if (rest < MAX_TRAIN && !(e * train_speed(&tr, rest) < v_min))
+                rest += 1.0;
+    }
+    x = tr.c > 0.0 ? (limit - t0) / tr.c : INFINITY;
+    if (e == 1.0) {
+        n = x;
+    } else {
+        double y = x * (1.0 - e);
+        n = y < 1.0 ? log1p(-y) / log(e) : INFINITY;
+    }
+    n = n >= 0.0 ? n : 0.0;
+    n = floor(n <= rest ? n : rest);
+    for (k = 0; k < 4; k++)
+        if (n > 0.0 && train_time(&tr, n) > limit)
+            n -= 1.0;
+    for (k = 0; k < 4; k++)
+        if (n < rest && train_time(&tr, n + 1.0) <= limit)
+            n += 1.0;
+    *t_last = train_time(&tr, n);
+    *v_last = train_speed(&tr, n);
+    return n;
 }
 
 void rst_ball_clear(const rst_ball_binding *binding, double *values)
@@ -99,7 +172,7 @@ void rst_ball_clear(const rst_ball_binding *binding, double *values)
     AT(RST_BALL_V_IMPACT) = 0.0;
     AT(RST_BALL_T_REBOUND) = -1.0;
     AT(RST_BALL_V_REBOUND) = 0.0;
-    AT(RST_BALL_E_APPLIED) = NAN;
+    AT(RST_BALL_E_APPLIED) = 0.0;
     AT(RST_BALL_IN_CONTACT) = AT(RST_BALL_AT_REST) = 0.0;
     start_flight(binding, values, 0.0, 0.0, 0.0);
 }
@@ -113,25 +186,31 @@ void rst_ball_initialize(const rst_ball_binding *binding, double *values, double
 
 void rst_ball_do_step(const rst_ball_binding *binding, double *values, double current_time, double step_size)
 {
-    double g = AT(RST_BALL_G);
+    double g = AT(RST_BALL_G), e = AT(RST_BALL_E), v_min = AT(RST_BALL_V_MIN);
     int wait = AT(RST_BALL_CONTACT_MODE) == CONTACT_MODE_WAIT; /* compared as a double: no cast of a bad value */
-    double end = current_time + step_size;
+    double end = current_time + step_size, limit = end + TIME_TOLERANCE;
     if (AT(RST_BALL_IN_CONTACT) != 0.0) /* the COR for the pending contact arrived at this point */
         rebound(binding, values, current_time);
-    while (AT(RST_BALL_AT_REST) == 0.0) {
-        /* root of h_start + v_start s - g s^2 / 2 = 0, in the form without cancellation */
+    if (AT(RST_BALL_AT_REST) == 0.0) {
+        /* flight_end: the contact that ends the current flight */
         double v_start = AT(RST_BALL_V_START);
         double v_hit = sqrt(v_start * v_start + 2.0 * g * AT(RST_BALL_H_START));
         double t_hit = AT(RST_BALL_T_START) + (v_start + v_hit) / g;
-        if (!(t_hit <= end + TIME_TOLERANCE)) /* as the slave's t_hit > end + tol, and a NaN ends the loop too */
-            break;
-        AT(RST_BALL_IMPACTS) += 1.0;
-        AT(RST_BALL_T_IMPACT) = t_hit;
-        AT(RST_BALL_V_IMPACT) = v_hit;
-        AT(RST_BALL_IN_CONTACT) = 1.0;
-        if (wait)
-            break;
-        rebound(binding, values, t_hit);
+        if (t_hit <= limit) { /* (a NaN is no contact) */
+            impact(binding, values, t_hit, v_hit, 1.0);
+            if (!wait) {
+                rebound(binding, values, t_hit);
+                if (AT(RST_BALL_AT_REST) == 0.0) { /* the rest of the step: flights from the plate, all with this e */
+                    double t_last, v_last;
+                    double n = bounce_train(AT(RST_BALL_T_START), AT(RST_BALL_V_START), e, g, v_min, limit, &t_last,
+                                            &v_last);
+                    if (n > 0.0) {
+                        impact(binding, values, t_last, v_last, n);
+                        rebound(binding, values, t_last);
+                    }
+                }
+            }
+        }
     }
     update_outputs(binding, values, end);
 }

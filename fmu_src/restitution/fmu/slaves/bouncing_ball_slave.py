@@ -28,6 +28,13 @@ The ball rests when the rebound speed would fall below ``v_min`` or e <= 0 (as t
 event-exact master ``restitution.cosim.bounce``). Impacts are instantaneous (the contact
 duration, tens of microseconds, is not spent), as in that master.
 
+Every ``do_step`` takes a bounded time, whatever the step and the parameters: in ``immediate``
+mode the bounces after the first rebound of a step all start at the plate with the same COR, so
+their impact times and speeds form a geometric series, and the step jumps to the last impact
+inside it in closed form (:func:`bounce_train`) instead of visiting each one (with e = 1 and a
+flight shorter than the clock's resolution there would be no end to them). ``impacts`` saturates
+at ``MAX_IMPACTS``.
+
 State: every quantity the ball evolves is a registered variable (outputs and the local
 ``flight.*``); the FMU state is every registered variable, tagged with the model, the state
 format and the variable list, and validated (parameters and input as the setters would, the
@@ -56,11 +63,23 @@ TIME_TOLERANCE = 1e-12
 
 CONTACT_MODES = ("wait", "immediate")
 
+#: Upper bound of h0 [m] and of g [m/s2] (1000 km; 1e5 standard gravities): the largest speed,
+#: sqrt(2 g h0) = 1.4e6 m/s, and every time and height then stay finite.
+MAX_HEIGHT_OR_GRAVITY = 1e6
+
+#: The count of impacts saturates here: the largest fmi2Integer (a ball whose flights are shorter
+#: than the clock's resolution can bounce more often in one step than an Integer counts).
+MAX_IMPACTS = 2**31 - 1
+#: The largest number of bounces one step jumps over (a float; where flights are too short for the
+#: clock to tell apart, the count is only a bound anyway).
+MAX_TRAIN = 1e18
+
 # (name, type, causality, unit, start, description, key); build_fmu.py reads this table to
 # write units, ranges and descriptions into modelDescription.xml.
 VARIABLES = (
-    ("h0", "Real", P, "m", 0.3, "Drop height: the ball is released from rest at the start time, > 0", "h0"),
-    ("g", "Real", P, "m/s2", 9.80665, "Gravitational acceleration, > 0", "g"),
+    ("h0", "Real", P, "m", 0.3, "Drop height: the ball is released from rest at the start time, 0 < h0 <= 1e6 m",
+     "h0"),
+    ("g", "Real", P, "m/s2", 9.80665, "Gravitational acceleration, 0 < g <= 1e6 m/s2", "g"),
     ("v_min", "Real", P, "m/s", 0.1, "The ball comes to rest when its rebound speed would be below v_min, > 0",
      "v_min"),
     ("contact_mode", "Integer", P, None, 1,
@@ -73,14 +92,16 @@ VARIABLES = (
     ("v", "Real", OUT, "m/s", None, "Vertical velocity of the ball, upward positive", "v"),
     ("v_approach", "Real", OUT, "m/s", None, "Speed of the ball toward the plate, max(-v, 0) "
      "(while waiting at the plate: the impact speed); connect to SpherePlateImpact.v_approach", "v_approach"),
-    ("impacts", "Integer", OUT, None, None, "Number of contacts with the plate so far", "impacts"),
+    ("impacts", "Integer", OUT, None, None, "Number of contacts with the plate so far (saturates at 2147483647)",
+     "impacts"),
     ("t_impact", "Real", OUT, "s", None, "Time of the last contact, located inside the step (-1: none yet)",
      "t_impact"),
     ("v_impact", "Real", OUT, "m/s", None, "Approach speed at the last contact", "v_impact"),
     ("t_rebound", "Real", OUT, "s", None, "Time the ball left the plate after the last contact (-1: not yet)",
      "t_rebound"),
     ("v_rebound", "Real", OUT, "m/s", None, "Rebound speed after the last contact (0: at rest)", "v_rebound"),
-    ("e_applied", "Real", OUT, "1", None, "COR applied at the last rebound", "e_applied"),
+    ("e_applied", "Real", OUT, "1", None, "COR applied at the last rebound (0 until the first rebound, while "
+     "t_rebound = -1)", "e_applied"),
     ("in_contact", "Boolean", OUT, None, None, "Waiting at the plate for the COR (contact_mode = 1)", "in_contact"),
     ("at_rest", "Boolean", OUT, None, None, "The ball has come to rest on the plate", "at_rest"),
     ("flight.t_start", "Real", LOCAL, "s", None, "Start time of the current free flight", "t_start"),
@@ -100,6 +121,8 @@ def allowed_interval(name):
         return 1, len(CONTACT_MODES), False, False
     if name == "e":
         return -1.0, 1.0, False, False
+    if name in ("h0", "g"):  # bounded: the speeds, sqrt(2 g h0) at most, and so every output stay finite
+        return 0.0, MAX_HEIGHT_OR_GRAVITY, True, False
     return 0.0, math.inf, True, True
 
 
@@ -112,9 +135,67 @@ def allowed_range(name):
     return interval_check(*allowed_interval(name))
 
 
+def flight_duration(h_start, v_start, g):
+    """Time [s] from the start of a free flight (height h_start [m], upward speed v_start [m/s],
+    gravity g [m/s2]) to its contact with the plate: the root of h_start + v_start s - g s^2/2 = 0,
+    as (v_start + v_hit)/g, the form without cancellation."""
+    return (v_start + math.sqrt(v_start * v_start + 2.0 * g * h_start)) / g
+
+
+def flight_end(t_start, h_start, v_start, g):
+    """Time [s] and approach speed [m/s] of the contact that ends a free flight started at t_start [s]."""
+    v_hit = math.sqrt(v_start * v_start + 2.0 * g * h_start)
+    return t_start + (v_start + v_hit) / g, v_hit
+
+
+def bounce_train(t0, u, e, g, v_min, limit):
+    """The bounces of a ball that leaves the plate at t0 [s] with upward speed u > 0 [m/s] and
+    rebounds every time with the same COR 0 < e <= 1 under gravity g [m/s2], until it would rebound
+    slower than v_min [m/s]: (n, T_n [s], w_n [m/s]), the number of its impacts at or before `limit`
+    [s] and the time and approach speed of the last of them (n = 0: none).
+
+    Flight j = 1, 2, ... starts at the plate with speed u e^(j-1) and lasts 2 u e^(j-1)/g, so impact j
+    is at T_j = t0 + (2u/g) S_j, S_j = (1 - e^j)/(1 - e) (j for e = 1; -expm1(j ln e)/(1 - e), no
+    cancellation for e near 1), with speed w_j = u e^(j-1); the ball comes to rest at the first impact
+    with e w_j < v_min. n comes from inverting T_j and is then checked against T_j and w_j as written,
+    a few steps either way, so it counts the impacts a one-by-one loop would count wherever the clock
+    resolves them, in bounded time where it does not. n <= MAX_TRAIN."""
+    c = 2.0 * u / g
+
+    def time(j):
+        return t0 + c * (j if e == 1.0 else -math.expm1(j * math.log(e)) / (1.0 - e))
+
+    def speed(j):
+        return u * e ** (j - 1.0)
+
+    rest = MAX_TRAIN  # the impact at which the ball comes to rest (at most)
+    if e < 1.0:
+        rest = min(max(math.floor((math.log(v_min) - math.log(u)) / math.log(e)) + 1.0, 1.0), MAX_TRAIN)
+        for _ in range(4):
+            if rest > 1.0 and e * speed(rest - 1.0) < v_min:
+                rest -= 1.0
+        for _ in range(4):
+            if rest < MAX_TRAIN and not e * speed(rest) < v_min:
+                rest += 1.0
+    x = (limit - t0) / c if c > 0.0 else math.inf  # the time to `limit` in flights of the first
+    if e == 1.0:
+        n = x
+    else:
+        y = x * (1.0 - e)
+        n = math.log1p(-y) / math.log(e) if y < 1.0 else math.inf
+    n = float(math.floor(min(max(n, 0.0), rest)))
+    for _ in range(4):
+        if n > 0.0 and time(n) > limit:
+            n -= 1.0
+    for _ in range(4):
+        if n < rest and time(n + 1.0) <= limit:
+            n += 1.0
+    return n, time(n), speed(n)
+
+
 _INITIAL_STATE = {
     "h": 0.0, "v": 0.0, "v_approach": 0.0, "impacts": 0, "t_impact": -1.0, "v_impact": 0.0,
-    "t_rebound": -1.0, "v_rebound": 0.0, "e_applied": math.nan, "in_contact": False, "at_rest": False,
+    "t_rebound": -1.0, "v_rebound": 0.0, "e_applied": 0.0, "in_contact": False, "at_rest": False,
     "t_start": 0.0, "h_start": 0.0, "v_start": 0.0,
 }
 
@@ -203,10 +284,18 @@ class BouncingBall(Fmi2Slave):
             s["h"], s["v"], s["v_approach"] = 0.0, -s["v_impact"], s["v_impact"]
             return
         g = float(self._values["g"])
-        dt = max(t - s["t_start"], 0.0)
+        # within the flight: a flight shorter than the clock's resolution must not extrapolate past its end
+        dt = min(max(t - s["t_start"], 0.0), flight_duration(s["h_start"], s["v_start"], g))
         s["h"] = max(s["h_start"] + s["v_start"] * dt - 0.5 * g * dt * dt, 0.0)
         s["v"] = s["v_start"] - g * dt
         s["v_approach"] = max(-s["v"], 0.0)
+
+    def _impact(self, t, v, count):
+        """The last of `count` contacts: at time t [s] with approach speed v [m/s]."""
+        s = self._s
+        s["impacts"] = int(min(s["impacts"] + count, MAX_IMPACTS))
+        s["t_impact"], s["v_impact"] = t, v
+        s["in_contact"] = True
 
     # --- FMI calls -------------------------------------------------------------------------
     def setup_experiment(self, start_time, stop_time=None, tolerance=None):
@@ -219,24 +308,24 @@ class BouncingBall(Fmi2Slave):
 
     def do_step(self, current_time: float, step_size: float) -> bool:
         s = self._s
-        g = float(self._values["g"])
+        g, e, v_min = float(self._values["g"]), float(self._values["e"]), float(self._values["v_min"])
         wait = int(self._values["contact_mode"]) == 1
         now = float(current_time)
         end = now + float(step_size)
+        limit = end + TIME_TOLERANCE
         if s["in_contact"]:  # the COR for the pending contact arrived at this communication point
             self._rebound(now)
-        while not s["at_rest"]:
-            # root of h_start + v_start s - g s^2 / 2 = 0; this form avoids cancellation
-            v_hit = math.sqrt(s["v_start"] ** 2 + 2.0 * g * s["h_start"])
-            t_hit = s["t_start"] + (s["v_start"] + v_hit) / g
-            if t_hit > end + TIME_TOLERANCE:
-                break
-            s["impacts"] += 1
-            s["t_impact"], s["v_impact"] = t_hit, v_hit
-            s["in_contact"] = True
-            if wait:
-                break
-            self._rebound(t_hit)
+        if not s["at_rest"]:
+            t_hit, v_hit = flight_end(s["t_start"], s["h_start"], s["v_start"], g)
+            if t_hit <= limit:  # (a NaN is no contact)
+                self._impact(t_hit, v_hit, 1)
+                if not wait:
+                    self._rebound(t_hit)
+                    if not s["at_rest"]:  # the rest of the step: flights from the plate, all with this e
+                        n, t_last, v_last = bounce_train(s["t_start"], s["v_start"], e, g, v_min, limit)
+                        if n > 0:
+                            self._impact(t_last, v_last, n)
+                            self._rebound(t_last)
         self._update_outputs(end)
         return True
 
