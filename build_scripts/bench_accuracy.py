@@ -841,7 +841,7 @@ def markdown(res: dict, cfg_name: str, elapsed: float) -> str:
         "## e44 against e45",
         "",
         "There is **no ground truth** here: both are JGM's fits to finite-element results (Eq. 7 = JGM "
-        "Eq. 44, Eq. 8 = JGM Eq. 45), and e44's branch above V* = 60 is a reconstruction (ERRATA.md). "
+        "Eq. 44, Eq. 8 = JGM Eq. 45), and e44's branch above V* = 60 is a reconstruction ([paper_departures.md](paper_departures.md)). "
         "Their difference over V* in [1, 1000] (4001 log-spaced points) measures how much the choice of fit "
         "matters, not the error of either. e45 depends on the yield strain eps_y of the pair, e44 does not.",
         "",
@@ -855,7 +855,7 @@ def markdown(res: dict, cfg_name: str, elapsed: float) -> str:
                      f"{w['e44_1000']:.3f} | {w['e45_1000']:.3f} |")
     if any(w["e45_1000"] == 0.0 or w["e45_at_max"] == 0.0 for w in jgm["rows"]):
         lines += ["", "e45 = 0 above: for a large yield strain the e45 fit falls below 0 before V* = 1000 and "
-                      "is floored there (ERRATA.md); e44 has no eps_y and stays positive."]
+                      "is floored there ([paper_departures.md](paper_departures.md)); e44 has no eps_y and stays positive."]
     lines += ["", f"Cost of a scalar call: e45 {_us(jgm['cost_e45'])}, e44 {_us(jgm['cost_e44'])} "
                   f"({jgm['e44_over_e45']:.2f}x); in the model the choice is free in comparison.", ""]
 

@@ -50,7 +50,7 @@ def e44_printed(v_star):
     v = mp.mpf(v_star)
     if v <= 60:
         return 1 - mp.mpf("0.1") * mp.log(v) * ((v - 1) / 59) ** mp.mpf("0.156")
-    # second branch as reconstructed (ERRATA.md): ((V* - 60)/940)^2.366
+    # second branch as reconstructed (docs/paper_departures.md): ((V* - 60)/940)^2.366
     return 1 - mp.mpf("0.1") * mp.log(60) - mp.mpf("0.11") * mp.log(v / 60) * ((v - 60) / 940) ** mp.mpf("2.366")
 
 

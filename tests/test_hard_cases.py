@@ -305,7 +305,7 @@ def test_speeds_down_to_1e_12_and_v_zero():
 
 def test_yield_rule_switch_is_the_papers_eq3():
     """Eq. (3) takes S_y of the body that yields first: at the switch C(nu_a) S_ya = C(nu_b) S_yb
-    eps_y jumps by C(nu_a)/C(nu_b) (the paper's rule, ERRATA: confirmed as printed); none when nu_a = nu_b."""
+    eps_y jumps by C(nu_a)/C(nu_b) (the paper's rule, confirmed as printed, docs/paper_departures.md); none when nu_a = nu_b."""
     for nu_a, nu_b in ((0.3, 0.3), (0.3, 0.33), (0.2, 0.45)):
         sy_b = 1e9
         sy_a_switch = jgm.poisson_coefficient(nu_b) * sy_b / jgm.poisson_coefficient(nu_a)

@@ -5,7 +5,7 @@ Two instances with different materials run in one fixed-step execution; instance
 ``v_rebound`` drives instance b's ``v_approach`` through a libcosim connection, an override
 manipulator feeds a's ``v_approach``, and a last-value observer reads every output after each
 step. libcosim counts time in integer nanoseconds (a float step such as 1e-3 silently becomes 0
-and the execution then crashes, FMI-NOTES.md): every duration here is an int. The execution runs
+and the execution then crashes, docs/fmi_tools.md): every duration here is an int. The execution runs
 in a child process so that a crash inside libcosim fails this test instead of killing pytest.
 """
 from __future__ import annotations

@@ -68,7 +68,7 @@ def test_eq23_is_the_fit_of_eq22_on_the_studied_range():
     """Eq. (23)'s 1.72847 is the least-squares fit of exp(-b lambda) to the linear model's closed
     form (Eq. 22) sampled every 0.005 on [0, 1.5] (the continuum limit is 1.72818)."""
     lam = np.linspace(0.0, 1.5, 301)
-    e_lin = np.exp(-math.pi * lam / np.sqrt(4 - lam ** 2))  # Eq. (22) solved in closed form (ERRATA.md)
+    e_lin = np.exp(-math.pi * lam / np.sqrt(4 - lam ** 2))  # Eq. (22) solved in closed form (docs/paper_departures.md)
     (b,), _ = curve_fit(lambda x, b: np.exp(-b * x), lam, e_lin, p0=[1.5])
     assert b == pytest.approx(1.72847, abs=5e-6)
     for x in (0.1, 0.75, 1.5):
@@ -167,7 +167,7 @@ def test_e45_never_underflows_just_above_yield_onset_for_any_preset_pair():
 
 @pytest.mark.parametrize("lam", [1e-12, 1e-6, 0.01, 0.5, 1.0, 1.5, 1.99])
 def test_linear_method_equals_the_closed_form_of_eq22_in_mpmath(lam):
-    """Eq. (22)'s closed form (ERRATA.md): e = exp(-pi lam / sqrt(4 - lam^2)), tau0 = 2 pi / sqrt(4 - lam^2),
+    """Eq. (22)'s closed form (docs/paper_departures.md): e = exp(-pi lam / sqrt(4 - lam^2)), tau0 = 2 pi / sqrt(4 - lam^2),
     evaluated in 40 digits; the deficit 1 - e to full relative accuracy (condition number ~1 in lam)."""
     mp.mp.dps = 40
     x = mp.mpf(lam)

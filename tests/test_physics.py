@@ -109,7 +109,7 @@ def test_paper_fit_matches_its_published_form_and_known_error():
     assert e == pytest.approx(math.exp(-1.68374 * 1.5)) and tau0 == pytest.approx(3.215 * math.exp(0.318 * 1.5 ** 1.5))
     e_exact, _ = zener.zener_restitution(1.5, "exact")
     assert e_exact == pytest.approx(0.066, abs=5e-4)
-    assert e == pytest.approx(0.080, abs=5e-4)  # ERRATA: the fit is ~20 % high at lambda = 1.5
+    assert e == pytest.approx(0.080, abs=5e-4)  # docs/paper_departures.md: the fit is ~20 % high at lambda = 1.5
 
 
 def _linear_oscillator(lam):

@@ -62,7 +62,7 @@ def sphere_yields_first(nu_a, Sy_a, nu_b, Sy_b):
 def yield_strain(E_prime, nu_a, Sy_a, nu_b, Sy_b):
     """eps_y = S_y / E' [1], Eq. (3), with S_y of the body that yields first.
 
-    Not C S_y / E' as some public scripts use (ERRATA.md).
+    Not C S_y / E' as some public scripts use (docs/paper_departures.md).
     """
     Sy = where(sphere_yields_first(nu_a, Sy_a, nu_b, Sy_b), Sy_a, Sy_b)
     return Sy / E_prime
@@ -133,7 +133,7 @@ def restitution_e44(v_star):
 
     Departure from the printed text: the OCR'd second branch reads (V* - 60)^2.366,
     which gives e ~ -350 at V* = 100 and cannot be right. The reconstruction
-    ((V* - 60)/940)^2.366 (ERRATA.md) mirrors the first branch's normalisation,
+    ((V* - 60)/940)^2.366 (docs/paper_departures.md) mirrors the first branch's normalisation,
     joins it continuously at V* = 60 and gives e = 0.281 at V* = 1000. Treat the
     second branch as reconstructed. Floored at 0 beyond the fit range, as e45.
     """

@@ -146,7 +146,7 @@ def table4_case(case: str) -> tuple[Material, Material]:
     """(sphere material, plate material) of Table 4 case A1-A4 or B1-B4.
 
     Table 4's fourth column is the *plate* modulus (mislabelled "Sphere" in the
-    text, see ERRATA). Cases A: heavy, stiff sphere on a light, soft plate;
+    text, see docs/paper_departures.md). Cases A: heavy, stiff sphere on a light, soft plate;
     cases B the reverse. The plate yield strength is 10, 100, 1000, 10000 MPa
     for cases 1-4.
     """

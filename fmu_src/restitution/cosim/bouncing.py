@@ -17,7 +17,7 @@ of bounces they are still the correctly rounded sums of the flight times. A rebo
 function that returns a non-finite e or v_rebound (e.g. an FMU whose inputs are invalid
 reads NaN) stops the drop with ValueError instead of bouncing on NaN.
 
-fmpy's ``simulate_fmu`` has no events in co-simulation (FMI-NOTES.md), hence this master
+fmpy's ``simulate_fmu`` has no events in co-simulation (docs/fmi_tools.md), hence this master
 on ``fmpy.fmi2.FMU2Slave`` (through :class:`~restitution.cosim.fmu.FmuInstance`).
 """
 from __future__ import annotations

@@ -8,7 +8,7 @@ time-series observer and returns a :class:`~restitution.cosim.fixed_step.CosimRe
 
 Times: the XML holds seconds (``BaseStepSize``); libcosim's own API counts integer
 **nanoseconds** (a float step such as 1e-3 silently becomes 0 and the execution then
-crashes, FMI-NOTES.md), so every duration passed to libcosimpy here is converted with
+crashes, docs/fmi_tools.md), so every duration passed to libcosimpy here is converted with
 :func:`to_ns`.
 
 libcosim's ``fixedStep`` algorithm steps every FMU, reads each FMU's outputs right after

@@ -5,7 +5,7 @@
 builds DIR/SpherePlateImpact.fmu and DIR/BouncingBall.fmu, bundling the physics modules of
 the installed ``restitution`` package (the same source ``pip install`` installs), then:
 
-* rewrites modelDescription.xml with what pythonfmu cannot write (FMI-NOTES.md): units
+* rewrites modelDescription.xml with what pythonfmu cannot write (docs/fmi_tools.md): units
   and UnitDefinitions, descriptions, min/max, and a ModelStructure that declares each
   output's direct dependence on the input (direct feedthrough) and the InitialUnknowns;
   value references, names and types are left as pythonfmu wrote them, since the binary
