@@ -77,6 +77,11 @@ static struct {
     const char *(*PyUnicode_AsUTF8)(PyObj *);
     void (*Py_DecRef)(PyObj *);
     void (*PyErr_Clear)(void);
+    /* optional: only needed to keep the host's pending signal handlers out of the slave */
+    int (*Py_MakePendingCalls)(void);
+    int (*Py_AddPendingCall)(int (*)(void *), void *);
+    void (*PyErr_Fetch)(PyObj **, PyObj **, PyObj **);
+    void (*PyErr_Restore)(PyObj *, PyObj *, PyObj *);
     /* legacy initialization */
     wchar_t *(*Py_DecodeLocale)(const char *, size_t *);
     void (*Py_SetProgramName)(const wchar_t *);
@@ -103,6 +108,10 @@ static const char *resolve_python_api(void *handle)
     RESOLVE(Py_DecRef);
     RESOLVE(PyErr_Clear);
 #undef RESOLVE
+    *(void **)(&py.Py_MakePendingCalls) = dlsym(handle, "Py_MakePendingCalls");
+    *(void **)(&py.Py_AddPendingCall) = dlsym(handle, "Py_AddPendingCall");
+    *(void **)(&py.PyErr_Fetch) = dlsym(handle, "PyErr_Fetch");
+    *(void **)(&py.PyErr_Restore) = dlsym(handle, "PyErr_Restore");
     *(void **)(&py.PyEval_RestoreThread) = dlsym(handle, "PyEval_RestoreThread");
     *(void **)(&py.PyThreadState_Clear) = dlsym(handle, "PyThreadState_Clear");
     *(void **)(&py.PyThreadState_DeleteCurrent) = dlsym(handle, "PyThreadState_DeleteCurrent");
@@ -735,5 +744,70 @@ const pythonfmu_api *pyhost_ensure_ready(rst_instance *inst, const char *resourc
 }
 
 void pyhost_attach_thread(void) { attach_thread(); }
+
+/* ------------------------------------------------------------------------ */
+/* Signal handlers that were due before a call (Python hosts only)          */
+/* ------------------------------------------------------------------------ */
+/* A signal that arrives while the host runs Python code or C code before the guard has set the host's
+ * handler aside (the ctypes call, the front's checks) only sets a flag of the interpreter: the Python
+ * handler runs at the eval loop's next check, which without this is inside the slave's code
+ * (KeyboardInterrupt there, which pythonfmu answers with fmi2Fatal). Py_MakePendingCalls runs the due
+ * handlers and pending calls now, on the interpreter's main thread only (elsewhere it returns 0); an
+ * exception stops it, so it is called again until nothing more fails. */
+static int pending_ready(void)
+{
+    return !g_shim_managed && py.Py_MakePendingCalls && py.Py_AddPendingCall && py.PyErr_Fetch &&
+           py.PyErr_Restore;
+}
+
+void pyhost_enter_call(pyhost_call *call)
+{
+    if (call == NULL)
+        return;
+    call->gil = -1;
+    call->n_raised = 0;
+    if (!pending_ready())
+        return;
+    call->gil = py.PyGILState_Ensure(); /* held until pyhost_leave_call: pythonfmu's Ensure only counts */
+    while (call->n_raised < PYHOST_MAX_RAISED && py.Py_MakePendingCalls() != 0) {
+        void **kept = call->raised[call->n_raised];
+        py.PyErr_Fetch((PyObj **)&kept[0], (PyObj **)&kept[1], (PyObj **)&kept[2]);
+        if (kept[0] == NULL) /* failed without an exception: nothing to hand on, and nothing more to run */
+            break;
+        call->n_raised++;
+    }
+}
+
+/* A pending call: the exception a signal handler raised before a call, raised again in the host's code. */
+static int raise_again(void *arg)
+{
+    void **kept = (void **)arg;
+    py.PyErr_Restore(kept[0], kept[1], kept[2]); /* steals the references */
+    free(kept);
+    return -1;
+}
+
+void pyhost_leave_call(pyhost_call *call)
+{
+    int i;
+    if (call == NULL || call->gil == -1)
+        return;
+    for (i = 0; i < call->n_raised; i++) {
+        void **kept = (void **)malloc(3 * sizeof(void *));
+        if (kept != NULL) {
+            memcpy(kept, call->raised[i], 3 * sizeof(void *));
+            if (py.Py_AddPendingCall(raise_again, kept) == 0)
+                continue;
+            free(kept);
+        }
+        /* out of memory or the interpreter's queue of pending calls full: the exception is lost */
+        if (call->raised[i][0]) py.Py_DecRef(call->raised[i][0]);
+        if (call->raised[i][1]) py.Py_DecRef(call->raised[i][1]);
+        if (call->raised[i][2]) py.Py_DecRef(call->raised[i][2]);
+    }
+    call->n_raised = 0;
+    py.PyGILState_Release(call->gil);
+    call->gil = -1;
+}
 
 int pyhost_interpreter_is_hosts(void) { return !g_shim_managed; }

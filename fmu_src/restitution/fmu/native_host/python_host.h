@@ -31,6 +31,22 @@ const pythonfmu_api *pyhost_ensure_ready(rst_instance *inst, const char *resourc
  * thread when this module started the interpreter). */
 void pyhost_attach_thread(void);
 
+/* Around every call into pythonfmu in a Python host (fmpy, libcosimpy), after the host's signal handlers
+ * have been set aside (pythonfmu_backend.c): pyhost_enter_call takes the GIL and runs, on the
+ * interpreter's main thread, the Python signal handlers and pending calls that were already due, so that
+ * they cannot run inside the slave's code; what they raise is kept in `call`. pyhost_leave_call has it
+ * raised again in the host's code (at the interpreter's next check, between two FMI calls) and releases
+ * the GIL. pythonfmu's own PyGILState_Ensure inside the call then only counts. Both do nothing in a
+ * plain C host. */
+#define PYHOST_MAX_RAISED 4
+typedef struct {
+    int gil;                            /* PyGILState_STATE taken by pyhost_enter_call, or -1 */
+    int n_raised;                       /* exceptions kept in `raised` */
+    void *raised[PYHOST_MAX_RAISED][3]; /* (type, value, traceback), owned references */
+} pyhost_call;
+void pyhost_enter_call(pyhost_call *call);
+void pyhost_leave_call(pyhost_call *call);
+
 /* 1 when the interpreter is the host's own (a Python host: fmpy, libcosimpy), 0 when it was started
  * for the FMU (a plain C host). Valid after pyhost_ensure_ready succeeded. */
 int pyhost_interpreter_is_hosts(void);
