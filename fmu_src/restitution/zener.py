@@ -137,7 +137,9 @@ def zener_linear_fit(lam):
 def zener_ode(lam, rtol: float = 1e-10):
     """(e_ze, tau0) [1] by integrating Eq. (10) at every call, relative tolerance ``rtol``.
 
-    The reference and the slow end of the accuracy scale.
+    The reference and the slow end of the accuracy scale. Bounded work per element: tolerances
+    are floored at what the integrator honours, and above lambda = 100 the verified large-lambda
+    form is returned instead of a solve (see :mod:`restitution.zener_ode`, "Bounded cost").
     """
     if is_scalar(lam):
         return solve_zener_ode(float(lam), rtol=rtol)
