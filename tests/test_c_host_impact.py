@@ -42,7 +42,7 @@ pytestmark = [
 
 REALS = {"e": "e", "v_rebound": "v_rebound", "jgm.e": "e_ep", "jgm.V_c": "V_c", "jgm.V_star": "V_star",
          "zener.e": "e_ze", "zener.lambda": "lam", "zener.tau0": "tau0", "zener.t_contact": "t_contact",
-         "plate.m_eff": "m_eff", "plate.v_after": "v_plate"}
+         "plate.mass_ratio": "mass_ratio", "plate.v_after": "v_plate"}
 FLAGS = {"valid": "valid", "zener.in_range": "lambda_in_range", "jgm.in_range": "vstar_in_range",
          "e_negative": "e_negative", "effects.plasticity": "plasticity_used", "effects.plate_waves": "plate_waves_used"}
 MATERIALS = [

@@ -11,7 +11,8 @@ from restitution.model import ImpactResult, impact
 
 from agree import assert_agree, stack
 
-FLAGS = {"plasticity_used", "plate_waves_used", "lambda_in_range", "vstar_in_range", "e_negative", "valid"}
+FLAGS = {"plasticity_used", "plate_waves_used", "lambda_in_range", "vstar_in_range", "e_negative", "valid",
+         "contact_ends"}
 
 
 def _cases(n, seed=5):

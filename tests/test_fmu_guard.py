@@ -594,7 +594,7 @@ def test_values_at_the_ends_of_the_declared_ranges(any_impact_fmu, unzipped):
             st = status(s.setReal, [VR[name]], [value])
             step = status(s.doStep, 0.0, 1e-3)
             got = reals(s, ["e", "v_rebound", "jgm.e", "jgm.V_c", "jgm.V_star", "zener.e", "zener.lambda",
-                            "zener.tau0", "zener.t_contact", "plate.m_eff", "plate.v_after"])
+                            "zener.tau0", "zener.t_contact", "plate.mass_ratio", "plate.v_after"])
             valid = bool(s.getBoolean([VR["valid"]])[0])
             out.append([base, name, value, st, step, got, valid, [m for _, _, m in LOG[n:]]])
             s.terminate()
@@ -605,7 +605,7 @@ def test_values_at_the_ends_of_the_declared_ranges(any_impact_fmu, unzipped):
 
     run = run_child(code, any_impact_fmu, unzipped, json.dumps(EXTREMES), timeout=900)
     assert run.returncode == 0 and run.report is not None, run.explain()
-    fields = ("e", "v_rebound", "e_ep", "V_c", "V_star", "e_ze", "lam", "tau0", "t_contact", "m_eff", "v_plate")
+    fields = ("e", "v_rebound", "e_ep", "V_c", "V_star", "e_ze", "lam", "tau0", "t_contact", "mass_ratio", "v_plate")
     defaults = {v.name: v.start for v in variables("SpherePlateImpact") if v.name in PACKAGE_NAME}
     bases = ({}, {"plate.t", "sphere.d"}, {"plate.t", "sphere.d"})
     assert len(run.report["out"]) == sum(name not in base for base in bases for name, _ in EXTREMES) > 140

@@ -75,7 +75,7 @@ def _bad_values(name):
 BAD = [(name, value) for name in INPUTS for value in _bad_values(name)]
 REAL_OUTPUTS = {"e": "e", "v_rebound": "v_rebound", "jgm.e": "e_ep", "jgm.V_c": "V_c", "jgm.V_star": "V_star",
                 "zener.e": "e_ze", "zener.lambda": "lam", "zener.tau0": "tau0", "zener.t_contact": "t_contact",
-                "plate.m_eff": "m_eff", "plate.v_after": "v_plate"}
+                "plate.mass_ratio": "mass_ratio", "plate.v_after": "v_plate"}
 OUTPUT_NAMES = list(REAL_OUTPUTS)
 BOOL_OUTPUTS = ["valid", "zener.in_range", "jgm.in_range", "e_negative", "effects.plasticity", "effects.plate_waves"]
 BOOL_FIELDS = ["valid", "lambda_in_range", "vstar_in_range", "e_negative", "plasticity_used", "plate_waves_used"]

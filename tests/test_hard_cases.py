@@ -7,9 +7,10 @@ material pairs (Tables 3 and 4, brittle on one or both sides, nu = 0 and 0.499),
 elastoplastic models, and at targeted branch boundaries (V* = 1, 60, 1000, 1e6; lambda = 1.5,
 2, 10, 100, the paper fit's cap, the auto thresholds):
 
-* all outputs finite, except the documented cases: plate.m_eff = +inf exactly when e_ze = 1
-  (half-space), tau0 = t_contact = +inf for the linear method at lambda >= 2 (it never
-  releases, e_ze = 0), T = +inf at v = 0 (where t_contact = 0);
+* all package outputs finite, except the documented cases: m_eff = +inf exactly when e_ze = 1
+  (half-space; mass_ratio = 0 there), tau0 = t_contact = +inf for the linear method at lambda >= 2
+  (it never releases, e_ze = 0, contact_ends False), T = +inf at v = 0 (where t_contact = 0);
+  every FMU output finite;
 * e in [-1, 1], e_ep and e_ze in [0, 1], tau0 >= tau0(0) of the method (3.2180654597 for the
   nonlinear ODE: exact and ode);
 * the flags say exactly where a model is used outside its validated range;
@@ -57,15 +58,16 @@ MODELS, METHODS = r.RESTITUTION_MODELS, r.ZENER_METHODS
 TAU0_MIN = {"exact": zener.TAU0_HERTZ, "ode": zener.TAU0_HERTZ, "paper_fit": 3.215, "linear": math.pi}
 
 REAL_FIELDS = ("e", "v_rebound", "e_ep", "V_c", "V_star", "eps_y", "e_ze", "lam", "tau0", "T", "t_contact",
-               "m_a", "m_eff", "v_plate")
-FLAG_FIELDS = ("plasticity_used", "plate_waves_used", "lambda_in_range", "vstar_in_range", "e_negative", "valid")
+               "m_a", "m_eff", "mass_ratio", "v_plate")
+FLAG_FIELDS = ("plasticity_used", "plate_waves_used", "lambda_in_range", "vstar_in_range", "e_negative",
+               "contact_ends", "valid")
 # FMU output -> ImpactResult field (the public interface table)
 FMU_REALS = {"e": "e", "v_rebound": "v_rebound", "jgm.e": "e_ep", "jgm.V_c": "V_c", "jgm.V_star": "V_star",
              "zener.e": "e_ze", "zener.lambda": "lam", "zener.tau0": "tau0", "zener.t_contact": "t_contact",
-             "plate.m_eff": "m_eff", "plate.v_after": "v_plate"}
+             "plate.mass_ratio": "mass_ratio", "plate.v_after": "v_plate", "sphere.m": "m_a"}
 FMU_FLAGS = {"valid": "valid", "zener.in_range": "lambda_in_range", "jgm.in_range": "vstar_in_range",
              "e_negative": "e_negative", "effects.plasticity": "plasticity_used",
-             "effects.plate_waves": "plate_waves_used"}
+             "effects.plate_waves": "plate_waves_used", "zener.contact_ends": "contact_ends"}
 MODE_CODE = {"off": 0, "on": 1, "auto": 2}
 
 
@@ -97,6 +99,8 @@ def check(res, method, v, context=""):
     assert res.tau0 >= TAU0_MIN[method], where
     if res.e_ze < 1.0:
         assert 0.0 < res.m_eff < math.inf, where
+    assert 0.0 <= res.mass_ratio <= 1.0 and (res.mass_ratio > 0.0 or res.e_ze == 1.0), where
+    assert res.contact_ends == (not linear_stuck), where
     if linear_stuck:
         assert res.e_ze == 0.0, where
     if v == 0.0:
@@ -363,6 +367,7 @@ def fmu_eval(fmu, params, v, model="e45", method="exact", plasticity="auto", pla
         fmu.do_step(step_size=1e-3)  # raises unless fmi2OK
         reals = dict(zip(FMU_REALS.values(), fmu.get_reals(list(FMU_REALS))))
         flags = dict(zip(FMU_FLAGS.values(), fmu.get(*FMU_FLAGS)))
+    assert all(math.isfinite(x) for x in reals.values()), reals  # every FMU output is finite
     return {**reals, **flags}
 
 

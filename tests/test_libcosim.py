@@ -30,8 +30,8 @@ B = (r.Sphere(r.MATERIALS["tungsten_carbide"], 4.76e-3), r.Plate(r.MATERIALS["bo
 B_CODES = {"zener_method": 4, "restitution_model": 2}  # ode (scipy) and e44 in instance b
 A_START_V = 2.3
 OUTPUTS = ["e", "v_rebound", "jgm.e", "jgm.V_c", "jgm.V_star", "zener.e", "zener.lambda", "zener.tau0",
-           "zener.t_contact", "plate.m_eff", "plate.v_after"]
-FIELDS = dict(zip(OUTPUTS, ["e", "v_rebound", "e_ep", "V_c", "V_star", "e_ze", "lam", "tau0", "t_contact", "m_eff",
+           "zener.t_contact", "plate.mass_ratio", "plate.v_after"]
+FIELDS = dict(zip(OUTPUTS, ["e", "v_rebound", "e_ep", "V_c", "V_star", "e_ze", "lam", "tau0", "t_contact", "mass_ratio",
                             "v_plate"]))
 
 SCRIPT = textwrap.dedent('''

@@ -1,7 +1,7 @@
 """Properties of the package over the whole declared domain (restitution.model.DOMAIN, the min/max the
 FMUs declare), searched with hypothesis: every output finite except the documented infinities, the
 CORs in their physical bounds, tau0 at least the method's value at lambda = 0, v_rebound = e v, and
-the validity flags consistent with lambda and V*. Runs derandomized (the same examples on every
+the validity flags consistent with lambda and V*, and every value the FMUs publish finite. Runs derandomized (the same examples on every
 machine), parameters drawn log-uniformly so that every decade, and both ends, are visited."""
 import math
 
@@ -11,7 +11,8 @@ from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
 import restitution as r
-from restitution.model import DOMAIN
+from restitution.model import DOMAIN, published
+from restitution.sweep.spec import OUTPUTS as PUBLISHED_OUTPUTS  # (FMU name, field, type) of every FMU output
 from restitution.zener import TAU0_HERTZ, zener_linear, zener_paper_fit
 
 pytestmark = pytest.mark.numerics
@@ -25,7 +26,7 @@ DOCUMENTED_INFINITE = {
     "tau0": lambda res, method, v: method == "linear" and res.lam >= 2.0,
     "t_contact": lambda res, method, v: method == "linear" and res.lam >= 2.0,
 }
-FLAGS = ("plasticity_used", "plate_waves_used", "lambda_in_range", "vstar_in_range", "e_negative")
+FLAGS = ("plasticity_used", "plate_waves_used", "lambda_in_range", "vstar_in_range", "e_negative", "contact_ends")
 
 
 def log_uniform(low, high):
@@ -73,6 +74,12 @@ def check_properties(case):
         assert res.e_ep == 1.0
     assert res.lambda_in_range == (res.lam <= 1.5) and res.vstar_in_range == (res.V_star <= 1000.0)
     assert res.valid == (res.lambda_in_range and res.vstar_in_range)
+    # what the FMUs and sweep tables publish: every value finite; m_a/m_b in [0, 1], 0 only where e_ze = 1
+    assert res.contact_ends == math.isfinite(res.tau0), case
+    assert 0.0 <= res.mass_ratio <= 1.0 and (res.mass_ratio > 0.0 or res.e_ze == 1.0), case
+    shown = published(res.as_dict())
+    for name, field, kind in PUBLISHED_OUTPUTS:
+        assert kind == "Boolean" or math.isfinite(shown[field]), (name, shown[field], case)
     assert res.e_negative == (res.e < 0.0)
     if v == 0.0:
         assert res.e == 1.0 and res.t_contact == 0.0 and res.lam == 0.0

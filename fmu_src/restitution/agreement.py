@@ -37,8 +37,9 @@ EPS = float(np.finfo(float).eps)
 ABSOLUTE = ("e", "e_ep", "v_rebound")
 #: The real outputs of :class:`restitution.ImpactResult`.
 REALS = ("e", "v_rebound", "e_ep", "V_c", "V_star", "eps_y", "e_ze", "lam", "tau0", "T", "t_contact",
-         "m_a", "m_eff", "v_plate")
-FLAGS = ("plasticity_used", "plate_waves_used", "lambda_in_range", "vstar_in_range", "e_negative", "valid")
+         "m_a", "m_eff", "mass_ratio", "v_plate")
+FLAGS = ("plasticity_used", "plate_waves_used", "lambda_in_range", "vstar_in_range", "e_negative", "contact_ends",
+         "valid")
 _INPUTS = ("v",) + tuple(name for name, _unit, _kind in PARAMETERS)
 
 
@@ -95,7 +96,7 @@ def tolerances(v, params: dict, **options) -> tuple[dict, dict]:
         with np.errstate(divide="ignore", invalid="ignore"):
             via_deficit = np.where(e_ze < 1.0, e_ze / (1.0 - e_ze), 0.0)
         for out in REALS:
-            factor = 1.0 + via_deficit if out in ("m_eff", "v_plate") else 1.0
+            factor = 1.0 + via_deficit if out in ("m_eff", "mass_ratio", "v_plate") else 1.0
             tol[out] = tol[out] + 100.0 * rtol * factor * scale(out)
     return tol, flips
 

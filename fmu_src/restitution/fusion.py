@@ -12,7 +12,7 @@ import math
 
 from ._num import where
 
-__all__ = ["apparent_restitution", "equivalent_plate_mass", "velocities_after_impact"]
+__all__ = ["apparent_restitution", "equivalent_plate_mass", "mass_ratio", "velocities_after_impact"]
 
 
 def apparent_restitution(e_ep, e_ze):
@@ -41,6 +41,19 @@ def equivalent_plate_mass(m_a, e_ze, deficit=None):
     gap = 1.0 - e_ze if deficit is None else deficit
     positive = gap > 0.0
     return where(positive, (1.0 + e_ze) * m_a / where(positive, gap, 1.0), math.inf)
+
+
+def mass_ratio(e_ze, deficit=None):
+    """m_a / m_b = (1 - e_ze) / (1 + e_ze) [1], Eq. (19) solved for the ratio of the sphere's mass to
+    the equivalent plate mass. In [0, 1]: 0 for a half-space (e_ze = 1, where m_b itself is +inf),
+    1 where the plate takes the whole motion (e_ze = 0). The finite form of Eq. (19) that the FMUs
+    publish (a result writer drops a time point with an infinite value).
+
+    ``deficit``: 1 - e_ze as in :func:`equivalent_plate_mass`; relative condition number in it
+    1 + d/(2 - d) <= 2.
+    """
+    gap = 1.0 - e_ze if deficit is None else deficit
+    return gap / (1.0 + e_ze)
 
 
 def velocities_after_impact(v_a1, e_ep, e_ze, deficit=None):

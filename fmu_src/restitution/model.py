@@ -13,7 +13,7 @@ from functools import lru_cache
 import numpy as np
 
 from ._num import is_scalar, where
-from .fusion import apparent_restitution, equivalent_plate_mass, velocities_after_impact
+from .fusion import apparent_restitution, equivalent_plate_mass, mass_ratio, velocities_after_impact
 from .jgm import (critical_interference, critical_load, critical_pressure,
                   critical_velocity, effective_modulus, restitution_e44, restitution_e45,
                   sphere_mass, vstar_in_fit_range, yield_strain)
@@ -22,7 +22,7 @@ from .zener import (TAU0_HERTZ, ZENER_METHODS, contact_duration, hertz_stiffness
                     lambda_in_studied_range, time_scale, zener_linear, zener_paper_fit,
                     zener_solution)
 
-__all__ = ["ImpactResult", "impact", "RESTITUTION_MODELS", "EFFECT_MODES", "ZENER_SLOPE_BOUND",
+__all__ = ["ImpactResult", "impact", "published", "RESTITUTION_MODELS", "EFFECT_MODES", "ZENER_SLOPE_BOUND",
            "PARAMETERS", "DOMAIN", "validate_parameters"]
 
 RESTITUTION_MODELS = ("e45", "e44")
@@ -85,12 +85,14 @@ class ImpactResult:
     t_contact: object  #: contact duration T tau0 [s] (0 when v = 0: no impact)
     m_a: object  #: sphere mass [kg]
     m_eff: object  #: equivalent plate mass, Eq. (19) [kg] (+inf for e_ze = 1)
+    mass_ratio: object  #: m_a / m_eff = (1 - e_ze)/(1 + e_ze), Eq. (19) [1], in [0, 1] (0 for e_ze = 1)
     v_plate: object  #: plate velocity after impact, Eq. (17) [m/s]
     plasticity_used: object  #: JGM contributed (e_ep < 1 was applied)
     plate_waves_used: object  #: Zener contributed (e_ze was computed)
     lambda_in_range: object  #: lambda <= 1.5, Zener's studied range
     vstar_in_range: object  #: V* <= 1000, JGM's fit range
     e_negative: object  #: e < 0: the sphere keeps moving with the plate
+    contact_ends: object  #: tau0 is finite (False: the linear method at lambda >= 2 never releases)
 
     @property
     def valid(self):
@@ -103,6 +105,26 @@ class ImpactResult:
         d = dict(self.__dict__)  # the fields, in order: a frozen dataclass has no other instance attributes
         d["valid"] = self.valid
         return d
+
+
+#: Outputs that are +inf where the contact never ends (``contact_ends`` False: the linear method at
+#: lambda >= 2, whose oscillator never returns to zero force).
+ENDLESS = ("tau0", "t_contact")
+
+
+def published(values: dict) -> dict:
+    """``values`` (:meth:`ImpactResult.as_dict`) as the FMUs and the sweep tables publish them: every
+    value finite. Result writers (OMSimulator's, for one) drop a whole time point for one inf, so where
+    the contact never ends tau0 and t_contact read 0 beside ``contact_ends`` = False, and the
+    equivalent plate mass is published as ``mass_ratio`` (0 for a half-space) instead of m_eff = +inf.
+    Nothing else changes; the package's own results keep the infinities."""
+    ends = values["contact_ends"]
+    if ends is True:  # one impact, the usual case
+        return values
+    out = dict(values)
+    for key in ENDLESS:
+        out[key] = where(ends, values[key], 0.0)
+    return out
 
 
 def _mode(name, value):
@@ -210,10 +232,12 @@ def _pipeline(v, params, scalar, restitution_model, zener_method, plasticity, pl
     # --- Fusion, Eqs. (17)-(20)
     e = apparent_restitution(e_ep, e_ze)
     m_eff = equivalent_plate_mass(m_a, e_ze, d_ze)
+    ratio = mass_ratio(e_ze, d_ze)
     _, v_plate = velocities_after_impact(v, e_ep, e_ze, d_ze)
 
-    values = (e, e * v, e_ep, V_c, V_star, eps_y, e_ze, lam, tau0, T, t_contact, m_a, m_eff, v_plate,
-              e_ep < 1.0, needed, lambda_in_studied_range(lam), vstar_in_fit_range(V_star), e < 0.0)
+    values = (e, e * v, e_ep, V_c, V_star, eps_y, e_ze, lam, tau0, T, t_contact, m_a, m_eff, ratio, v_plate,
+              e_ep < 1.0, needed, lambda_in_studied_range(lam), vstar_in_fit_range(V_star), e < 0.0,
+              tau0 < math.inf)
     out = object.__new__(ImpactResult)  # frozen dataclass: fill __dict__ directly, ~5x faster
     if scalar:  # every value is already a Python float or bool (math-module paths; the tests check it)
         out.__dict__.update(zip(_FIELD_NAMES, values))
@@ -230,7 +254,8 @@ def _pipeline(v, params, scalar, restitution_model, zener_method, plasticity, pl
 _TAU0_AT_LAMBDA0 = {"exact": TAU0_HERTZ, "ode": TAU0_HERTZ, "paper_fit": zener_paper_fit(0.0)[1],
                     "linear": zener_linear(0.0)[1]}
 
-_FLAGS = frozenset({"plasticity_used", "plate_waves_used", "lambda_in_range", "vstar_in_range", "e_negative"})
+_FLAGS = frozenset({"plasticity_used", "plate_waves_used", "lambda_in_range", "vstar_in_range", "e_negative",
+                    "contact_ends"})
 _FIELD_NAMES = tuple(f.name for f in fields(ImpactResult))
 
 

@@ -107,7 +107,7 @@ _PAPER_FIT_LAMBDA_CAP = (700.0 / 0.318) ** (2.0 / 3.0)
 def zener_linear(lam):
     """(e_ze, tau0) [1] of the linearised ODE, Eq. (22): sigma'' + lambda sigma' + sigma = 0.
 
-    Closed form (ERRATA.md), for lambda < 2: e = exp(-pi lambda / sqrt(4 - lambda^2)),
+    Closed form (docs/paper_departures.md), for lambda < 2: e = exp(-pi lambda / sqrt(4 - lambda^2)),
     tau0 = pi / sqrt(1 - lambda^2/4). For lambda >= 2 the oscillator is (over)damped
     and never returns to sigma = 0: e = 0 and tau0 = +inf (contact is never lost).
     Note tau0(0) = pi, not the Hertz value 3.2180655: a different contact law.

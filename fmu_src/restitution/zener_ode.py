@@ -12,8 +12,8 @@ where sigma [1] is Zener's nondimensional interference, tau [1] his
 nondimensional time (Eq. (9)) and lambda [1] his "inelasticity" parameter
 (Eq. (12)).  The expanded form is Eq. (21).
 
-Zener's own first-order form is used (see ERRATA.md, "Numerical notes for
-Eq. (10)/(21)"):
+Zener's own first-order form is used (see docs/paper_departures.md, "Numerics of
+Eq. (10)"):
 
     p      = sigma' + lambda sigma^(3/2)
     sigma' = p - lambda max(sigma, 0)^(3/2)

@@ -73,7 +73,7 @@ def complete_model_description(xml_text: str, variables, allowed_range, feedthro
     ``variables`` is the slave's table: (name, type, causality, unit, start, description, key);
     ``allowed_range(name)`` gives (check, text, min, max) for inputs and parameters;
     ``feedthrough``: names of the outputs that depend directly on the inputs (default: all
-    but V_c, as in SpherePlateImpact).
+    but V_c and the sphere's mass, as in SpherePlateImpact).
     """
     spec = {row[0]: row for row in variables}
     root = ET.fromstring(xml_text)
@@ -115,7 +115,7 @@ def complete_model_description(xml_text: str, variables, allowed_range, feedthro
         if row[2] != "output":
             continue
         if feedthrough is None:
-            depends_on_input = row[6] not in ("V_c",)  # V_c depends on parameters only
+            depends_on_input = row[6] not in ("V_c", "m_a")  # these depend on parameters only
         else:
             depends_on_input = row[0] in feedthrough
         deps = " ".join(map(str, inputs)) if depends_on_input else ""

@@ -121,12 +121,12 @@ class PackageBackend(Backend):
     default_chunk = 100_000
 
     def evaluate(self, cases: dict, payload=None, outputs=None):
-        from ..model import impact
+        from ..model import impact, published
 
         n = np.size(cases["v_approach"])
         out = _empty_outputs(n)
         for sel, inputs, options in impact_groups(cases, np.flatnonzero(inputs_ok(cases))):
-            values = impact(**inputs, **options, validate=False).as_dict()
+            values = published(impact(**inputs, **options, validate=False).as_dict())
             for name, field_name, _t in OUTPUTS:
                 out[name][sel] = values[field_name]
             out["ok"][sel] = True

@@ -65,16 +65,16 @@ CODES = {
     "plate_waves": {"off": 0, "on": 1, "auto": 2},
 }
 
-# (FMU name, ImpactResult field, FMI type): the FMU's outputs.
+# (FMU name, ImpactResult field, FMI type): the FMU's outputs, as restitution.model.published gives them.
 OUTPUTS = (
     ("e", "e", "Real"), ("v_rebound", "v_rebound", "Real"), ("jgm.e", "e_ep", "Real"),
     ("jgm.V_c", "V_c", "Real"), ("jgm.V_star", "V_star", "Real"), ("zener.e", "e_ze", "Real"),
     ("zener.lambda", "lam", "Real"), ("zener.tau0", "tau0", "Real"),
-    ("zener.t_contact", "t_contact", "Real"), ("plate.m_eff", "m_eff", "Real"),
-    ("plate.v_after", "v_plate", "Real"), ("valid", "valid", "Boolean"),
+    ("zener.t_contact", "t_contact", "Real"), ("plate.mass_ratio", "mass_ratio", "Real"),
+    ("plate.v_after", "v_plate", "Real"), ("sphere.m", "m_a", "Real"), ("valid", "valid", "Boolean"),
     ("zener.in_range", "lambda_in_range", "Boolean"), ("jgm.in_range", "vstar_in_range", "Boolean"),
     ("e_negative", "e_negative", "Boolean"), ("effects.plasticity", "plasticity_used", "Boolean"),
-    ("effects.plate_waves", "plate_waves_used", "Boolean"),
+    ("effects.plate_waves", "plate_waves_used", "Boolean"), ("zener.contact_ends", "contact_ends", "Boolean"),
 )
 OUTPUT_NAMES = tuple(row[0] for row in OUTPUTS)
 

@@ -17,8 +17,9 @@ METHOD_CODE = {"exact": 1, "paper_fit": 2, "linear": 3, "ode": 4}
 MODE_CODE = {"off": 0, "on": 1, "auto": 2}
 OK, BAD_CODE, UNSUPPORTED = 0, 1, 2
 _RESULT_REALS = ("e", "v_rebound", "e_ep", "V_c", "V_star", "eps_y", "e_ze", "lam", "tau0", "T", "t_contact",
-                 "m_a", "m_eff", "v_plate")
-_RESULT_FLAGS = ("plasticity_used", "plate_waves_used", "lambda_in_range", "vstar_in_range", "e_negative", "valid")
+                 "m_a", "m_eff", "mass_ratio", "v_plate")
+_RESULT_FLAGS = ("plasticity_used", "plate_waves_used", "lambda_in_range", "vstar_in_range", "e_negative",
+                 "contact_ends", "valid")
 assert set(_RESULT_REALS) == set(REALS) and set(_RESULT_FLAGS) == set(FLAGS)
 
 

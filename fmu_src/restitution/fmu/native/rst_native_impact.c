@@ -16,12 +16,19 @@ static const char *const INPUT_NAMES[RST_IMPACT_N_INPUTS] = {
 #define N_REAL_INPUTS 11
 #define N_CODES 4
 
-/* FMU names of the outputs: the 11 Reals, then the 6 Booleans (order of output_value below). */
+/* The outputs: the Reals, then the Booleans; OUTPUT_NAMES gives their FMU names in this order. */
+enum {
+    OUT_E, OUT_V_REBOUND, OUT_E_EP, OUT_V_C, OUT_V_STAR, OUT_E_ZE, OUT_LAMBDA, OUT_TAU0, OUT_T_CONTACT,
+    OUT_MASS_RATIO, OUT_V_PLATE, OUT_M_A, N_REAL_OUTPUTS,
+    OUT_VALID = N_REAL_OUTPUTS, OUT_LAMBDA_IN_RANGE, OUT_VSTAR_IN_RANGE, OUT_E_NEGATIVE, OUT_PLASTICITY_USED,
+    OUT_PLATE_WAVES_USED, OUT_CONTACT_ENDS, N_OUTPUTS
+};
+typedef char outputs_counted[N_OUTPUTS == RST_IMPACT_N_OUTPUTS ? 1 : -1];
 static const char *const OUTPUT_NAMES[RST_IMPACT_N_OUTPUTS] = {
     "e", "v_rebound", "jgm.e", "jgm.V_c", "jgm.V_star", "zener.e", "zener.lambda", "zener.tau0",
-    "zener.t_contact", "plate.m_eff", "plate.v_after",
-    "valid", "zener.in_range", "jgm.in_range", "e_negative", "effects.plasticity", "effects.plate_waves"};
-#define N_REAL_OUTPUTS 11
+    "zener.t_contact", "plate.mass_ratio", "plate.v_after", "sphere.m",
+    "valid", "zener.in_range", "jgm.in_range", "e_negative", "effects.plasticity", "effects.plate_waves",
+    "zener.contact_ends"};
 
 /* An Integer code held as a double; -1 (no valid code) for NaN, fractions or values beyond int
  * (converting those to int would be undefined behaviour). */
@@ -92,22 +99,14 @@ int rst_impact_accept(const rst_impact_binding *binding, unsigned int vr, double
     return 0;
 }
 
-/* The slave's _undocumented_nonfinite: the first Real output that is not finite although the
- * interface does not say it may be (m_eff = +inf for e_ze = 1; tau0 and t_contact = +inf for the
- * linear method at lambda >= 2), or -1. */
-static int undocumented_nonfinite(const rst_impact_inputs *in, const double outputs[])
+/* The slave's nonfinite_outputs: the first Real output that is not finite (every published output
+ * is), or -1. */
+static int first_nonfinite(const double outputs[])
 {
     int i;
-    for (i = 0; i < N_REAL_OUTPUTS; i++) {
-        double x = outputs[i];
-        if (isfinite(x))
-            continue;
-        if (x == INFINITY && i == 9 && outputs[5] == 1.0) /* plate.m_eff, zener.e */
-            continue;
-        if (x == INFINITY && (i == 7 || i == 8) && in->zener_method == RST_ZENER_LINEAR && outputs[6] >= 2.0)
-            continue;
-        return i;
-    }
+    for (i = 0; i < N_REAL_OUTPUTS; i++)
+        if (!isfinite(outputs[i]))
+            return i;
     return -1;
 }
 
@@ -117,7 +116,7 @@ int rst_impact_evaluate(const rst_impact_binding *binding, double *values, char 
     rst_impact_inputs inputs;
     rst_impact_result r;
     double outputs[RST_IMPACT_N_OUTPUTS];
-    int status, k;
+    int status, k, endless;
     size_t i;
     inputs.v = values[in[0]];
     inputs.sphere_E = values[in[1]];
@@ -143,24 +142,29 @@ int rst_impact_evaluate(const rst_impact_binding *binding, double *values, char 
         snprintf(message, size, "invalid code: restitution_model = %d, zener_method = %d, plasticity = %d, "
                  "plate_waves = %d", inputs.restitution_model, inputs.zener_method, inputs.plasticity,
                  inputs.plate_waves);
-    outputs[0] = r.e;
-    outputs[1] = r.v_rebound;
-    outputs[2] = r.e_ep;
-    outputs[3] = r.V_c;
-    outputs[4] = r.V_star;
-    outputs[5] = r.e_ze;
-    outputs[6] = r.lam;
-    outputs[7] = r.tau0;
-    outputs[8] = r.t_contact;
-    outputs[9] = r.m_eff;
-    outputs[10] = r.v_plate;
-    outputs[11] = r.valid;
-    outputs[12] = r.lambda_in_range;
-    outputs[13] = r.vstar_in_range;
-    outputs[14] = r.e_negative;
-    outputs[15] = r.plasticity_used;
-    outputs[16] = r.plate_waves_used;
-    if (status == RST_PHYSICS_OK && (k = undocumented_nonfinite(&inputs, outputs)) >= 0) {
+    /* as restitution.model.published: tau0 and t_contact read 0 where the contact never ends (a failed
+     * evaluation leaves every Real NaN) */
+    endless = status == RST_PHYSICS_OK && !r.contact_ends;
+    outputs[OUT_E] = r.e;
+    outputs[OUT_V_REBOUND] = r.v_rebound;
+    outputs[OUT_E_EP] = r.e_ep;
+    outputs[OUT_V_C] = r.V_c;
+    outputs[OUT_V_STAR] = r.V_star;
+    outputs[OUT_E_ZE] = r.e_ze;
+    outputs[OUT_LAMBDA] = r.lam;
+    outputs[OUT_TAU0] = endless ? 0.0 : r.tau0;
+    outputs[OUT_T_CONTACT] = endless ? 0.0 : r.t_contact;
+    outputs[OUT_MASS_RATIO] = r.mass_ratio;
+    outputs[OUT_V_PLATE] = r.v_plate;
+    outputs[OUT_M_A] = r.m_a;
+    outputs[OUT_VALID] = r.valid;
+    outputs[OUT_LAMBDA_IN_RANGE] = r.lambda_in_range;
+    outputs[OUT_VSTAR_IN_RANGE] = r.vstar_in_range;
+    outputs[OUT_E_NEGATIVE] = r.e_negative;
+    outputs[OUT_PLASTICITY_USED] = r.plasticity_used;
+    outputs[OUT_PLATE_WAVES_USED] = r.plate_waves_used;
+    outputs[OUT_CONTACT_ENDS] = r.contact_ends;
+    if (status == RST_PHYSICS_OK && (k = first_nonfinite(outputs)) >= 0) {
         snprintf(message, size, "non-finite output %s = %s", OUTPUT_NAMES[k],
                  isnan(outputs[k]) ? "nan" : outputs[k] > 0 ? "inf" : "-inf");
         status = RST_IMPACT_NONFINITE;

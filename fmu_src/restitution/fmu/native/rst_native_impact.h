@@ -19,7 +19,7 @@
 #include <stddef.h>
 
 #define RST_IMPACT_N_INPUTS 17  /* v_approach, the 10 material/geometry parameters, 4 codes, 2 tolerances */
-#define RST_IMPACT_N_OUTPUTS 17 /* 11 Real and 6 Boolean outputs */
+#define RST_IMPACT_N_OUTPUTS 19 /* 12 Real and 7 Boolean outputs */
 
 typedef struct {
     size_t n_variables;                         /* the value store's length (largest vr + 1) */
@@ -31,8 +31,8 @@ typedef struct {
  * `message` names the variable that is missing or has an unexpected type. */
 int rst_impact_bind(rst_impact_binding *binding, char *message, size_t size);
 
-/* Return code of rst_impact_evaluate besides rst_physics.h's: an output is NaN or infinite where the
- * interface does not document it (an evaluation failure: every output NaN/false). */
+/* Return code of rst_impact_evaluate besides rst_physics.h's: an output is NaN or infinite (every
+ * published output is finite: an evaluation failure: every output NaN/false). */
 #define RST_IMPACT_NONFINITE 100
 
 /* A value the interface table allows but this backend refuses: zener_method = 4 (ode), which only

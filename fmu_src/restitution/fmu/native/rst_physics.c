@@ -90,7 +90,7 @@ static double restitution_e45(double v_star, double eps_y)
 }
 
 /* e44 [1], Eq. (7) (JGM Eqs. 43-44), restitution.jgm.restitution_e44, second branch reconstructed
- * as ((V* - 60)/940)^2.366 (ERRATA.md; the OCR'd (V* - 60)^2.366 cannot be right); floored at 0. */
+ * as ((V* - 60)/940)^2.366 (docs/paper_departures.md; the OCR'd (V* - 60)^2.366 cannot be right); floored at 0. */
 static double restitution_e44(double v_star)
 {
     int above = v_star > 1.0, upper = v_star > RST_E44_BRANCH_JOIN;
@@ -227,15 +227,18 @@ static double equivalent_plate_mass(double m_a, double e_ze, double deficit)
     return deficit > 0.0 ? (1.0 + e_ze) * m_a / deficit : INFINITY;
 }
 
+/* m_a / m_b = (1 - e_ze) / (1 + e_ze) [1], Eq. (19) solved for the mass ratio, in [0, 1] (fusion.mass_ratio). */
+static double mass_ratio(double e_ze, double deficit) { return deficit / (1.0 + e_ze); }
+
 /* v_b2 = (1 + e_ep)(1 - e_ze)/2 v_a1 [m/s], Eq. (17) with m_b of Eq. (19). */
 static double plate_velocity(double v_a1, double e_ep, double deficit) { return 0.5 * (1.0 + e_ep) * deficit * v_a1; }
 
 static void fail(rst_impact_result *out)
 {
     out->e = out->v_rebound = out->e_ep = out->V_c = out->V_star = out->eps_y = NAN;
-    out->e_ze = out->lam = out->tau0 = out->T = out->t_contact = out->m_a = out->m_eff = out->v_plate = NAN;
+    out->e_ze = out->lam = out->tau0 = out->T = out->t_contact = out->m_a = out->m_eff = out->mass_ratio = out->v_plate = NAN;
     out->plasticity_used = out->plate_waves_used = out->lambda_in_range = 0;
-    out->vstar_in_range = out->e_negative = out->valid = 0;
+    out->vstar_in_range = out->e_negative = out->contact_ends = out->valid = 0;
 }
 
 /* restitution.model._pipeline for one impact. */
@@ -311,12 +314,14 @@ int rst_impact(const rst_impact_inputs *in, rst_impact_result *out)
     out->lam = lam;
     out->tau0 = tau0;
     out->m_eff = equivalent_plate_mass(out->m_a, e_ze, deficit);
+    out->mass_ratio = mass_ratio(e_ze, deficit);
     out->v_plate = plate_velocity(in->v, e_ep, deficit);
     out->plasticity_used = e_ep < 1.0;
     out->plate_waves_used = needed;
     out->lambda_in_range = lam <= RST_LAMBDA_STUDIED_MAX;
     out->vstar_in_range = out->V_star <= RST_VSTAR_FIT_MAX;
     out->e_negative = e < 0.0;
+    out->contact_ends = tau0 < INFINITY;
     out->valid = out->lambda_in_range && out->vstar_in_range;
     return RST_PHYSICS_OK;
 }

@@ -49,8 +49,8 @@ typedef struct {
 
 /* Everything one impact produces: the fields of restitution.ImpactResult, same names and units. */
 typedef struct {
-    double e, v_rebound, e_ep, V_c, V_star, eps_y, e_ze, lam, tau0, T, t_contact, m_a, m_eff, v_plate;
-    int plasticity_used, plate_waves_used, lambda_in_range, vstar_in_range, e_negative, valid;
+    double e, v_rebound, e_ep, V_c, V_star, eps_y, e_ze, lam, tau0, T, t_contact, m_a, m_eff, mass_ratio, v_plate;
+    int plasticity_used, plate_waves_used, lambda_in_range, vstar_in_range, e_negative, contact_ends, valid;
 } rst_impact_result;
 
 /* Evaluate the model; RST_PHYSICS_OK, or an error code with every real output NaN and every flag 0. */

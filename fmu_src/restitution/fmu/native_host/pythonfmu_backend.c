@@ -3,7 +3,7 @@
  *
  * The front has checked every call and value before anything reaches here, so pythonfmu only ever
  * sees legal calls with values inside their declared ranges. What pythonfmu 0.7's binary does wrong
- * (FMI-NOTES.md) is worked around here, never copied:
+ * (docs/fmi_tools.md) is worked around here, never copied:
  *
  * - Resources: pythonfmu decodes only "%20" in the resource URI and crashes when it cannot open the
  *   slave script. It is handed "file://" + the decoded path, after checking that the slave script

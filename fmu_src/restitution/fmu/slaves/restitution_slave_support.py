@@ -12,7 +12,6 @@ code that drives a slave directly.
 from __future__ import annotations
 
 import json
-import math
 
 from pythonfmu.enums import Fmi2Status
 
@@ -108,8 +107,3 @@ def state_from_bytes(data) -> dict:
     except (ValueError, TypeError, UnicodeDecodeError) as exc:
         return {"unreadable": f"{type(exc).__name__}: {exc}"}
     return state
-
-
-def finite_or(value, allowed_infinite: bool) -> bool:
-    """Is ``value`` finite, or +inf where the interface documents it?"""
-    return math.isfinite(value) or (allowed_infinite and value == math.inf)

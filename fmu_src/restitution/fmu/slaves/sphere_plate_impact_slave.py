@@ -8,7 +8,7 @@ Bad input never raises (pythonfmu would turn an exception into fmi2Fatal for eve
 instance): a value outside its range is refused, the previous value kept, and a message
 naming the variable, its value and the allowed range is logged with fmi2Error (in the built
 FMU the C guard refuses it first and returns fmi2Error). An evaluation that fails, or gives a
-non-finite output the interface does not document, is logged with the inputs; the outputs then
+non-finite output (every published output is finite), is logged with the inputs; the outputs then
 read NaN (Booleans false) and ``fmi2DoStep`` returns fmi2Discard.
 
 The FMU state is exactly the inputs and parameters, tagged with the model, the state format
@@ -32,9 +32,9 @@ _HERE = os.path.dirname(os.path.abspath(__file__))
 if os.path.isdir(os.path.join(_HERE, "restitution")) and sys.path[0] != _HERE:
     sys.path.insert(0, _HERE)
 
-from restitution.model import DOMAIN, EFFECT_MODES, RESTITUTION_MODELS, ZENER_METHODS, impact  # noqa: E402
+from restitution.model import DOMAIN, EFFECT_MODES, RESTITUTION_MODELS, ZENER_METHODS, impact, published  # noqa: E402
 from restitution.validation import interval_check  # noqa: E402
-from restitution_slave_support import (checked_setter, finite_or, restore_state, state_check,  # noqa: E402
+from restitution_slave_support import (checked_setter, restore_state, state_check,  # noqa: E402
                                        state_from_bytes, state_schema, state_to_bytes)
 
 P, IN, OUT = "parameter", "input", "output"
@@ -68,7 +68,8 @@ VARIABLES = (
      "2 = auto (skipped where 1 - e_ze < effect_tolerance is guaranteed)", "plate_waves"),
     ("effect_tolerance", "Real", P, "1", 1e-6, "Largest change in e that auto may neglect, >= 0", "effect_tolerance"),
     ("zener.ode_tolerance", "Real", P, "1", 1e-10,
-     "Relative tolerance of zener_method = 4 (ode), 1e-14 <= tol <= 1e-2", "ode_rtol"),
+     "Relative tolerance of zener_method = 4 (ode), 1e-14 <= tol <= 1e-2 (below what the integrator honours "
+     "it is raised to 2.2e-14 for lambda <= 10, 1e-13 above)", "ode_rtol"),
     ("e", "Real", OUT, "1", None, "Apparent coefficient of restitution, Eq. (20); < 0: sphere moves on with the plate", "e"),
     ("v_rebound", "Real", OUT, "m/s", None, "Sphere speed away from the plate after impact, e * v_approach", "v_rebound"),
     ("jgm.e", "Real", OUT, "1", None, "Elastoplastic COR e_ep, Eq. (7) or (8)", "e_ep"),
@@ -77,16 +78,23 @@ VARIABLES = (
     ("zener.e", "Real", OUT, "1", None, "Zener's COR e_ze (1 where plate waves are off or skipped)", "e_ze"),
     ("zener.lambda", "Real", OUT, "1", None, "Zener's inelasticity parameter lambda, Eq. (12)", "lam"),
     ("zener.tau0", "Real", OUT, "1", None, "Dimensionless contact time tau0 (plate_waves off: 3.2180655, Hertz; "
-     "skipped by auto: the method's value at lambda = 0)", "tau0"),
-    ("zener.t_contact", "Real", OUT, "s", None, "Contact duration T * tau0 (0 when v_approach = 0)", "t_contact"),
-    ("plate.m_eff", "Real", OUT, "kg", None, "Equivalent plate mass, Eq. (19) (+inf for a half-space, e_ze = 1)", "m_eff"),
+     "skipped by auto: the method's value at lambda = 0; 0 where zener.contact_ends is false)", "tau0"),
+    ("zener.t_contact", "Real", OUT, "s", None, "Contact duration T * tau0 (0 when v_approach = 0 "
+     "or where zener.contact_ends is false)", "t_contact"),
+    ("plate.mass_ratio", "Real", OUT, "1", None, "Sphere mass over the equivalent plate mass of Eq. (19), "
+     "m_a/m_b = (1 - e_ze)/(1 + e_ze): 0 for a half-space (plate waves off or negligible), 1 when e_ze = 0",
+     "mass_ratio"),
     ("plate.v_after", "Real", OUT, "m/s", None, "Plate velocity after impact, Eq. (17), positive along the approach", "v_plate"),
+    ("sphere.m", "Real", OUT, "kg", None, "Sphere mass m_a = rho pi d^3/6 (equivalent plate mass m_b = "
+     "sphere.m / plate.mass_ratio)", "m_a"),
     ("valid", "Boolean", OUT, None, None, "Inside both models' validated ranges: lambda <= 1.5 and V* <= 1000", "valid"),
     ("zener.in_range", "Boolean", OUT, None, None, "lambda <= 1.5, Zener's studied range", "lambda_in_range"),
     ("jgm.in_range", "Boolean", OUT, None, None, "V* <= 1000, the range of the JGM fits", "vstar_in_range"),
     ("e_negative", "Boolean", OUT, None, None, "e < 0: the sphere keeps moving with the plate after impact", "e_negative"),
     ("effects.plasticity", "Boolean", OUT, None, None, "The elastoplastic effect was applied (e_ep < 1)", "plasticity_used"),
     ("effects.plate_waves", "Boolean", OUT, None, None, "The plate-wave effect was computed", "plate_waves_used"),
+    ("zener.contact_ends", "Boolean", OUT, None, None, "The sphere leaves the plate after a finite contact time "
+     "(false only for the linear method at lambda >= 2: e_ze = 0, tau0 and t_contact read 0)", "contact_ends"),
 )
 
 _CHOICES = {
@@ -98,27 +106,18 @@ _CHOICES = {
 _CODE_OFFSET = {"restitution_model": 1, "zener_method": 1, "plasticity": 0, "plate_waves": 0}
 _PACKAGE_KEY = {row[0]: row[6] for row in VARIABLES}
 _TYPES = {row[0]: row[1] for row in VARIABLES}
-_LINEAR = ZENER_METHODS.index("linear") + 1
 #: FMU name of each Real output, by ImpactResult key
 _REAL_OUTPUTS = {row[6]: row[0] for row in VARIABLES if row[2] == OUT and row[1] == "Real"}
 
 
-def undocumented_nonfinite(outputs: dict, zener_method: int) -> list[str]:
-    """The Real outputs that are NaN or infinite where the interface does not say they may be
-    (``name = value`` texts): +inf is documented for plate.m_eff when e_ze = 1 (a half-space) and
-    for zener.tau0 and zener.t_contact with the linear method at lambda >= 2 (the oscillator never
-    returns). Anything else non-finite is an evaluation failure."""
+def nonfinite_outputs(outputs: dict) -> list[str]:
+    """The Real outputs that are NaN or infinite (``name = value`` texts). Every output is finite
+    (``outputs`` as :func:`restitution.model.published` gives them): anything else is an evaluation
+    failure."""
     values = [outputs[key] for key in _REAL_OUTPUTS]
     if math.isfinite(sum(values)):  # the usual case, one C loop (a NaN or inf, or an overflow, falls through)
         return []
-    bad = []
-    for key, name in _REAL_OUTPUTS.items():
-        x = outputs[key]
-        documented = ((key == "m_eff" and outputs["e_ze"] == 1.0)
-                      or (key in ("tau0", "t_contact") and zener_method == _LINEAR and outputs["lam"] >= 2.0))
-        if not finite_or(x, documented):
-            bad.append(f"{name} = {x!r}")
-    return bad
+    return [f"{name} = {outputs[key]!r}" for key, name in _REAL_OUTPUTS.items() if not math.isfinite(outputs[key])]
 
 
 def allowed_interval(name):
@@ -248,8 +247,8 @@ class SpherePlateImpact(Fmi2Slave):
             result = impact(float(v["v_approach"]), *args, **kwargs)
         except Exception as exc:  # a numerical failure must not become fmi2Fatal
             return self._fail(f"{type(exc).__name__}: {exc}")
-        outputs = result.as_dict()
-        bad = undocumented_nonfinite(outputs, int(v["zener_method"]))
+        outputs = published(result.as_dict())
+        bad = nonfinite_outputs(outputs)
         if bad:
             return self._fail("non-finite output " + ", ".join(bad))
         self._failure = None
