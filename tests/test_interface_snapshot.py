@@ -1,0 +1,42 @@
+"""What hosts see of the FMUs' interface does not change by accident: each built modelDescription.xml
+(both models, both implementations) equals its checked-in copy in tests/data/model_descriptions/,
+apart from what differs between builds (the GUID and the generation time).
+
+A deliberate change of the interface updates the copies in the same commit:
+
+    RESTITUTION_UPDATE_SNAPSHOTS=1 bash build_scripts/quickstart.sh test tests/test_interface_snapshot.py
+
+and the diff of the copies is what a reviewer reads to see what hosts will see."""
+import difflib
+import os
+import re
+import zipfile
+from pathlib import Path
+
+import pytest
+
+SNAPSHOTS = Path(__file__).resolve().parent / "data" / "model_descriptions"
+#: Attributes that differ between two builds of the same sources.
+PER_BUILD = re.compile(r'\s(guid|generationDateAndTime)="[^"]*"')
+
+
+def _normalized(fmu: Path) -> str:
+    with zipfile.ZipFile(fmu) as z:
+        return PER_BUILD.sub("", z.read("modelDescription.xml").decode("utf-8"))
+
+
+@pytest.mark.parametrize("model", ["SpherePlateImpact", "BouncingBall"])
+@pytest.mark.parametrize("implementation", ["python", "native"])
+def test_model_description_equals_its_checked_in_copy(built_fmus, implementation, model):
+    fmu = built_fmus / (f"{model}.fmu" if implementation == "python" else f"native/{model}.fmu")
+    if not fmu.is_file():
+        pytest.skip(f"{implementation} {model}.fmu not built here (needs gcc)")
+    text = _normalized(fmu)
+    copy = SNAPSHOTS / implementation / f"{model}.xml"
+    if os.environ.get("RESTITUTION_UPDATE_SNAPSHOTS") == "1":
+        copy.parent.mkdir(parents=True, exist_ok=True)
+        copy.write_text(text, encoding="utf-8")
+    expected = copy.read_text(encoding="utf-8")
+    diff = "".join(difflib.unified_diff(expected.splitlines(True), text.splitlines(True),
+                                        f"checked-in {copy.name}", f"built {fmu.name}", n=1))
+    assert text == expected, f"{implementation} {model}: the modelDescription changed:\n{diff}"
