@@ -410,17 +410,16 @@ FLOOR_FAST_ACCESSORS = '''
 def build_fmus(work: Path) -> dict:
     """Build SpherePlateImpact, BouncingBall and the two trivial FMUs from the working tree."""
     from pythonfmu.builder import FmuBuilder
-    from restitution.fmu.build import FMUS, _slave_module, build_one
+    from restitution.fmu.build import FMUS, build_one
+    from restitution.fmu.models import table
     from restitution.fmu.native_host.make_standalone import make_standalone
-
-    spi = _slave_module("SpherePlateImpact")
 
     out = {"SpherePlateImpact": build_one("SpherePlateImpact", work)}
     if "BouncingBall" in FMUS:
         out["BouncingBall"] = build_one("BouncingBall", work)
     counts = {}
-    for row in spi.VARIABLES:
-        key = (row[1], row[2])
+    for var in table("SpherePlateImpact"):
+        key = (var.type, var.causality)
         counts[key] = counts.get(key, 0) + 1
     for name, extra in (("BenchWrapperFloor", ""), ("BenchWrapperFloorOnePass", FLOOR_FAST_ACCESSORS)):
         src = work / "floor_src" / name

@@ -28,6 +28,7 @@ import numpy as np
 import restitution as r
 from restitution.viz import write_png
 from restitution.cosim import FmuInstance, build_default_fmu
+from restitution.fmu.models.sphere_plate_impact.variables import fmu_values
 from restitution.materials import table4_case
 
 HERE = Path(__file__).resolve().parent
@@ -52,9 +53,7 @@ class ImpactFMU:
         self.evaluations = 0
 
     def configure(self, sphere: r.Material, d: float, plate: r.Material):
-        self.fmu.set(**{"sphere.E": sphere.E, "sphere.nu": sphere.nu, "sphere.Sy": sphere.Sy,
-                        "sphere.rho": sphere.rho, "sphere.d": d, "plate.E": plate.E, "plate.nu": plate.nu,
-                        "plate.Sy": plate.Sy, "plate.rho": plate.rho})
+        self.fmu.set(**fmu_values(**r.Sphere(sphere, d).params(), **plate.params("plate")))
 
     def sweep(self, t, v) -> dict:
         """Outputs for every (plate thickness t [m], approach speed v [m/s]) pair (broadcast)."""

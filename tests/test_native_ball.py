@@ -17,22 +17,17 @@ import subprocess
 import numpy as np
 import pytest
 
-from restitution.fmu.interface import _slave_class, variables
+from restitution.fmu.interface import variables
 from restitution.fmu.native.build_native import write_backend
 from restitution.fmu.native.compile import CFLAGS
 
 pytestmark = pytest.mark.skipif(shutil.which("gcc") is None, reason="gcc is needed to compile the native backend")
 
-N_SLOTS = 19
 TABLE = {v.name: v for v in variables("BouncingBall")}
 STATE_KEYS = {"h": "h", "v": "v", "v_approach": "v_approach", "impacts": "impacts", "t_impact": "t_impact",
               "v_impact": "v_impact", "t_rebound": "t_rebound", "v_rebound": "v_rebound", "e_applied": "e_applied",
               "in_contact": "in_contact", "at_rest": "at_rest", "flight.t_start": "t_start",
               "flight.h_start": "h_start", "flight.v_start": "v_start"}
-
-
-class Binding(ctypes.Structure):
-    _fields_ = [("n_variables", ctypes.c_size_t), ("vr", ctypes.c_uint * N_SLOTS)]
 
 
 @pytest.fixture(scope="module")
@@ -45,20 +40,15 @@ def ball(tmp_path_factory):
     subprocess.run(["gcc", *CFLAGS, "-fPIC", "-shared", "-o", str(lib), str(src / "rst_native_ball.c"), "-lm"],
                    check=True, capture_output=True, text=True)
     so = ctypes.CDLL(str(lib))
-    so.rst_ball_bind.argtypes = (ctypes.POINTER(Binding), ctypes.c_char_p, ctypes.c_size_t)
-    so.rst_ball_initialize.argtypes = (ctypes.POINTER(Binding), ctypes.POINTER(ctypes.c_double), ctypes.c_double)
-    so.rst_ball_do_step.argtypes = (ctypes.POINTER(Binding), ctypes.POINTER(ctypes.c_double), ctypes.c_double,
-                                    ctypes.c_double)
-    binding = Binding()
-    message = ctypes.create_string_buffer(256)
-    assert so.rst_ball_bind(ctypes.byref(binding), message, 256) == 0, message.value
-    return so, binding
+    so.rst_ball_initialize.argtypes = (ctypes.POINTER(ctypes.c_double), ctypes.c_double)
+    so.rst_ball_do_step.argtypes = (ctypes.POINTER(ctypes.c_double), ctypes.c_double, ctypes.c_double)
+    return so
 
 
 def python_slave():
     import bouncing_ball_slave
 
-    return _slave_class(bouncing_ball_slave)(instance_name="native-ball-test", visible=False)
+    return bouncing_ball_slave.BouncingBall(instance_name="native-ball-test", visible=False)
 
 
 def same(a, b):
@@ -73,8 +63,8 @@ def same(a, b):
 @pytest.mark.parametrize("h0,g,v_min,start,step", [(0.3, 9.80665, 0.1, 0.0, 1e-3), (1.0, 9.81, 0.05, 2.5, 7e-3),
                                                     (0.01, 1.62, 1e-3, 0.0, 0.05), (2.0, 9.81, 0.5, 0.0, 0.1)])
 def test_ball_follows_the_python_slave(ball, contact_mode, h0, g, v_min, start, step):
-    so, binding = ball
-    store = (ctypes.c_double * binding.n_variables)()
+    so = ball
+    store = (ctypes.c_double * len(TABLE))()
     params = {"h0": h0, "g": g, "v_min": v_min, "contact_mode": contact_mode, "e": 1.0}
     for name, value in params.items():
         store[TABLE[name].vr] = value
@@ -82,7 +72,7 @@ def test_ball_follows_the_python_slave(ball, contact_mode, h0, g, v_min, start, 
     py._values.update(params)
     py.setup_experiment(start)
     py.exit_initialization_mode()
-    so.rst_ball_initialize(ctypes.byref(binding), store, start)
+    so.rst_ball_initialize(store, start)
     rng = np.random.default_rng(int(h0 * 1000) + contact_mode)
     t = start
     contacts = 0
@@ -91,7 +81,7 @@ def test_ball_follows_the_python_slave(ball, contact_mode, h0, g, v_min, start, 
         py._values["e"] = e
         store[TABLE["e"].vr] = e
         assert py.do_step(t, step)
-        so.rst_ball_do_step(ctypes.byref(binding), store, t, step)
+        so.rst_ball_do_step(store, t, step)
         t += step
         for name, key in STATE_KEYS.items():
             expected = py._s[key]

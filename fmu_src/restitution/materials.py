@@ -36,6 +36,13 @@ class Material:
         check_positive(f"{self.name}.Sy", self.Sy, "Pa")
         check_positive(f"{self.name}.rho", self.rho, "kg/m3")
 
+    def params(self, role: str) -> dict:
+        """The material's keyword arguments for :func:`restitution.impact` as the ``role``
+        ("sphere" or "plate"): ``sphere_E``, ``sphere_nu``, ``sphere_Sy``, ``sphere_rho`` or ``plate_*``."""
+        if role not in ("sphere", "plate"):
+            raise ValueError(f"role = {role!r}: 'sphere' or 'plate'")
+        return {f"{role}_E": self.E, f"{role}_nu": self.nu, f"{role}_Sy": self.Sy, f"{role}_rho": self.rho}
+
     @property
     def brittle(self) -> bool:
         return self.Sy >= BRITTLE_SY
@@ -53,8 +60,7 @@ class Sphere:
 
     def params(self) -> dict:
         """Keyword arguments for :func:`restitution.impact` (``sphere_*``)."""
-        m = self.material
-        return dict(sphere_E=m.E, sphere_nu=m.nu, sphere_Sy=m.Sy, sphere_rho=m.rho, sphere_d=self.d)
+        return dict(self.material.params("sphere"), sphere_d=self.d)
 
 
 @dataclass(frozen=True)
@@ -69,8 +75,7 @@ class Plate:
 
     def params(self) -> dict:
         """Keyword arguments for :func:`restitution.impact` (``plate_*``)."""
-        m = self.material
-        return dict(plate_E=m.E, plate_nu=m.nu, plate_Sy=m.Sy, plate_rho=m.rho, plate_t=self.t)
+        return dict(self.material.params("plate"), plate_t=self.t)
 
     def with_thickness(self, t: float) -> "Plate":
         return replace(self, t=t)

@@ -7,7 +7,7 @@ import numpy as np
 
 from ._num import is_scalar
 
-__all__ = ["check_positive", "check_nonnegative", "check_poisson", "check_choice", "interval_check"]
+__all__ = ["check_positive", "check_nonnegative", "check_poisson", "check_choice"]
 
 
 def _check(name, value, unit, ok_scalar, ok_array, allowed):
@@ -55,21 +55,3 @@ def check_choice(name: str, value, choices):
     if value not in choices:
         raise ValueError(f"{name} = {value!r} is not one of {sorted(choices)}")
     return value
-
-
-def interval_check(low, high, low_open, high_open, text=None):
-    """(predicate, allowed-range text, xml min, xml max) of the interval from ``low`` to ``high``.
-
-    The predicate rejects NaN (every comparison with NaN is false) and, since an infinite bound is
-    open, +-inf. The text is what an error message shows ("finite and > 0", "0 <= value < 0.5").
-    """
-    def ok(v):
-        return (low < v if low_open else low <= v) and (v < high if high_open else v <= high)
-
-    if text is None:
-        lo_op, hi_op = ("<" if low_open else "<="), ("<" if high_open else "<=")
-        if high == math.inf:
-            text = f"finite and {'>' if low_open else '>='} {low:g}"
-        else:
-            text = f"{low:g} {lo_op} value {hi_op} {high:g}"
-    return ok, text, (None if low == -math.inf else f"{low:g}"), (None if high == math.inf else f"{high:g}")

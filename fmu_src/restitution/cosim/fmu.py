@@ -26,9 +26,9 @@ def build_default_fmu(out_dir: str | Path | None = None, model: str = "SpherePla
 
 def impact_fmu_parameters(sphere, plate) -> dict:
     """FMU parameter values (by FMI name) for a :class:`~restitution.Sphere` and :class:`~restitution.Plate`."""
-    values = {f"sphere.{k.split('_', 1)[1]}": v for k, v in sphere.params().items()}
-    values.update({f"plate.{k.split('_', 1)[1]}": v for k, v in plate.params().items()})
-    return values
+    from ..fmu.models.sphere_plate_impact.variables import fmu_values
+
+    return fmu_values(**sphere.params(), **plate.params())
 
 
 # fmpy's native logger proxy (which formats the variadic C message) keeps one logger for the

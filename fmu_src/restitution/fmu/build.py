@@ -34,9 +34,12 @@ import zipfile
 from pathlib import Path
 from xml.etree import ElementTree as ET
 
+from .models import table
+
 HERE = Path(__file__).resolve().parent
 PACKAGE = HERE.parent  # the restitution package the FMUs bundle
 SLAVES = HERE / "slaves"
+MODELS = HERE / "models"
 
 #: FMU model identifier -> pythonfmu slave script (shipped with the package).
 FMUS = {"SpherePlateImpact": SLAVES / "sphere_plate_impact_slave.py",
@@ -67,15 +70,10 @@ UNITS = {
 PARAMETER_CAUSALITIES = ("parameter", "input")
 
 
-def complete_model_description(xml_text: str, variables, allowed_range, feedthrough=None) -> str:
-    """modelDescription.xml with units, descriptions, limits and a full ModelStructure.
-
-    ``variables`` is the slave's table: (name, type, causality, unit, start, description, key);
-    ``allowed_range(name)`` gives (check, text, min, max) for inputs and parameters;
-    ``feedthrough``: names of the outputs that depend directly on the inputs (default: all
-    but V_c and the sphere's mass, as in SpherePlateImpact).
-    """
-    spec = {row[0]: row for row in variables}
+def complete_model_description(xml_text: str, table) -> str:
+    """modelDescription.xml with units, descriptions, limits and a full ModelStructure, from the
+    model's interface ``table`` (:class:`restitution.fmu.table.Table`): each output's dependence on
+    the inputs is its ``feedthrough``."""
     root = ET.fromstring(xml_text)
     model_variables = root.find("ModelVariables")
     scalar_variables = list(model_variables)
@@ -83,14 +81,14 @@ def complete_model_description(xml_text: str, variables, allowed_range, feedthro
 
     used_units = set()
     for sv in scalar_variables:
-        name, vtype, causality, unit, _start, description, _key = spec[sv.get("name")]
-        sv.set("description", description)
+        var = table[sv.get("name")]
+        sv.set("description", var.description)
         type_node = sv[0]
-        if vtype == "Real" and unit is not None:
-            type_node.set("unit", unit)
-            used_units.add(unit)
-        if causality in PARAMETER_CAUSALITIES:
-            _check, _text, low, high = allowed_range(name)
+        if var.type == "Real" and var.unit is not None:
+            type_node.set("unit", var.unit)
+            used_units.add(var.unit)
+        if var.causality in PARAMETER_CAUSALITIES:
+            low, high = var.xml_limits()
             if low is not None:
                 type_node.set("min", low)
             if high is not None:
@@ -105,25 +103,19 @@ def complete_model_description(xml_text: str, variables, allowed_range, feedthro
     position = list(root).index(root.find("CoSimulation")) + 1
     root.insert(position, unit_defs)
 
-    inputs = [index[row[0]] for row in variables if row[2] == "input"]
+    inputs = [index[var.name] for var in table if var.causality == "input"]
     structure = root.find("ModelStructure")
     for child in list(structure):
         structure.remove(child)
     outputs = ET.SubElement(structure, "Outputs")
     initial = ET.SubElement(structure, "InitialUnknowns")
-    for row in variables:
-        if row[2] != "output":
-            continue
-        if feedthrough is None:
-            depends_on_input = row[6] not in ("V_c", "m_a")  # these depend on parameters only
-        else:
-            depends_on_input = row[0] in feedthrough
-        deps = " ".join(map(str, inputs)) if depends_on_input else ""
-        attrs = {"index": str(index[row[0]]), "dependencies": deps}
+    for var in table.outputs:
+        deps = " ".join(map(str, inputs)) if var.feedthrough else ""
+        attrs = {"index": str(index[var.name]), "dependencies": deps}
         if deps:
             attrs["dependenciesKind"] = " ".join("dependent" for _ in inputs)
         ET.SubElement(outputs, "Unknown", attrs)
-        ET.SubElement(initial, "Unknown", {"index": str(index[row[0]])})
+        ET.SubElement(initial, "Unknown", {"index": str(index[var.name])})
     for element in root.iter():
         if element.text is not None and not element.text.strip():
             element.text = None
@@ -148,24 +140,38 @@ def _rewrite_zip(fmu: Path, transform=None, member: str | None = None, extra: di
     tmp.replace(fmu)
 
 
-#: Subfolders of the package the FMUs bundle; the others (cosim/, scene/, sweep/, fmu/, ...) are
-#: host-side helpers whose imports (fmpy, dask, matplotlib, ...) the slaves never need. Bundling
-#: them made the plain-C-host loader require those packages at start-up (python_env.txt require=).
+#: Subfolders of the package the FMUs bundle; the others (cosim/, scene/, sweep/, ...) are host-side
+#: helpers whose imports (fmpy, dask, matplotlib, ...) the slaves never need. Bundling them made the
+#: plain-C-host loader require those packages at start-up (python_env.txt require=).
 BUNDLED_SUBDIRS = {"data"}
+#: Of fmu/, the slaves need only the interface tables (pure data): these files, and models/*/variables.py.
+BUNDLED_FMU_FILES = {"__init__.py", "table.py"}
 
 
 def _physics_only(directory, names):
-    """copytree filter: no caches, and only BUNDLED_SUBDIRS below the package root."""
+    """copytree filter: no caches; below the package root only BUNDLED_SUBDIRS and, of fmu/, the
+    interface tables."""
     ignored = set(shutil.ignore_patterns("__pycache__", "*.pyc", "*.egg-info")(directory, names))
-    if Path(directory).resolve() == PACKAGE.resolve():
-        ignored |= {n for n in names if (PACKAGE / n).is_dir() and n not in BUNDLED_SUBDIRS}
+    here = Path(directory).resolve()
+    if here == PACKAGE.resolve():
+        ignored |= {n for n in names if (PACKAGE / n).is_dir() and n not in BUNDLED_SUBDIRS | {"fmu"}}
+    elif here == HERE:
+        ignored |= {n for n in names if n not in BUNDLED_FMU_FILES | {"models"}}
+    elif here == MODELS or here.parent == MODELS:
+        ignored |= {n for n in names if (here / n).is_file() and n not in ("__init__.py", "variables.py")}
     return ignored
+
+
+def _table_files() -> list[Path]:
+    """The interface tables' files the FMUs bundle (see :func:`_physics_only`)."""
+    return ([HERE / name for name in sorted(BUNDLED_FMU_FILES)] + [MODELS / "__init__.py"]
+            + sorted(MODELS.glob("*/__init__.py")) + sorted(MODELS.glob("*/variables.py")))
 
 
 def source_files(model: str) -> list[Path]:
     """Every file ``<model>.fmu`` is built from: the slave, the bundled physics modules and data,
     this build module, the interface table's generator and the guard (C front and native-host loader)."""
-    files = [FMUS[model], SLAVE_SUPPORT, Path(__file__).resolve(), HERE / "interface.py"]
+    files = [FMUS[model], SLAVE_SUPPORT, Path(__file__).resolve(), HERE / "interface.py", *_table_files()]
     files += sorted((HERE / "cfront").glob("*.[ch]"))
     files += sorted((HERE / "native_host").glob("*.[ch]")) + sorted((HERE / "native_host").glob("*.py"))
     files += sorted(PACKAGE.glob("*.py"))
@@ -240,11 +246,9 @@ def build_one(model: str, out_dir: Path, standalone: bool = True, log=None) -> P
         shutil.copytree(PACKAGE, staged, ignore=_physics_only)
         fmu = Path(FmuBuilder.build_FMU(script, dest=tmp, project_files=[staged, SLAVE_SUPPORT],
                                         canGetAndSetFMUstate=True, canSerializeFMUstate=True))
-        slave_module = _slave_module(model)
         info = json.dumps({"model": model, "source_hash": source_hash(model)}, indent=1)
-        _rewrite_zip(fmu, lambda xml: complete_model_description(
-            xml, slave_module.VARIABLES, slave_module.allowed_range, getattr(slave_module, "FEEDTHROUGH", None)),
-            member="modelDescription.xml", extra={BUILD_INFO: info})
+        _rewrite_zip(fmu, lambda xml: complete_model_description(xml, table(model)),
+                     member="modelDescription.xml", extra={BUILD_INFO: info})
         if standalone and shutil.which("gcc") is None:
             log(f"warning: gcc not found: {model}.fmu is built for Python hosts only (fmpy, libcosimpy), "
                 "without the C guard that checks every FMI call; install gcc")
@@ -259,14 +263,6 @@ def build_one(model: str, out_dir: Path, standalone: bool = True, log=None) -> P
         target = out_dir / f"{model}.fmu"
         os.replace(fmu, target)
     return target
-
-
-def _slave_module(model: str):
-    """The slave module of ``model`` (its VARIABLES table, allowed_range, FEEDTHROUGH)."""
-    script = FMUS[model]
-    if str(script.parent) not in sys.path:
-        sys.path.insert(0, str(script.parent))
-    return importlib.import_module(script.stem)
 
 
 def build_all(out_dir: Path, standalone: bool = True, log=None) -> list[Path]:

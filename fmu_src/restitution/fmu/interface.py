@@ -1,76 +1,29 @@
-"""The FMUs' interface as data, from the one source: each slave's ``VARIABLES`` table.
+"""The C form of the FMUs' interface tables (``models/<model>/variables.py``), generated at build time.
 
-:func:`variables` lists every variable of an FMU as pythonfmu registers it (value reference,
-type, causality, variability, initial, start) joined with the slave's table (unit, description)
-and its ``allowed_interval`` (range of inputs and parameters). The C guard in front of pythonfmu
-and the native FMU are compiled against :func:`c_header`, generated at build time, so no C code
-parses XML at run time and no C table is edited by hand.
+The C guard in front of pythonfmu and the native FMUs are compiled against :func:`c_header`: one
+row per variable (value reference, name, type, causality, variability, state flag, start, range,
+unit, description), and an enum of value references and codes, so no C code parses XML at run time,
+indexes variables by number or holds a table edited by hand.
 
     python -m restitution.fmu.interface SpherePlateImpact > interface.h
 """
 from __future__ import annotations
 
 import math
+import re
 import sys
-from dataclasses import dataclass
+
+from .models import table
+from .table import Variable
 
 #: The layout of the C row (``cfront/rst_variable.h``'s RST_VARIABLE_LAYOUT): the generated header
 #: refuses to compile against another.
 TABLE_VERSION = 2
 
 
-@dataclass(frozen=True)
-class Variable:
-    """One scalar variable of an FMU's interface (units and ranges in SI, as in the modelDescription)."""
-
-    vr: int
-    name: str
-    type: str  #: "Real", "Integer" or "Boolean"
-    causality: str  #: "parameter", "input", "output" or "local"
-    variability: str  #: "fixed", "tunable", "discrete" or "continuous"
-    initial: str | None  #: "exact", "calculated", ... or None (not declared)
-    start: float | int | bool | None
-    unit: str | None
-    description: str
-    #: allowed values of an input or parameter: (low, high, low_open, high_open); None for outputs
-    interval: tuple | None
-    range_text: str | None  #: the allowed range as an error message shows it
-    #: part of the FMU state: inputs, parameters, and outputs/locals the model evolves (those the
-    #: slave can set back, i.e. registered with a setter); other outputs are recomputed from them
-    state: bool = False
-
-
-def _slave_class(module):
-    from pythonfmu import Fmi2Slave
-
-    classes = [obj for obj in vars(module).values()
-               if isinstance(obj, type) and issubclass(obj, Fmi2Slave) and obj is not Fmi2Slave]
-    if len(classes) != 1:
-        raise RuntimeError(f"{module.__name__} defines {len(classes)} Fmi2Slave classes, expected one")
-    return classes[0]
-
-
-def variables(model: str) -> list[Variable]:
-    """Every variable of ``model`` (a key of :data:`restitution.fmu.build.FMUS`), by value reference."""
-    from .build import _slave_module
-
-    module = _slave_module(model)
-    rows = {row[0]: row for row in module.VARIABLES}
-    slave = _slave_class(module)(instance_name="interface-table", visible=False)
-    out = []
-    for vr, var in sorted(slave.vars.items()):
-        _name, vtype, causality, unit, _start, description, _key = rows[var.name]
-        interval = text = None
-        if causality in ("parameter", "input"):
-            interval = tuple(module.allowed_interval(var.name))
-            text = module.allowed_range(var.name)[1]
-        initial = getattr(var, "initial", None)
-        out.append(Variable(
-            vr=vr, name=var.name, type=vtype, causality=var.causality.name, variability=var.variability.name,
-            initial=initial.name if initial is not None else None, start=getattr(var, "start", None),
-            unit=unit, description=description, interval=interval, range_text=text,
-            state=causality in ("parameter", "input") or getattr(var, "setter", None) is not None))
-    return out
+def variables(model: str) -> tuple[Variable, ...]:
+    """Every variable of ``model`` (a key of :data:`restitution.fmu.models.FOLDERS`), by value reference."""
+    return table(model).rows
 
 
 def variables_from_model_description(xml_text: str) -> list[Variable]:
@@ -97,10 +50,10 @@ def variables_from_model_description(xml_text: str) -> list[Variable]:
             interval = (low, high, math.isinf(low), math.isinf(high))
             text = "finite" if interval[2] and interval[3] else f"{node.get('min', '-inf')} <= value <= {node.get('max', 'inf')}"
         out.append(Variable(
-            vr=int(sv.get("valueReference")), name=sv.get("name"), type=vtype, causality=causality,
-            variability=sv.get("variability", "continuous"), initial=sv.get("initial"), start=start,
-            unit=node.get("unit"), description=sv.get("description", ""), interval=interval, range_text=text,
-            state=causality in ("parameter", "input")))
+            name=sv.get("name"), key=sv.get("name"), type=vtype, causality=causality,
+            variability=sv.get("variability", "continuous"), unit=node.get("unit"),
+            description=sv.get("description", ""), start=start, interval=interval, range_text=text,
+            state=causality in ("parameter", "input"), vr=int(sv.get("valueReference"))))
     return sorted(out, key=lambda v: v.vr)
 
 
@@ -146,17 +99,42 @@ def _c_double(x) -> str:
     return repr(x)
 
 
+def c_identifier(text: str) -> str:
+    """``text`` as an upper-case C identifier part: "zener.lambda" -> "ZENER_LAMBDA"."""
+    return re.sub(r"[^0-9A-Za-z]", "_", text).upper()
+
+
+def _c_enums(upper: str, rows) -> list[str]:
+    """The value references (``RST_<MODEL>_VR_<NAME>``) and the codes of every choice
+    (``RST_<MODEL>_<NAME>_<WORD>``), so the C names variables and codes instead of numbering them."""
+    names = [f"RST_{upper}_VR_{c_identifier(v.name)}" for v in rows]
+    codes = [(f"RST_{upper}_{c_identifier(v.name)}_{c_identifier(word)}", code)
+             for v in rows if v.choices is not None for word, code in v.codes.items()]
+    every = names + [name for name, _code in codes]
+    if len(set(every)) != len(every):
+        raise RuntimeError(f"two variables or codes of {upper} give the same C name")
+    n_outputs = sum(v.causality == "output" for v in rows)
+    lines = ["", f"#define RST_{upper}_N_OUTPUTS {n_outputs}", "/* value references */", "enum {"]
+    lines += [f"    {name} = {v.vr}," for name, v in zip(names, rows)]
+    lines += ["};", "/* the codes of the Integer choices */", "enum {"]
+    lines += [f"    {name} = {code}," for name, code in codes]
+    return lines + ["};"]
+
+
 def c_header(model: str, rows: list[Variable] | None = None) -> str:
     """A C99 header with ``model``'s variable table (one row per variable, indexed by value reference):
     ``RST_<MODEL>_VARIABLES`` and ``RST_MODEL_VARIABLES`` (the same table under a generic name, for the
-    front's glue). ``rows`` defaults to :func:`variables` (the slave's VARIABLES)."""
+    front's glue). ``rows`` defaults to the model's interface table, and then the header also names
+    every value reference and code (:func:`_c_enums`); rows read from a foreign FMU's modelDescription
+    (``make_standalone``) give the table alone."""
+    enums = rows is None
     rows = variables(model) if rows is None else rows
     if [v.vr for v in rows] != list(range(len(rows))):
         raise RuntimeError(f"{model}: value references are not 0..n-1")
-    upper = model.upper()
+    upper = c_identifier(model)
     lines = [
-        f"/* {model}: the FMU interface, generated by restitution.fmu.interface from the slave's",
-        " * VARIABLES table at build time. Do not edit: rebuild. */",
+        f"/* {model}: the FMU interface, generated by restitution.fmu.interface from the model's",
+        " * interface table at build time. Do not edit: rebuild. */",
         f"#ifndef RST_{upper}_INTERFACE_H",
         f"#define RST_{upper}_INTERFACE_H",
         "#include <math.h>",
@@ -174,10 +152,13 @@ def c_header(model: str, rows: list[Variable] | None = None) -> str:
         lines.append(
             f"    {{{v.vr}, {_c_string(v.name)}, RST_{v.type.upper()}, RST_{v.causality.upper()}, "
             f"RST_{v.variability.upper()}, {int(v.state)}, {_c_double(v.start)}, {_c_double(low)}, "
-            f"{_c_double(high)}, {int(bool(low_open))}, {int(bool(high_open))}, {_c_string(v.range_text)}, "
+            f"{_c_double(high)}, {int(bool(low_open))}, {int(bool(high_open))}, {_c_string(v.allowed_text())}, "
             f"{_c_string(v.unit)}, {_c_string(v.description)}}},")
     lines += ["};", f"#define RST_MODEL_N_VARIABLES RST_{upper}_N_VARIABLES",
-              f"#define RST_MODEL_VARIABLES RST_{upper}_VARIABLES", "#endif", ""]
+              f"#define RST_MODEL_VARIABLES RST_{upper}_VARIABLES"]
+    if enums:
+        lines += _c_enums(upper, rows)
+    lines += ["#endif", ""]
     return "\n".join(lines)
 
 

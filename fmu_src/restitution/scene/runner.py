@@ -35,10 +35,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ..jgm import (critical_interference, critical_load, critical_pressure, critical_velocity,
-                   effective_modulus, sphere_mass)
-from ..model import EFFECT_MODES, RESTITUTION_MODELS, ZENER_SLOPE_BOUND
-from ..zener import ZENER_METHODS, inelasticity_parameter
+from ..fmu.models.sphere_plate_impact.variables import fmu_values
+from ..model import ZENER_SLOPE_BOUND, impact
+from ..zener import ZENER_METHODS
 from ..cosim.bouncing import impact_sequence
 from ..cosim.interrupt import DeferredInterrupt
 from .loader import Drop, Scene, SceneError
@@ -98,15 +97,9 @@ def open_instance(fmu_path):
 
 
 def drop_parameters(scene: Scene, drop: Drop, plasticity: str, plate_waves: str, zener_method: str) -> dict:
-    ms, mp = drop.ball.material, drop.plate.material
-    return {
-        "sphere.E": ms.E, "sphere.nu": ms.nu, "sphere.Sy": ms.Sy, "sphere.rho": ms.rho, "sphere.d": drop.ball.diameter,
-        "plate.E": mp.E, "plate.nu": mp.nu, "plate.Sy": mp.Sy, "plate.rho": mp.rho, "plate.t": drop.plate.thickness,
-        "restitution_model": RESTITUTION_MODELS.index(scene.model.restitution_model) + 1,
-        "zener_method": ZENER_METHODS.index(zener_method) + 1,
-        "plasticity": EFFECT_MODES.index(plasticity), "plate_waves": EFFECT_MODES.index(plate_waves),
-        "effect_tolerance": scene.model.effect_tolerance,
-    }
+    return fmu_values(
+        **_package_params(drop), restitution_model=scene.model.restitution_model, zener_method=zener_method, plasticity=plasticity,
+        plate_waves=plate_waves, effect_tolerance=scene.model.effect_tolerance)
 
 
 # --- results -----------------------------------------------------------------------------------
@@ -308,20 +301,19 @@ class DropWriter:
 
 # --- why effects were left out ---------------------------------------------------------------
 
+def _package_params(drop: Drop) -> dict:
+    return dict(**drop.ball.material.params("sphere"), sphere_d=drop.ball.diameter,
+                **drop.plate.material.params("plate"), plate_t=drop.plate.thickness)
+
+
 def critical_velocity_of(drop: Drop) -> float:
-    """V_c [m/s] of the ball/plate pair, Eq. (6) (host side, for the explanations only)."""
-    ms, mp = drop.ball.material, drop.plate.material
-    E_prime = effective_modulus(ms.E, ms.nu, mp.E, mp.nu)
-    CSy = critical_pressure(ms.nu, ms.Sy, mp.nu, mp.Sy)
-    R = 0.5 * drop.ball.diameter
-    return float(critical_velocity(critical_interference(CSy, E_prime, R), critical_load(CSy, E_prime, R),
-                                   sphere_mass(ms.rho, drop.ball.diameter)))
+    """V_c [m/s] of the ball/plate pair, Eq. (6), from the package (host side, for the explanations only)."""
+    return float(impact(0.0, **_package_params(drop), plasticity="off", plate_waves="off").V_c)
 
 
 def zener_lambda_of(drop: Drop, v) -> np.ndarray:
-    ms, mp = drop.ball.material, drop.plate.material
-    return inelasticity_parameter(np.asarray(v, dtype=float), ms.E, ms.nu, ms.rho, drop.ball.diameter,
-                                  mp.E, mp.nu, mp.rho, drop.plate.thickness)
+    """Zener's lambda [1] of the drop's pair at the approach speeds ``v`` [m/s], Eq. (12), from the package."""
+    return impact(np.asarray(v, dtype=float), **_package_params(drop), plasticity="off", plate_waves="off").lam
 
 
 def explain(result: SceneResult) -> list[str]:
@@ -357,7 +349,7 @@ def explain(result: SceneResult) -> list[str]:
                and scene.model.plate_waves == "auto" else "plate_waves = on")
         lines.append(f"plate waves: computed at all {n} impacts ({why})")
     elif skipped == 0:
-        lines.append(f"plate waves: needed at all {n} impacts (1.731 lambda >= effect_tolerance = {tol:g})")
+        lines.append(f"plate waves: needed at all {n} impacts ({ZENER_SLOPE_BOUND} lambda >= effect_tolerance = {tol:g})")
     else:
         lam_max = max(float(np.max(zener_lambda_of(d.drop, d.v_approach[~d.plate_waves])))
                       for d in result.drops if np.any(~d.plate_waves))

@@ -30,6 +30,8 @@ from pathlib import Path
 
 import numpy as np
 
+from ..fmu.models.sphere_plate_impact.variables import TABLE
+from ..model import PARAMETERS
 from .spec import CODES, INPUTS, INTEGER_INPUTS, OUTPUTS
 
 __all__ = ["Backend", "PackageBackend", "FmuBackend", "get_backend", "code_fingerprint", "release_fmus",
@@ -37,8 +39,9 @@ __all__ = ["Backend", "PackageBackend", "FmuBackend", "get_backend", "code_finge
 
 _REAL_OUT = [name for name, _f, t in OUTPUTS if t == "Real"]
 _BOOL_OUT = [name for name, _f, t in OUTPUTS if t == "Boolean"]
-_OPTION_NAMES = ("restitution_model", "zener_method", "plasticity", "plate_waves", "effect_tolerance",
-                 "zener.ode_tolerance")
+#: impact()'s keyword options (the inputs that are neither v nor a material or geometry parameter)
+_OPTION_NAMES = tuple(v.name for v in TABLE.settable
+                      if v.key not in {"v", *(key for key, _unit, _check in PARAMETERS)})
 
 
 def code_fingerprint(package_dir=None) -> str:
@@ -74,23 +77,17 @@ def _empty_outputs(n: int) -> dict:
 
 
 def inputs_ok(cases: dict) -> np.ndarray:
-    """Cases whose inputs the FMU accepts (its ``allowed_range``): the others read NaN."""
+    """Cases whose inputs the FMU accepts (each in its declared range, codes whole numbers): the
+    others read NaN."""
     ok = np.ones(np.size(cases["v_approach"]), dtype=bool)
     with np.errstate(invalid="ignore"):
-        for name, _kw, _type, _start in INPUTS:
-            x = np.asarray(cases[name], dtype=float)
-            if name in CODES:
-                codes = sorted(CODES[name].values())
-                good = (x >= codes[0]) & (x <= codes[-1]) & (x == np.round(x))
-            elif name.endswith(".nu"):
-                good = (x >= 0.0) & (x < 0.5)
-            elif name in ("v_approach", "effect_tolerance"):
-                good = (x >= 0.0) & np.isfinite(x)
-            elif name == "zener.ode_tolerance":
-                good = (x >= 1e-14) & (x <= 1e-2)
-            else:
-                good = (x > 0.0) & np.isfinite(x)
-            ok &= good
+        for var in TABLE.settable:
+            x = np.asarray(cases[var.name], dtype=float)
+            low, high, low_open, high_open = var.interval
+            ok &= (x > low) if low_open else (x >= low)
+            ok &= (x < high) if high_open else (x <= high)
+            if var.type == "Integer":
+                ok &= x == np.round(x)
     return ok
 
 
@@ -136,8 +133,6 @@ class PackageBackend(Backend):
 def impact_groups(cases: dict, rows):
     """(rows, impact() input arrays, impact() option keywords) for the ``rows`` of ``cases``,
     grouped by their integer-coded options (one vectorized call per group)."""
-    from ..model import EFFECT_MODES, RESTITUTION_MODELS, ZENER_METHODS
-
     rows = np.asarray(rows)
     if rows.size == 0:
         return
@@ -147,10 +142,8 @@ def impact_groups(cases: dict, rows):
         sel = rows[inverse.ravel() == g]
         inputs = {kw: np.asarray(cases[name], dtype=float)[sel]
                   for name, kw, _t, _s in INPUTS if name not in _OPTION_NAMES}
-        yield sel, inputs, dict(restitution_model=RESTITUTION_MODELS[int(opt[0]) - 1],
-                                zener_method=ZENER_METHODS[int(opt[1]) - 1],
-                                plasticity=EFFECT_MODES[int(opt[2])], plate_waves=EFFECT_MODES[int(opt[3])],
-                                effect_tolerance=float(opt[4]), ode_rtol=float(opt[5]))
+        yield sel, inputs, {TABLE.key_of(name): (TABLE[name].word(int(x)) if name in CODES else float(x))
+                            for name, x in zip(_OPTION_NAMES, opt)}
 
 
 # --- the FMU back end --------------------------------------------------------------------

@@ -23,6 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..fmu.models.sphere_plate_impact.variables import TABLE, fmu_values
 from ..materials import MATERIALS, TABLE4_CASES, table4_case
 
 __all__ = ["SweepSpec", "INPUTS", "OUTPUTS", "CODES", "RANDOM_BLOCK", "canonical_name", "load_spec",
@@ -33,55 +34,23 @@ class SizeError(ValueError):
     """A sweep refused before any work by the size guard: an axis too long to build, or a table too
     big for the memory budget and for the disk (the message gives the numbers)."""
 
-# (FMU name, impact() keyword, FMI type, start value): the FMU's inputs and parameters.
-INPUTS = (
-    ("v_approach", "v", "Real", 1.0),
-    ("sphere.E", "sphere_E", "Real", 207e9),
-    ("sphere.nu", "sphere_nu", "Real", 0.30),
-    ("sphere.Sy", "sphere_Sy", "Real", 2.0e9),
-    ("sphere.rho", "sphere_rho", "Real", 7861.0),
-    ("sphere.d", "sphere_d", "Real", 6.35e-3),
-    ("plate.E", "plate_E", "Real", 69e9),
-    ("plate.nu", "plate_nu", "Real", 0.33),
-    ("plate.Sy", "plate_Sy", "Real", 0.290e9),
-    ("plate.rho", "plate_rho", "Real", 2700.0),
-    ("plate.t", "plate_t", "Real", 6.35e-3),
-    ("restitution_model", "restitution_model", "Integer", 1),
-    ("zener_method", "zener_method", "Integer", 1),
-    ("plasticity", "plasticity", "Integer", 2),
-    ("plate_waves", "plate_waves", "Integer", 2),
-    ("effect_tolerance", "effect_tolerance", "Real", 1e-6),
-    ("zener.ode_tolerance", "ode_rtol", "Real", 1e-10),
-)
+#: (FMU name, impact() keyword, FMI type, start value): the FMU's inputs and parameters.
+INPUTS = tuple((v.name, v.key, v.type, v.start) for v in TABLE.settable)
 INPUT_NAMES = tuple(row[0] for row in INPUTS)
 START = {row[0]: row[3] for row in INPUTS}
 INTEGER_INPUTS = tuple(row[0] for row in INPUTS if row[2] == "Integer")
 
 #: Integer-coded parameters: the words accepted for each code (as in the FMU's descriptions).
-CODES = {
-    "restitution_model": {"e45": 1, "e44": 2},
-    "zener_method": {"exact": 1, "paper_fit": 2, "linear": 3, "ode": 4},
-    "plasticity": {"off": 0, "on": 1, "auto": 2},
-    "plate_waves": {"off": 0, "on": 1, "auto": 2},
-}
+CODES = TABLE.choices
 
-# (FMU name, ImpactResult field, FMI type): the FMU's outputs, as restitution.model.published gives them.
-OUTPUTS = (
-    ("e", "e", "Real"), ("v_rebound", "v_rebound", "Real"), ("jgm.e", "e_ep", "Real"),
-    ("jgm.V_c", "V_c", "Real"), ("jgm.V_star", "V_star", "Real"), ("zener.e", "e_ze", "Real"),
-    ("zener.lambda", "lam", "Real"), ("zener.tau0", "tau0", "Real"),
-    ("zener.t_contact", "t_contact", "Real"), ("plate.mass_ratio", "mass_ratio", "Real"),
-    ("plate.v_after", "v_plate", "Real"), ("sphere.m", "m_a", "Real"), ("valid", "valid", "Boolean"),
-    ("zener.in_range", "lambda_in_range", "Boolean"), ("jgm.in_range", "vstar_in_range", "Boolean"),
-    ("e_negative", "e_negative", "Boolean"), ("effects.plasticity", "plasticity_used", "Boolean"),
-    ("effects.plate_waves", "plate_waves_used", "Boolean"), ("zener.contact_ends", "contact_ends", "Boolean"),
-)
+#: (FMU name, ImpactResult field, FMI type): the FMU's outputs, as restitution.model.published gives them.
+OUTPUTS = tuple((v.name, v.key, v.type) for v in TABLE.outputs)
 OUTPUT_NAMES = tuple(row[0] for row in OUTPUTS)
 
 #: Derived axis: plate.t = t_over_d * sphere.d.
 T_OVER_D = "t_over_d"
 #: Material-property inputs a material pair sets.
-PAIR_INPUTS = ("sphere.E", "sphere.nu", "sphere.Sy", "sphere.rho", "plate.E", "plate.nu", "plate.Sy", "plate.rho")
+PAIR_INPUTS = tuple(fmu_values(**MATERIALS["s2_tool_steel"].params("sphere"), **MATERIALS["al_6061"].params("plate")))
 #: Largest ``samples`` and ``seed`` a spec accepts.
 MAX_SAMPLES = 10**12
 MAX_SEED = 2**63 - 1
@@ -292,8 +261,7 @@ def resolve_pair(pair: str):
 
 def _pair_values(pair: str) -> dict:
     sphere, plate = resolve_pair(pair)
-    return {"sphere.E": sphere.E, "sphere.nu": sphere.nu, "sphere.Sy": sphere.Sy, "sphere.rho": sphere.rho,
-            "plate.E": plate.E, "plate.nu": plate.nu, "plate.Sy": plate.Sy, "plate.rho": plate.rho}
+    return fmu_values(**sphere.params("sphere"), **plate.params("plate"))
 
 
 def pair_label(pair: str) -> str:

@@ -8,13 +8,14 @@ from types import SimpleNamespace
 import numpy as np
 
 from ...agreement import FLAGS, REALS
+from ..models.sphere_plate_impact.variables import TABLE
 
 _INPUT_REALS = ("v", "sphere_E", "sphere_nu", "sphere_Sy", "sphere_rho", "sphere_d",
                 "plate_E", "plate_nu", "plate_Sy", "plate_rho", "plate_t")
-#: Codes of the FMU's Integer parameters, as rst_physics.h numbers them.
-MODEL_CODE = {"e45": 1, "e44": 2}
-METHOD_CODE = {"exact": 1, "paper_fit": 2, "linear": 3, "ode": 4}
-MODE_CODE = {"off": 0, "on": 1, "auto": 2}
+#: Codes of the FMU's Integer parameters, which rst_physics.h numbers the same way.
+MODEL_CODE = TABLE["restitution_model"].codes
+METHOD_CODE = TABLE["zener_method"].codes
+MODE_CODE = TABLE["plasticity"].codes
 OK, BAD_CODE, UNSUPPORTED = 0, 1, 2
 _RESULT_REALS = ("e", "v_rebound", "e_ep", "V_c", "V_star", "eps_y", "e_ze", "lam", "tau0", "T", "t_contact",
                  "m_a", "m_eff", "mass_ratio", "v_plate")

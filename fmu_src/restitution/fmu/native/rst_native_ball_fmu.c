@@ -9,36 +9,30 @@
 
 static fmi2Status instantiate(rst_instance *inst, const char *resource_dir, fmi2Boolean visible)
 {
-    rst_ball_binding *b = (rst_ball_binding *)rst_backend(inst);
-    char message[256];
     (void)resource_dir, (void)visible;
-    if (rst_ball_bind(b, message, sizeof message) != 0) {
-        rst_log(inst, fmi2Error, "fmi2Instantiate: %s", message);
-        return fmi2Error;
-    }
-    rst_ball_clear(b, rst_store(inst));
+    rst_ball_clear(rst_store(inst));
     return fmi2OK;
 }
 
 static fmi2Status reset(rst_instance *inst)
 {
-    rst_ball_clear((rst_ball_binding *)rst_backend(inst), rst_store(inst));
+    rst_ball_clear(rst_store(inst));
     return fmi2OK;
 }
 
 static fmi2Status exit_initialization(rst_instance *inst)
 {
-    rst_ball_initialize((rst_ball_binding *)rst_backend(inst), rst_store(inst), rst_start_time(inst));
+    rst_ball_initialize(rst_store(inst), rst_start_time(inst));
     return fmi2OK;
 }
 
 static fmi2Status do_step(rst_instance *inst, double t, double h)
 {
-    rst_ball_do_step((rst_ball_binding *)rst_backend(inst), rst_store(inst), t, h);
+    rst_ball_do_step(rst_store(inst), t, h);
     return fmi2OK;
 }
 
 const rst_model RST_MODEL = {
     .identifier = RST_MODEL_IDENTIFIER, .guid = RST_MODEL_GUID,
-    .variables = RST_MODEL_VARIABLES, .n_variables = RST_MODEL_N_VARIABLES, .backend_size = sizeof(rst_ball_binding),
+    .variables = RST_MODEL_VARIABLES, .n_variables = RST_MODEL_N_VARIABLES, .backend_size = 0,
     .instantiate = instantiate, .exit_initialization = exit_initialization, .do_step = do_step, .reset = reset};

@@ -10,21 +10,14 @@
 #include "rst_native_impact.h"
 
 typedef struct {
-    rst_impact_binding binding;
     int stale;  /* an input or parameter changed since the last evaluation */
     int failed; /* the last evaluation failed: outputs are NaN/false */
 } impact_backend;
 
 static fmi2Status instantiate(rst_instance *inst, const char *resource_dir, fmi2Boolean visible)
 {
-    impact_backend *b = (impact_backend *)rst_backend(inst);
-    char message[256];
     (void)resource_dir, (void)visible; /* no resources, no user interface */
-    if (rst_impact_bind(&b->binding, message, sizeof message) != 0) {
-        rst_log(inst, fmi2Error, "fmi2Instantiate: %s", message);
-        return fmi2Error;
-    }
-    b->stale = 1;
+    ((impact_backend *)rst_backend(inst))->stale = 1;
     return fmi2OK;
 }
 
@@ -57,7 +50,7 @@ static void evaluate(rst_instance *inst)
     if (!b->stale)
         return;
     b->stale = 0;
-    b->failed = rst_impact_evaluate(&b->binding, rst_store(inst), message, sizeof message) != 0;
+    b->failed = rst_impact_evaluate(rst_store(inst), message, sizeof message) != 0;
     if (b->failed) {
         describe_inputs(inst, inputs, sizeof inputs);
         rst_log(inst, fmi2Error, "evaluation failed for %s: %s", inputs, message);
@@ -66,9 +59,8 @@ static void evaluate(rst_instance *inst)
 
 static fmi2Status accept(rst_instance *inst, const rst_variable *var, double value)
 {
-    impact_backend *b = (impact_backend *)rst_backend(inst);
     char message[256];
-    if (rst_impact_accept(&b->binding, var->vr, value, message, sizeof message) != 0) {
+    if (rst_impact_accept(var->vr, value, message, sizeof message) != 0) {
         rst_log(inst, fmi2Error, "%s", message);
         return fmi2Error;
     }

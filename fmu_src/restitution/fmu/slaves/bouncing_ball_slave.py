@@ -50,22 +50,14 @@ import math
 from pythonfmu import Boolean, Fmi2Causality, Fmi2Slave, Fmi2Variability, Integer, Real
 from pythonfmu.enums import Fmi2Initial
 
-from restitution.validation import interval_check
+from restitution.fmu.models.bouncing_ball.variables import TABLE
 from restitution_slave_support import (checked_setter, restore_state, state_check, state_from_bytes, state_schema,
                                        state_to_bytes)
-
-P, IN, OUT, LOCAL = "parameter", "input", "output", "local"
 
 #: A contact found within this time [s] after the end of a step still belongs to the step:
 #: a master that steps exactly to a reported contact time (t_impact) must see the contact
 #: although (t + (t_impact - t)) may differ from t_impact by an ulp.
 TIME_TOLERANCE = 1e-12
-
-CONTACT_MODES = ("wait", "immediate")
-
-#: Upper bound of h0 [m] and of g [m/s2] (1000 km; 1e5 standard gravities): the largest speed,
-#: sqrt(2 g h0) = 1.4e6 m/s, and every time and height then stay finite.
-MAX_HEIGHT_OR_GRAVITY = 1e6
 
 #: The count of impacts saturates here: the largest fmi2Integer (a ball whose flights are shorter
 #: than the clock's resolution can bounce more often in one step than an Integer counts).
@@ -73,67 +65,6 @@ MAX_IMPACTS = 2**31 - 1
 #: The largest number of bounces one step jumps over (a float; where flights are too short for the
 #: clock to tell apart, the count is only a bound anyway).
 MAX_TRAIN = 1e18
-
-# (name, type, causality, unit, start, description, key); build_fmu.py reads this table to
-# write units, ranges and descriptions into modelDescription.xml.
-VARIABLES = (
-    ("h0", "Real", P, "m", 0.3, "Drop height: the ball is released from rest at the start time, 0 < h0 <= 1e6 m",
-     "h0"),
-    ("g", "Real", P, "m/s2", 9.80665, "Gravitational acceleration, 0 < g <= 1e6 m/s2", "g"),
-    ("v_min", "Real", P, "m/s", 0.1, "The ball comes to rest when its rebound speed would be below v_min, > 0",
-     "v_min"),
-    ("contact_mode", "Integer", P, None, 1,
-     "1 = wait (at contact stay at the plate until the next communication point, then rebound with the COR "
-     "input), 2 = immediate (rebound at contact with the COR input held since the last communication point)",
-     "contact_mode"),
-    ("e", "Real", IN, "1", 1.0, "Coefficient of restitution for the current approach speed "
-     "(from SpherePlateImpact.e), -1 <= e <= 1; e <= 0: the ball stays at the plate", "e"),
-    ("h", "Real", OUT, "m", None, "Height of the ball above the plate", "h"),
-    ("v", "Real", OUT, "m/s", None, "Vertical velocity of the ball, upward positive", "v"),
-    ("v_approach", "Real", OUT, "m/s", None, "Speed of the ball toward the plate, max(-v, 0) "
-     "(while waiting at the plate: the impact speed); connect to SpherePlateImpact.v_approach", "v_approach"),
-    ("impacts", "Integer", OUT, None, None, "Number of contacts with the plate so far (saturates at 2147483647)",
-     "impacts"),
-    ("t_impact", "Real", OUT, "s", None, "Time of the last contact, located inside the step (-1: none yet)",
-     "t_impact"),
-    ("v_impact", "Real", OUT, "m/s", None, "Approach speed at the last contact", "v_impact"),
-    ("t_rebound", "Real", OUT, "s", None, "Time the ball left the plate after the last contact (-1: not yet)",
-     "t_rebound"),
-    ("v_rebound", "Real", OUT, "m/s", None, "Rebound speed after the last contact (0: at rest)", "v_rebound"),
-    ("e_applied", "Real", OUT, "1", None, "COR applied at the last rebound (0 until the first rebound, while "
-     "t_rebound = -1)", "e_applied"),
-    ("in_contact", "Boolean", OUT, None, None, "Waiting at the plate for the COR (contact_mode = 1)", "in_contact"),
-    ("at_rest", "Boolean", OUT, None, None, "The ball has come to rest on the plate", "at_rest"),
-    ("flight.t_start", "Real", LOCAL, "s", None, "Start time of the current free flight", "t_start"),
-    ("flight.h_start", "Real", LOCAL, "m", None, "Height at the start of the current free flight", "h_start"),
-    ("flight.v_start", "Real", LOCAL, "m/s", None, "Upward velocity at the start of the current free flight",
-     "v_start"),
-)
-
-#: Outputs that depend directly on an input at the same communication point: none (the
-#: COR input acts only inside fmi2DoStep). build_fmu.py writes the ModelStructure from it.
-FEEDTHROUGH = ()
-
-
-def allowed_interval(name):
-    """(low, high, low_open, high_open) of an input or parameter (see the SpherePlateImpact slave)."""
-    if name == "contact_mode":
-        return 1, len(CONTACT_MODES), False, False
-    if name == "e":
-        return -1.0, 1.0, False, False
-    if name in ("h0", "g"):  # bounded: the speeds, sqrt(2 g h0) at most, and so every output stay finite
-        return 0.0, MAX_HEIGHT_OR_GRAVITY, True, False
-    return 0.0, math.inf, True, True
-
-
-def allowed_range(name):
-    """(predicate, allowed-range text, xml min, xml max) of an input or parameter, from :func:`allowed_interval`."""
-    if name == "contact_mode":
-        return (lambda v: 1 <= int(v) <= len(CONTACT_MODES)), "1 = wait or 2 = immediate", "1", "2"
-    if name == "e":
-        return interval_check(*allowed_interval(name), text="-1 <= e <= 1")
-    return interval_check(*allowed_interval(name))
-
 
 def flight_duration(h_start, v_start, g):
     """Time [s] from the start of a free flight (height h_start [m], upward speed v_start [m/s],
@@ -204,8 +135,7 @@ class BouncingBall(Fmi2Slave):
     """A ball dropped onto a plate; the coefficient of restitution is an input (from SpherePlateImpact)."""
 
     author = "restitution developers"
-    description = ("Ball in free flight above a plate; locates each contact inside the step and rebounds "
-                   "with the coefficient of restitution on its input (connect to SpherePlateImpact.fmu)")
+    description = TABLE.description
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
@@ -213,24 +143,23 @@ class BouncingBall(Fmi2Slave):
         self._s = dict(_INITIAL_STATE)  # evolving state, by table key
         self._setters = {}  # every registered variable's setter, by FMI name (FMU state restore)
         self._start_time = 0.0
-        for name, vtype, causality, _unit, start, description, key in VARIABLES:
-            var_cls = {"Real": Real, "Integer": Integer, "Boolean": Boolean}[vtype]
-            if causality in (P, IN):
-                self._values[name] = start
-                self._setters[name] = checked_setter(self, name, allowed_range, self._values, lambda _name: None)
-                self.register_variable(var_cls(
-                    name, causality=Fmi2Causality.parameter if causality == P else Fmi2Causality.input,
-                    variability=Fmi2Variability.fixed if causality == P else Fmi2Variability.continuous,
-                    start=start, description=description, getter=self._value_getter(name),
-                    setter=self._setters[name]), nested=False)
+        for var in TABLE:
+            kind = {"Real": Real, "Integer": Integer, "Boolean": Boolean}[var.type]
+            variability = getattr(Fmi2Variability, var.variability)
+            if var.causality in ("parameter", "input"):
+                self._values[var.name] = var.start
+                self._setters[var.name] = checked_setter(self, var, self._values, lambda _name: None)
+                self.register_variable(kind(
+                    var.name, causality=getattr(Fmi2Causality, var.causality), variability=variability,
+                    start=var.start, description=var.description, getter=self._value_getter(var.name),
+                    setter=self._setters[var.name]), nested=False)
                 continue
-            variability = Fmi2Variability.continuous if vtype == "Real" else Fmi2Variability.discrete
-            self._setters[name] = self._state_setter(key)
-            self.register_variable(var_cls(
-                name, causality=Fmi2Causality.output if causality == OUT else Fmi2Causality.local,
-                variability=variability, initial=Fmi2Initial.calculated, description=description,
-                getter=self._state_getter(key), setter=self._setters[name]), nested=False)
-        self._schema = state_schema("BouncingBall", [row[0] for row in VARIABLES])
+            self._setters[var.name] = self._state_setter(var.key)
+            self.register_variable(kind(
+                var.name, causality=getattr(Fmi2Causality, var.causality), variability=variability,
+                initial=Fmi2Initial.calculated, description=var.description,
+                getter=self._state_getter(var.key), setter=self._setters[var.name]), nested=False)
+        self._schema = state_schema("BouncingBall", [var.name for var in TABLE])
 
     # --- variable access ---------------------------------------------------------------
     def _value_getter(self, name):
@@ -248,7 +177,7 @@ class BouncingBall(Fmi2Slave):
         return {"schema": self._schema, "values": {var.name: var.getter() for var in self.vars.values()}}
 
     def _set_fmu_state(self, state):
-        checks = {row[0]: state_check(row[0], allowed_range, row[1]) for row in VARIABLES if row[2] in (P, IN)}
+        checks = {var.name: state_check(var) for var in TABLE.settable}
         restore_state(self, state, self._schema, checks, self._setters)
 
     _fmu_state_to_bytes = staticmethod(state_to_bytes)
@@ -309,7 +238,7 @@ class BouncingBall(Fmi2Slave):
     def do_step(self, current_time: float, step_size: float) -> bool:
         s = self._s
         g, e, v_min = float(self._values["g"]), float(self._values["e"]), float(self._values["v_min"])
-        wait = int(self._values["contact_mode"]) == 1
+        wait = TABLE["contact_mode"].word(self._values["contact_mode"]) == "wait"
         now = float(current_time)
         end = now + float(step_size)
         limit = end + TIME_TOLERANCE
@@ -330,8 +259,7 @@ class BouncingBall(Fmi2Slave):
         return True
 
     def reset(self):
-        for name, _vtype, causality, _unit, start, _description, _key in VARIABLES:
-            if causality in (P, IN):
-                self._values[name] = start
+        for var in TABLE.settable:
+            self._values[var.name] = var.start
         self._s = dict(_INITIAL_STATE)
         self._start_time = 0.0

@@ -19,15 +19,15 @@ from pythonfmu.enums import Fmi2Status
 STATE_FORMAT = 1
 
 
-def checked_setter(slave, name, allowed_range, values: dict, on_change):
-    """A setter for the input or parameter ``name`` that keeps ``values[name]`` unless the new value
-    passes ``allowed_range(name)``'s check; a refused value is logged (name, value, allowed range)
-    with fmi2Error. ``on_change(name)`` runs after an accepted change."""
-    ok, allowed, _low, _high = allowed_range(name)
+def checked_setter(slave, variable, values: dict, on_change):
+    """A setter for the input or parameter ``variable`` (a row of the model's interface table) that keeps
+    ``values[variable.name]`` unless the new value is in its allowed range; a refused value is logged
+    (name, value, allowed range) with fmi2Error. ``on_change(name)`` runs after an accepted change."""
+    name, allowed = variable.name, variable.allowed_text()
 
     def set_value(value):
         try:
-            good = bool(ok(value))
+            good = variable.accepts(value)
         except (TypeError, ValueError, OverflowError):
             good = False
         if not good:
@@ -39,13 +39,12 @@ def checked_setter(slave, name, allowed_range, values: dict, on_change):
     return set_value
 
 
-def state_check(name, allowed_range, vtype: str):
-    """The check a restored value of the input or parameter ``name`` must pass: ``allowed_range``'s
-    predicate, and for an Integer an int (a JSON state may carry anything)."""
-    ok = allowed_range(name)[0]
-    if vtype == "Integer":
-        return lambda value: isinstance(value, int) and not isinstance(value, bool) and bool(ok(value))
-    return lambda value: isinstance(value, (int, float)) and not isinstance(value, bool) and bool(ok(value))
+def state_check(variable):
+    """The check a restored value of the input or parameter ``variable`` must pass: its allowed range,
+    and for an Integer an int (a JSON state may carry anything)."""
+    if variable.type == "Integer":
+        return lambda value: isinstance(value, int) and not isinstance(value, bool) and variable.accepts(value)
+    return lambda value: isinstance(value, (int, float)) and not isinstance(value, bool) and variable.accepts(value)
 
 
 def state_schema(model: str, names) -> dict:
@@ -55,7 +54,7 @@ def state_schema(model: str, names) -> dict:
 
 def state_problem(state, schema: dict, checks: dict) -> str | None:
     """Why ``state`` cannot be restored into a slave with ``schema``, or None. ``checks`` maps each
-    input and parameter to allowed_range's predicate; the other variables must be numbers."""
+    input and parameter to :func:`state_check`'s predicate; the other variables must be numbers."""
     if isinstance(state, dict) and "unreadable" in state:
         return f"the bytes are not a state ({state['unreadable']})"
     if not isinstance(state, dict) or set(state) != {"schema", "values"}:

@@ -1,0 +1,1 @@
+"""BouncingBall: its interface table (variables.py)."""

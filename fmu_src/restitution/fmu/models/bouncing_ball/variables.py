@@ -1,0 +1,59 @@
+"""BouncingBall's interface: one row per variable, in value-reference order.
+
+Parameters and the input carry the slave's names; outputs and locals the key of the quantity the
+ball evolves (all of them are part of the FMU state). No output depends directly on the input at
+the same communication point: the COR acts only inside fmi2DoStep.
+"""
+from __future__ import annotations
+
+import math
+
+from ...table import Table, input_, local, output, parameter
+
+#: contact_mode's choices, codes 1 and 2
+CONTACT_MODES = ("wait", "immediate")
+#: Upper bound of h0 [m] and of g [m/s2] (1000 km; 1e5 standard gravities): the largest speed,
+#: sqrt(2 g h0) = 1.4e6 m/s, and every time and height then stay finite.
+MAX_HEIGHT_OR_GRAVITY = 1e6
+STANDARD_GRAVITY = 9.80665  # [m/s2]
+
+_BOUNDED = (0.0, MAX_HEIGHT_OR_GRAVITY, True, False)
+
+
+def _evolved(name, key, unit, description, vtype="Real"):
+    return output(name, key, unit, description, vtype=vtype, state=True)
+
+
+TABLE = Table("BouncingBall", "Ball in free flight above a plate; locates each contact inside the step and "
+              "rebounds with the coefficient of restitution on its input (connect to SpherePlateImpact.fmu)", (
+    parameter("h0", "h0", "m", 0.3, "Drop height: the ball is released from rest at the start time, 0 < h0 <= 1e6 m",
+              _BOUNDED, variability="fixed"),
+    parameter("g", "g", "m/s2", STANDARD_GRAVITY, "Gravitational acceleration, 0 < g <= 1e6 m/s2", _BOUNDED,
+              variability="fixed"),
+    parameter("v_min", "v_min", "m/s", 0.1, "The ball comes to rest when its rebound speed would be below v_min, > 0",
+              (0.0, math.inf, True, True), variability="fixed"),
+    parameter("contact_mode", "contact_mode", None, 1,
+              "1 = wait (at contact stay at the plate until the next communication point, then rebound with the COR "
+              "input), 2 = immediate (rebound at contact with the COR input held since the last communication point)",
+              vtype="Integer", variability="fixed", choices=CONTACT_MODES),
+    input_("e", "e", "1", 1.0, "Coefficient of restitution for the current approach speed "
+           "(from SpherePlateImpact.e), -1 <= e <= 1; e <= 0: the ball stays at the plate", (-1.0, 1.0, False, False),
+           range_text="-1 <= e <= 1"),
+    _evolved("h", "h", "m", "Height of the ball above the plate"),
+    _evolved("v", "v", "m/s", "Vertical velocity of the ball, upward positive"),
+    _evolved("v_approach", "v_approach", "m/s", "Speed of the ball toward the plate, max(-v, 0) "
+             "(while waiting at the plate: the impact speed); connect to SpherePlateImpact.v_approach"),
+    _evolved("impacts", "impacts", None, "Number of contacts with the plate so far (saturates at 2147483647)",
+             "Integer"),
+    _evolved("t_impact", "t_impact", "s", "Time of the last contact, located inside the step (-1: none yet)"),
+    _evolved("v_impact", "v_impact", "m/s", "Approach speed at the last contact"),
+    _evolved("t_rebound", "t_rebound", "s", "Time the ball left the plate after the last contact (-1: not yet)"),
+    _evolved("v_rebound", "v_rebound", "m/s", "Rebound speed after the last contact (0: at rest)"),
+    _evolved("e_applied", "e_applied", "1", "COR applied at the last rebound (0 until the first rebound, while "
+             "t_rebound = -1)"),
+    _evolved("in_contact", "in_contact", None, "Waiting at the plate for the COR (contact_mode = 1)", "Boolean"),
+    _evolved("at_rest", "at_rest", None, "The ball has come to rest on the plate", "Boolean"),
+    local("flight.t_start", "t_start", "s", "Start time of the current free flight"),
+    local("flight.h_start", "h_start", "m", "Height at the start of the current free flight"),
+    local("flight.v_start", "v_start", "m/s", "Upward velocity at the start of the current free flight"),
+))

@@ -1,0 +1,1 @@
+"""SpherePlateImpact: its interface table (variables.py)."""

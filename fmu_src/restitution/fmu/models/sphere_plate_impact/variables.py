@@ -1,0 +1,119 @@
+"""SpherePlateImpact's interface: one row per variable, in value-reference order.
+
+Inputs and parameters carry :func:`restitution.impact`'s keyword, outputs the field of
+:meth:`restitution.ImpactResult.as_dict` as :func:`restitution.model.published` gives it (every
+output finite). Ranges are the package's declared domain (:data:`restitution.model.DOMAIN`), inside
+which every output is finite; the defaults are the paper's Table 3 pair (S2 tool-steel ball on Al 6061).
+"""
+from __future__ import annotations
+
+import math
+
+from ....materials import MATERIALS
+from ....model import DOMAIN, EFFECT_MODES, RESTITUTION_MODELS, ZENER_METHODS
+from ...table import Table, input_, output, parameter
+
+_BALL, _PLATE = MATERIALS["s2_tool_steel"], MATERIALS["al_6061"]
+_D = 6.35e-3  # [m] the paper's default ball diameter and plate thickness (1/4 in)
+_NU = (0.0, 0.5, False, True)  # 0.5 (incompressible) makes E' infinite
+
+
+def _domain(key):
+    low, high = DOMAIN[key]
+    return low, high, False, False
+
+
+def _feedthrough(name, key, unit, description, vtype="Real"):
+    return output(name, key, unit, description, vtype=vtype, feedthrough=True)
+
+
+TABLE = Table("SpherePlateImpact", "Apparent coefficient of restitution of a sphere hitting a plate of finite "
+              "thickness: JGM elastoplastic model fused with Zener's plate-wave model, I. Green, Nonlinear Dyn (2022)", (
+    input_("v_approach", "v", "m/s", 1.0, "Normal approach speed of the sphere toward the plate, 0 to 1e4 m/s",
+           _domain("v")),
+    parameter("sphere.E", "sphere_E", "Pa", float(_BALL.E),
+              "Sphere elastic modulus, 1e5 to 1e13 Pa (default: S2 tool steel, Table 3)", _domain("sphere_E")),
+    parameter("sphere.nu", "sphere_nu", "1", float(_BALL.nu), "Sphere Poisson's ratio, 0 <= nu < 0.5", _NU),
+    parameter("sphere.Sy", "sphere_Sy", "Pa", float(_BALL.Sy),
+              "Sphere yield strength, 1e3 to 1e13 Pa (1e12 for brittle materials)", _domain("sphere_Sy")),
+    parameter("sphere.rho", "sphere_rho", "kg/m3", float(_BALL.rho), "Sphere density, 1 to 1e5 kg/m3",
+              _domain("sphere_rho")),
+    parameter("sphere.d", "sphere_d", "m", _D, "Sphere diameter, 1e-6 to 10 m", _domain("sphere_d")),
+    parameter("plate.E", "plate_E", "Pa", float(_PLATE.E),
+              "Plate elastic modulus, 1e5 to 1e13 Pa (default: Al 6061, Table 3)", _domain("plate_E")),
+    parameter("plate.nu", "plate_nu", "1", float(_PLATE.nu), "Plate Poisson's ratio, 0 <= nu < 0.5", _NU),
+    parameter("plate.Sy", "plate_Sy", "Pa", float(_PLATE.Sy),
+              "Plate yield strength, 1e3 to 1e13 Pa (1e12 for brittle materials)", _domain("plate_Sy")),
+    parameter("plate.rho", "plate_rho", "kg/m3", float(_PLATE.rho), "Plate density, 1 to 1e5 kg/m3",
+              _domain("plate_rho")),
+    parameter("plate.t", "plate_t", "m", _D, "Plate thickness, 1e-7 to 100 m", _domain("plate_t")),
+    parameter("restitution_model", "restitution_model", None, 1,
+              "Elastoplastic COR: 1 = e45 (Eq. 8, default), 2 = e44 (Eq. 7, second branch reconstructed)",
+              vtype="Integer", choices=RESTITUTION_MODELS),
+    parameter("zener_method", "zener_method", None, 1,
+              "Zener COR and contact time: 1 = exact (tabulated ODE solution), 2 = paper_fit (Eqs. 13, 13a), "
+              "3 = linear (Eq. 22), 4 = ode (Eq. 10 integrated at every evaluation)",
+              vtype="Integer", choices=ZENER_METHODS),
+    parameter("plasticity", "plasticity", None, 2,
+              "Elastoplastic effect: 0 = off (e_ep = 1), 1 = on, 2 = auto (skipped where 1 - e_ep < effect_tolerance)",
+              vtype="Integer", choices=EFFECT_MODES, first_code=0),
+    parameter("plate_waves", "plate_waves", None, 2,
+              "Plate-wave effect: 0 = off (e_ze = 1, half-space), 1 = on, "
+              "2 = auto (skipped where 1 - e_ze < effect_tolerance is guaranteed)",
+              vtype="Integer", choices=EFFECT_MODES, first_code=0),
+    parameter("effect_tolerance", "effect_tolerance", "1", 1e-6, "Largest change in e that auto may neglect, >= 0",
+              (0.0, math.inf, False, True)),
+    parameter("zener.ode_tolerance", "ode_rtol", "1", 1e-10,
+              "Relative tolerance of zener_method = 4 (ode), 1e-14 <= tol <= 1e-2 (below what the integrator "
+              "honours it is raised to 2.2e-14 for lambda <= 10, 1e-13 above)",
+              (1e-14, 1e-2, False, False), range_text="1e-14 <= value <= 1e-2"),
+    _feedthrough("e", "e", "1",
+                 "Apparent coefficient of restitution, Eq. (20); < 0: sphere moves on with the plate"),
+    _feedthrough("v_rebound", "v_rebound", "m/s", "Sphere speed away from the plate after impact, e * v_approach"),
+    _feedthrough("jgm.e", "e_ep", "1", "Elastoplastic COR e_ep, Eq. (7) or (8)"),
+    output("jgm.V_c", "V_c", "m/s", "Critical velocity at the onset of yielding, Eq. (6)"),
+    _feedthrough("jgm.V_star", "V_star", "1", "Normalised impact speed V* = v_approach / V_c"),
+    _feedthrough("zener.e", "e_ze", "1", "Zener's COR e_ze (1 where plate waves are off or skipped)"),
+    _feedthrough("zener.lambda", "lam", "1", "Zener's inelasticity parameter lambda, Eq. (12)"),
+    _feedthrough("zener.tau0", "tau0", "1", "Dimensionless contact time tau0 (plate_waves off: 3.2180655, Hertz; "
+                 "skipped by auto: the method's value at lambda = 0; 0 where zener.contact_ends is false)"),
+    _feedthrough("zener.t_contact", "t_contact", "s", "Contact duration T * tau0 (0 when v_approach = 0 "
+                 "or where zener.contact_ends is false)"),
+    _feedthrough("plate.mass_ratio", "mass_ratio", "1", "Sphere mass over the equivalent plate mass of Eq. (19), "
+                 "m_a/m_b = (1 - e_ze)/(1 + e_ze): 0 for a half-space (plate waves off or negligible), 1 when e_ze = 0"),
+    _feedthrough("plate.v_after", "v_plate", "m/s",
+                 "Plate velocity after impact, Eq. (17), positive along the approach"),
+    output("sphere.m", "m_a", "kg", "Sphere mass m_a = rho pi d^3/6 (equivalent plate mass m_b = "
+           "sphere.m / plate.mass_ratio)"),
+    _feedthrough("valid", "valid", None, "Inside both models' validated ranges: lambda <= 1.5 and V* <= 1000",
+                 "Boolean"),
+    _feedthrough("zener.in_range", "lambda_in_range", None, "lambda <= 1.5, Zener's studied range", "Boolean"),
+    _feedthrough("jgm.in_range", "vstar_in_range", None, "V* <= 1000, the range of the JGM fits", "Boolean"),
+    _feedthrough("e_negative", "e_negative", None, "e < 0: the sphere keeps moving with the plate after impact",
+                 "Boolean"),
+    _feedthrough("effects.plasticity", "plasticity_used", None, "The elastoplastic effect was applied (e_ep < 1)",
+                 "Boolean"),
+    _feedthrough("effects.plate_waves", "plate_waves_used", None, "The plate-wave effect was computed", "Boolean"),
+    _feedthrough("zener.contact_ends", "contact_ends", None, "The sphere leaves the plate after a finite contact "
+                 "time (false only for the linear method at lambda >= 2: e_ze = 0, tau0 and t_contact read 0)",
+                 "Boolean"),
+))
+
+
+def fmu_values(**package_values) -> dict:
+    """FMU name -> value for :func:`restitution.impact`'s keyword arguments (``sphere_E=...``,
+    ``zener_method="exact"``, ``v=...``): the one translation from the package's names and words to
+    the FMU's names and codes (``{"sphere.E": ..., "zener_method": 1, "v_approach": ...}``)."""
+    by_key = TABLE.by_key()
+    unknown = [key for key in package_values if key not in by_key]
+    if unknown:
+        raise KeyError(f"not an input or parameter of {TABLE.model}: {', '.join(unknown)}")
+    out = {}
+    for key, value in package_values.items():
+        var = by_key[key]
+        if var.choices is not None and isinstance(value, str):
+            if value not in var.codes:
+                raise ValueError(f"{key} = {value!r} is not one of {', '.join(var.choices)}")
+            value = var.codes[value]
+        out[var.name] = value
+    return out

@@ -1,0 +1,168 @@
+"""The FMUs' interface as data: one row per variable, one table per model (``models/<model>/variables.py``).
+
+Pure data and lookups (no pythonfmu, no fmpy): the pythonfmu slaves register their variables from
+it, the build writes the modelDescription from it, :mod:`restitution.fmu.interface` generates the C
+headers from it, and the host tools (sweeps, scenes, co-simulation helpers, the ctypes binding,
+benchmarks) read names, package keywords and codes from it. Adding a variable is one row here plus
+its physics. Shipped inside the pythonfmu FMUs with the physics (the slaves read it at run time).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+
+__all__ = ["Variable", "Table", "parameter", "input_", "output", "local"]
+
+CAUSALITIES = ("parameter", "input", "output", "local")
+TYPES = ("Real", "Integer", "Boolean")
+
+
+@dataclass(frozen=True)
+class Variable:
+    """One scalar variable of an FMU (units and ranges in SI, as in the modelDescription)."""
+
+    name: str  #: the FMU name ("sphere.E")
+    key: str  #: the package keyword (inputs, parameters) or result field / model quantity (outputs, locals)
+    type: str  #: "Real", "Integer" or "Boolean"
+    causality: str  #: "parameter", "input", "output" or "local"
+    variability: str  #: "fixed", "tunable", "discrete" or "continuous"
+    unit: str | None
+    description: str
+    start: float | int | bool | None = None
+    #: allowed values of an input or parameter: (low, high, low_open, high_open); an infinite bound is
+    #: open (non-finite values are refused); None for outputs and locals
+    interval: tuple | None = None
+    #: the allowed range as an error message shows it (None: from the interval)
+    range_text: str | None = None
+    #: the words of an Integer-coded choice, in code order (code of choices[i] = first_code + i)
+    choices: tuple[str, ...] | None = None
+    first_code: int = 1
+    #: an output that depends directly on the inputs at the same communication point
+    feedthrough: bool = False
+    #: part of the FMU state: every input and parameter, and the outputs and locals the model evolves
+    #: (the others are recomputed from the inputs)
+    state: bool = False
+    vr: int = -1  #: value reference: the row's position in its table
+
+    @property
+    def initial(self) -> str | None:
+        """The ``initial`` attribute the modelDescription declares (outputs and locals are calculated)."""
+        return "calculated" if self.causality in ("output", "local") else None
+
+    @property
+    def codes(self) -> dict[str, int] | None:
+        """word -> code of an Integer-coded choice ({"exact": 1, ...}), else None."""
+        if self.choices is None:
+            return None
+        return {word: self.first_code + i for i, word in enumerate(self.choices)}
+
+    def word(self, code: int) -> str:
+        """The choice a code stands for (ValueError for another code)."""
+        if self.choices is None or not self.first_code <= int(code) < self.first_code + len(self.choices):
+            raise ValueError(f"{self.name} = {code!r} is not one of its codes")
+        return self.choices[int(code) - self.first_code]
+
+    def allowed_text(self) -> str | None:
+        """What a refusal message gives as the allowed range ("0 <= value < 0.5", "1 = e45 or 2 = e44")."""
+        if self.range_text is not None:
+            return self.range_text
+        if self.choices is not None:
+            items = [f"{code} = {word}" for word, code in self.codes.items()]
+            return ", ".join(items[:-1]) + " or " + items[-1] if len(items) > 1 else items[0]
+        if self.interval is None:
+            return None
+        low, high, low_open, high_open = self.interval
+        if high == math.inf:
+            return f"finite and {'>' if low_open else '>='} {low:g}"
+        return f"{low:g} {'<' if low_open else '<='} value {'<' if high_open else '<='} {high:g}"
+
+    def accepts(self, value) -> bool:
+        """Whether ``value`` lies in the allowed interval (NaN and, an infinite bound being open, +-inf never)."""
+        low, high, low_open, high_open = self.interval
+        if self.type == "Integer":
+            value = int(value)  # ValueError for NaN, OverflowError for inf: the caller refuses the value
+        return bool((low < value if low_open else low <= value) and (value < high if high_open else value <= high))
+
+    def xml_limits(self) -> tuple[str | None, str | None]:
+        """The min and max attributes of the modelDescription (None where the bound is infinite)."""
+        low, high = self.interval[:2]
+        return (None if low == -math.inf else f"{low:g}"), (None if high == math.inf else f"{high:g}")
+
+
+def _settable(name, key, vtype, causality, variability, unit, start, description, interval=None, *,
+              choices=None, first_code=1, range_text=None):
+    if choices is not None:
+        interval = (first_code, first_code + len(choices) - 1, False, False)
+    if interval is None:
+        interval = (0.0, math.inf, True, True)  # finite and > 0: the usual physical quantity
+    return Variable(name, key, vtype, causality, variability, unit, description, start, tuple(interval), range_text,
+                    tuple(choices) if choices is not None else None, first_code, state=True)
+
+
+def parameter(name, key, unit, start, description, interval=None, *, vtype="Real", variability="tunable", **kw):
+    """A parameter (tunable unless said otherwise); ``interval`` default: finite and > 0."""
+    return _settable(name, key, vtype, "parameter", variability, unit, start, description, interval, **kw)
+
+
+def input_(name, key, unit, start, description, interval=None, **kw):
+    """A continuous Real input; ``interval`` default: finite and > 0."""
+    return _settable(name, key, "Real", "input", "continuous", unit, start, description, interval, **kw)
+
+
+def output(name, key, unit, description, *, vtype="Real", feedthrough=False, state=False):
+    """An output (Reals continuous, Integers and Booleans discrete)."""
+    variability = "continuous" if vtype == "Real" else "discrete"
+    return Variable(name, key, vtype, "output", variability, unit, description, feedthrough=feedthrough, state=state)
+
+
+def local(name, key, unit, description, *, state=True):
+    """A continuous Real local variable (one the model evolves: part of the state)."""
+    return Variable(name, key, "Real", "local", "continuous", unit, description, state=state)
+
+
+class Table:
+    """The variables of one model, value reference = position; looked up by FMU name."""
+
+    def __init__(self, model: str, description: str, rows):
+        self.model = model
+        self.description = description
+        self.rows = tuple(replace(row, vr=i) for i, row in enumerate(rows))
+        self._by_name = {row.name: row for row in self.rows}
+        if len(self._by_name) != len(self.rows):
+            raise ValueError(f"{model}: two variables share a name")
+        for row in self.rows:
+            if row.type not in TYPES or row.causality not in CAUSALITIES:
+                raise ValueError(f"{model}.{row.name}: unknown type {row.type!r} or causality {row.causality!r}")
+
+    def __getitem__(self, name: str) -> Variable:
+        return self._by_name[name]
+
+    def __contains__(self, name: str) -> bool:
+        return name in self._by_name
+
+    def __iter__(self):
+        return iter(self.rows)
+
+    def __len__(self):
+        return len(self.rows)
+
+    @property
+    def settable(self) -> tuple[Variable, ...]:
+        """The inputs and parameters, in value-reference order."""
+        return tuple(row for row in self.rows if row.causality in ("parameter", "input"))
+
+    @property
+    def outputs(self) -> tuple[Variable, ...]:
+        return tuple(row for row in self.rows if row.causality == "output")
+
+    @property
+    def choices(self) -> dict[str, dict[str, int]]:
+        """FMU name -> {word: code} of every Integer-coded choice."""
+        return {row.name: row.codes for row in self.rows if row.choices is not None}
+
+    def key_of(self, name: str) -> str:
+        return self._by_name[name].key
+
+    def by_key(self, causalities=("parameter", "input")) -> dict[str, Variable]:
+        """Package keyword (or result field) -> variable, for the given causalities."""
+        return {row.key: row for row in self.rows if row.causality in causalities}
