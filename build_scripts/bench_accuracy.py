@@ -57,7 +57,7 @@ import restitution as r  # noqa: E402
 from restitution.jgm import restitution_e44, restitution_e45  # noqa: E402
 from restitution.zener import TAU0_HERTZ, zener_restitution  # noqa: E402
 
-#: The benchmark's targets (issue 5): name -> (goal text, test on the measured value).
+#: The benchmark's targets: name -> (goal text, test on the measured value).
 TARGETS = {
     "exact_rel_error": ("<= 1e-8", lambda x: x <= 1e-8),
     "exact_over_paper_fit_package": ("<= 2x", lambda x: x <= 2.0),
@@ -412,7 +412,7 @@ def build_fmus(work: Path) -> dict:
     from pythonfmu.builder import FmuBuilder
     from restitution.fmu.build import FMUS, build_one
     from restitution.fmu.models import table
-    from restitution.fmu.native_host.make_standalone import make_standalone
+    from restitution.fmu.build_guard import make_standalone
 
     out = {"SpherePlateImpact": build_one("SpherePlateImpact", work)}
     if "BouncingBall" in FMUS:
@@ -812,7 +812,7 @@ def markdown(res: dict, cfg_name: str, elapsed: float) -> str:
     g = fmu["get_e_only"]
     lines += [
         f"The trivial FMU has the same {n_vars} variables as SpherePlateImpact (same types and causalities) "
-        "and does nothing, and carries the same native loader (restitution/fmu/native_host): its round trip is "
+        "and does nothing, and carries the same native loader (restitution/fmu/pythonfmu_guard): its round trip is "
         "what pythonfmu, the loader and fmpy cost. The SpherePlateImpact slave reads "
         "its cached outputs in one pass per `fmi2GetReal`/`fmi2GetBoolean` call instead of pythonfmu's "
         "getter per variable; the row *trivial FMU, one-pass getters* is the floor with that same change, "

@@ -397,7 +397,7 @@ def build_floor(work: Path, model_description: str) -> Path:
     model info, :data:`FLOOR_GLUE`, compiled by ``build_native.compile_binary`` (gcc, the native FMU's
     flags); its modelDescription is the native FMU's."""
     from restitution.fmu.interface import c_header, model_info_header
-    from restitution.fmu.native import build_native as bn
+    from restitution.fmu import build_native as bn
 
     stage = work / "floor"
     sources = stage / "sources"
@@ -417,7 +417,7 @@ def build_floor(work: Path, model_description: str) -> Path:
 
 def _compile(out: Path, sources: list[Path], includes: list[Path], libs: list[str]) -> Path:
     """gcc with the native build's flags (C99, -Wall -Wextra -Werror -pedantic, -O2, no FMA contraction)."""
-    from restitution.fmu.native.compile import CFLAGS
+    from restitution.fmu.compile import CFLAGS
 
     cmd = ["gcc", *CFLAGS, *(f"-I{p}" for p in includes), "-o", str(out), *map(str, sources), *libs]
     done = subprocess.run(cmd, capture_output=True, text=True)
@@ -429,8 +429,8 @@ def _compile(out: Path, sources: list[Path], includes: list[Path], libs: list[st
 def build_all(work: Path, log=None) -> Built:
     """Build everything the benchmark times into ``work`` (an empty scratch directory)."""
     from restitution.fmu.build import build_one
-    from restitution.fmu.native.build_native import build_native_one, fmi2_include_dir
-    from restitution.fmu.native.compile import prepare_sources
+    from restitution.fmu.build_native import build_native_one, fmi2_include_dir
+    from restitution.fmu.compile import prepare_sources
 
     log = log or (lambda message: None)
     if shutil.which("gcc") is None:

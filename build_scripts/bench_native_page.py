@@ -5,7 +5,7 @@ import math
 
 from bench_native_timing import METHODS
 
-#: The goals of issue 12: key -> (what is measured, goal text, test on the measured value). Ratios are
+#: The native FMUs' cost goals: key -> (what is measured, goal text, test on the measured value). Ratios are
 #: medians over the repeats of the ratio within a repeat; the absolute figure a median of batches.
 TARGETS = {
     "native_over_floor_fmpy": (

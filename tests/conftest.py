@@ -6,8 +6,10 @@ import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "build_scripts"))
-# the slave modules (sphere_plate_impact_slave, ...) import by name, as the FMUs do
-sys.path.insert(0, str(ROOT / "fmu_src" / "restitution" / "fmu" / "slaves"))
+# the slave modules (sphere_plate_impact_slave, ...) and what they share import by name, as in the FMUs
+MODELS = ROOT / "fmu_src" / "restitution" / "fmu" / "models"
+for _folder in (MODELS / "sphere_plate_impact", MODELS / "bouncing_ball", MODELS):
+    sys.path.insert(0, str(_folder))
 
 
 @pytest.fixture(scope="session")

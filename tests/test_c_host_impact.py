@@ -36,7 +36,7 @@ HOST_SOURCE = ROOT / "tests" / "c_host" / "fmi2_script_host.c"
 MODEL = "SpherePlateImpact"
 
 pytestmark = [
-    pytest.mark.skipif(not sys.platform.startswith("linux"), reason="Linux-only (linux64 shim)"),
+    pytest.mark.skipif(not sys.platform.startswith("linux"), reason="Linux-only (linux64 guard)"),
     pytest.mark.skipif(shutil.which("gcc") is None, reason="gcc not available"),
 ]
 
@@ -177,7 +177,7 @@ def test_the_fmu_runs_in_a_plain_c_host_and_matches_the_package(host, any_impact
     assert run.returncode == 0, run.stdout[-3000:] + run.stderr  # also: no crash at process exit
     assert run.libpython == (not native), "libpython is in the native FMU's process" if native else run.stdout[-300:]
     if not native:
-        assert any("native-host shim: started embedded Python" in line for line in run.logs), run.logs[:3]
+        assert any("pythonfmu guard: started embedded Python" in line for line in run.logs), run.logs[:3]
     bad = [s for s in run.statuses if s[2] != "OK"]
     assert bad == [("set_real", "1", "Error")], bad
     assert any(line.startswith("impact_b Error") and "plate.t = nan is outside the allowed range: 1e-07 <= value <= 100"

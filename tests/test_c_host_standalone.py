@@ -1,4 +1,4 @@
-"""A pythonfmu FMU post-processed by restitution/fmu/native_host/make_standalone.py
+"""A pythonfmu FMU post-processed by restitution/fmu/build_guard.py
 must run in a plain C FMI host (no LD_PRELOAD, no PYTHONPATH/PYTHONHOME, no
 venv, PATH=/usr/bin:/bin), must keep running in Python hosts (fmpy), and must
 fail cleanly (log message + NULL instance) when its interpreter is missing.
@@ -19,10 +19,10 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 HOST_SOURCE = ROOT / "tests" / "c_host" / "fmi2_script_host.c"
-MAKE_STANDALONE = ROOT / "fmu_src" / "restitution" / "fmu" / "native_host" / "make_standalone.py"
+MAKE_STANDALONE = ROOT / "fmu_src" / "restitution" / "fmu" / "build_guard.py"
 
 pytestmark = [
-    pytest.mark.skipif(not sys.platform.startswith("linux"), reason="Linux-only (linux64 shim)"),
+    pytest.mark.skipif(not sys.platform.startswith("linux"), reason="Linux-only (linux64 guard)"),
     pytest.mark.skipif(shutil.which("gcc") is None, reason="gcc not available"),
 ]
 

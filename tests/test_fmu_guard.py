@@ -1,4 +1,4 @@
-"""The FMUs never take their host down (issue 11): the C front in front of pythonfmu, and the same
+"""The FMUs never take their host down: the C front in front of pythonfmu, and the same
 front in the native FMUs.
 
 Every hostile scenario runs in a child process (tests/fmi_child.py) whose exit code is asserted, so

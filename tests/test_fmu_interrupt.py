@@ -7,7 +7,7 @@ Python handler raised KeyboardInterrupt; pythonfmu answered fmi2Fatal ("[getBool
 PyObject_CallMethod"), the instance was latched for good and fmpy raised FMICallException instead of
 KeyboardInterrupt: 5-10 % of the SIGINTs here, and 55 % of SIGTERMs with a Python handler (not held back
 during calls at all). See "Ctrl-C and SIGTERM in a Python host" in
-fmu_src/restitution/fmu/native_host/README.md for what the guard does about it.
+fmu_src/restitution/fmu/pythonfmu_guard/README.md for what the guard does about it.
 
 Each scenario runs in a child process (tests/fmi_child.py) under a timeout. A sender thread in the child
 fires the signal at the process at random moments, through a POSIX timer (on time whoever holds the

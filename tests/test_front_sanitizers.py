@@ -34,7 +34,7 @@ pytestmark = [
 
 
 def _fmi2_headers():
-    from restitution.fmu.native.build_native import fmi2_include_dir
+    from restitution.fmu.build_native import fmi2_include_dir
 
     return fmi2_include_dir()
 
@@ -67,7 +67,7 @@ def _sanitized_native(fmu, model, dest):
 def _sanitized_guard(fmu, model, dest):
     """The pythonfmu FMU unpacked, its guard rebuilt with the sanitizers."""
     from restitution.fmu.interface import c_header
-    from restitution.fmu.native_host import make_standalone as ms
+    from restitution.fmu import build_guard as ms
 
     unpacked = _unpack(fmu, dest)
     real = unpacked / "binaries" / "linux64" / f"{model}{ms.REAL_SUFFIX}.so"

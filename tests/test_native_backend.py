@@ -20,8 +20,8 @@ import restitution as r
 from restitution.agreement import disagreements, tolerances
 from restitution.fmu.interface import variables
 from restitution.model import published
-from restitution.fmu.native.build_native import write_backend
-from restitution.fmu.native.compile import CFLAGS, prepare_sources
+from restitution.fmu.build_native import write_backend
+from restitution.fmu.compile import CFLAGS, prepare_sources
 
 from test_hard_cases import FMU_FLAGS, FMU_REALS
 from test_native_physics import NAMES, random_cases
@@ -161,7 +161,7 @@ def test_backends_take_hostile_store_values_under_sanitizers(tmp_path):
     an ASan + UBSan build (any report aborts) run as a child process: no undefined behaviour (a code
     beyond int is never cast), no hang, no crash. The front rejects such values before they get here;
     this is the backends' own defence."""
-    from restitution.fmu.native.compile import prepare_sources
+    from restitution.fmu.compile import prepare_sources
 
     src = prepare_sources(tmp_path / "src")
     write_backend("SpherePlateImpact", src)

@@ -18,8 +18,8 @@ import numpy as np
 import pytest
 
 from restitution.fmu.interface import variables
-from restitution.fmu.native.build_native import write_backend
-from restitution.fmu.native.compile import CFLAGS
+from restitution.fmu.build_native import write_backend
+from restitution.fmu.compile import CFLAGS
 
 pytestmark = pytest.mark.skipif(shutil.which("gcc") is None, reason="gcc is needed to compile the native backend")
 

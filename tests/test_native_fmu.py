@@ -21,7 +21,7 @@ from hypothesis import strategies as st
 import restitution as r
 from restitution.agreement import disagreements, tolerances
 from restitution.model import published
-from restitution.fmu.native.build_native import (GENERATION_TOOL, NativeBuildSkipped, front_files,
+from restitution.fmu.build_native import (GENERATION_TOOL, NativeBuildSkipped, front_files,
                                                  native_model_description)
 
 from test_hard_cases import FMU_FLAGS, FMU_REALS, params_for

@@ -1,4 +1,4 @@
-"""The native FMUs (C only, no Python: DIR/native/*.fmu) in the hosts issue 12 lists, each test skipping
+"""The native FMUs (C only, no Python: DIR/native/*.fmu) in real hosts, each test skipping
 with the reason where its tool is missing. (The win64 DLL under Wine: tests/test_native_win64.py.)
 
 1. OSP libcosim (libcosimpy): BouncingBall + SpherePlateImpact from the OspSystemStructure.xml that

@@ -1,4 +1,4 @@
-"""The native C physics (fmu_src/restitution/fmu/native/rst_physics.c) is the package's model.
+"""The native C physics (fmu_src/restitution/fmu/physics_c/rst_physics.c) is the package's model.
 
 The C is compiled into a shared library in a temp dir and called through ctypes. Every output and
 every flag is compared with :func:`restitution.impact` (the authoritative implementation) within
@@ -25,8 +25,8 @@ import pytest
 
 import restitution as r
 from restitution.agreement import disagreements, tolerances
-from restitution.fmu.native.compile import CFLAGS, compile_shared, prepare_sources
-from restitution.fmu.native.physics_ctypes import METHOD_CODE, MODE_CODE, MODEL_CODE, UNSUPPORTED, NativePhysics
+from restitution.fmu.compile import CFLAGS, compile_shared, prepare_sources
+from restitution.fmu.physics_c.physics_ctypes import METHOD_CODE, MODE_CODE, MODEL_CODE, UNSUPPORTED, NativePhysics
 from restitution.model import DOMAIN, PARAMETERS
 
 from test_hard_cases import PAIRS, SPEEDS, T_OVER_D, params_for

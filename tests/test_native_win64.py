@@ -32,7 +32,7 @@ import pytest
 
 import restitution as r
 from restitution.agreement import disagreements, tolerances
-from restitution.fmu.native.compile import CFLAGS, prepare_sources
+from restitution.fmu.compile import CFLAGS, prepare_sources
 
 from test_hard_cases import FMU_FLAGS, FMU_REALS, PAIRS, params_for
 from test_native_physics import _DRIVER, NAMES, random_cases

@@ -1,4 +1,4 @@
-"""Scenes lose nothing and flag what they extrapolate (issue 13): every finished drop on disk,
+"""Scenes lose nothing and flag what they extrapolate: every finished drop on disk,
 Ctrl-C (SIGINT to the child's process group, as a terminal sends it) writes what is done and exits
 130, validity columns and counts, values the FMU would reject refused by the loader naming the key
 (and a value an FMU refuses at run time reported the same way), one-line errors, progress output

@@ -220,7 +220,7 @@ def test_fewer_columns_same_numbers(serial, impact_fmu):
     spec = SweepSpec(**SPEC)
     for backend in ("package", "fmu"):
         res = run_sweep(spec, backend, fmu=impact_fmu, scheduler="serial", columns=["v_approach", "e", "valid"])
-        # case, pair, ok and the validity flags travel with every row (issue 13)
+        # case, pair, ok and the validity flags travel with every row
         assert list(res.columns) == ["case", "pair", "v_approach", "e", "valid", "zener.in_range", "jgm.in_range",
                                      "ok"]
         for name in res.columns:

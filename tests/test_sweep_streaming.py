@@ -1,4 +1,4 @@
-"""Sweeps lose nothing (issue 13): finished chunks on disk as they complete, Ctrl-C (SIGINT to the
+"""Sweeps lose nothing: finished chunks on disk as they complete, Ctrl-C (SIGINT to the
 process group, as a terminal sends it) writes what is done and exits 130, --resume completes only
 the missing chunks and gives the table of an uninterrupted run, for both back ends, serially and
 on a 2-worker LocalCluster; guards before any work (case counts, axis sizes, memory budget or

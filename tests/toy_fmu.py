@@ -13,7 +13,7 @@ def build_toy_fmu(work: Path, module: str, source: str, model: str) -> Path:
     module name: FMU scripts sharing one clash in a process), with the project's guard in front of
     pythonfmu's binary, as every project FMU has (a plain pythonfmu 0.7 binary also frees its static
     PyState twice at process exit, which can abort the test process)."""
-    from restitution.fmu.native_host.make_standalone import make_standalone
+    from restitution.fmu.build_guard import make_standalone
 
     script = work / f"{module}.py"
     script.write_text(textwrap.dedent(source))

@@ -1,9 +1,17 @@
 """Building the project's FMUs from the installed package (``python -m restitution.fmu build``).
 
-The interface tables (``table.py``, ``models/<model>/variables.py``), the slave scripts (``slaves/``),
-the plain-C-host loader (``native_host/``) and the build ship with the package, so an installed
-``restitution[fmu]`` builds the same FMUs as a source checkout. The build is imported on first use:
-the pythonfmu FMUs bundle the interface tables, never the build.
+Everything an FMU is made of ships with the package, so an installed ``restitution[fmu]`` builds the
+same FMUs as a source checkout:
+
+* ``table.py`` and ``models/<model>/``: each model's interface table (``variables.py``), its pythonfmu
+  slave, its native C backend and glue;
+* ``cfront/``: the C FMI front (the FMI 2.0 plumbing, written once for every model and both
+  implementations); ``physics_c/``: the physics in C99; ``pythonfmu_guard/``: the guard's backend that
+  forwards checked calls to pythonfmu, and its Python loader for plain C hosts;
+* the build, here: ``build.py`` (the pythonfmu FMUs, and the entry points), ``build_native.py``,
+  ``build_guard.py``, ``interface.py`` (the C headers from the tables), ``compile.py``, ``sources.py``.
+
+The build is imported on first use: the pythonfmu FMUs bundle the interface tables, never the build.
 """
 __all__ = ["FMUS", "BuildError", "build_all", "build_one", "default_fmu", "default_fmu_dir"]
 

@@ -16,7 +16,7 @@ def main(argv=None) -> int:
     build.add_argument("--out", type=Path, default=None,
                        help=f"output directory (default: {default_fmu_dir()})")
     build.add_argument("--python-hosts-only", action="store_true",
-                       help="skip the plain-C-host loader (the FMUs then need a Python host)")
+                       help="skip the pythonfmu guard (the C checks of every FMI call, and the loader for plain C hosts; the FMUs then need a Python host)")
     args = parser.parse_args(argv)
     out = args.out if args.out is not None else default_fmu_dir()
     try:

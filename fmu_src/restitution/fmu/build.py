@@ -12,9 +12,9 @@ the installed ``restitution`` package (the same source ``pip install`` installs)
   never reads the XML;
 * records a hash of the sources it was built from (``resources/build_info.json``), which
   :func:`default_fmu` compares to decide whether an FMU is stale;
-* puts the guard in front of pythonfmu's Linux binary (``native_host.make_standalone``: the C FMI
+* puts the guard in front of pythonfmu's Linux binary (``build_guard.make_standalone``: the C FMI
   front checks every call against the FMI 2.0 state machine and the interface table generated
-  from the slave's VARIABLES, and the binary also loads in plain C hosts; needs gcc, without it
+  from the model's interface table, and the binary also loads in plain C hosts; needs gcc, without it
   the FMU is built for Python hosts only, unguarded, and the build says so);
 * checks the result with fmpy's validation.
 
@@ -23,8 +23,6 @@ Everything is built in a temporary directory beside the output and moved into pl
 """
 from __future__ import annotations
 
-import hashlib
-import importlib
 import json
 import os
 import shutil
@@ -34,21 +32,11 @@ import zipfile
 from pathlib import Path
 from xml.etree import ElementTree as ET
 
-from .models import table
+from .models import FOLDERS, SLAVE_SUPPORT, slave_script, table
+from .sources import BUILD_INFO, PACKAGE, bundle_filter, recorded_source_hash, source_hash
 
-HERE = Path(__file__).resolve().parent
-PACKAGE = HERE.parent  # the restitution package the FMUs bundle
-SLAVES = HERE / "slaves"
-MODELS = HERE / "models"
-
-#: FMU model identifier -> pythonfmu slave script (shipped with the package).
-FMUS = {"SpherePlateImpact": SLAVES / "sphere_plate_impact_slave.py",
-        "BouncingBall": SLAVES / "bouncing_ball_slave.py"}
-#: What both slaves import, shipped beside each script in resources/.
-SLAVE_SUPPORT = SLAVES / "restitution_slave_support.py"
-
-#: Where the build records what it was built from, inside the FMU.
-BUILD_INFO = "resources/build_info.json"
+#: FMU model identifier -> pythonfmu slave script (shipped with the package, in the model's folder).
+FMUS = {model: slave_script(model) for model in FOLDERS}
 
 
 class BuildError(RuntimeError):
@@ -140,65 +128,6 @@ def _rewrite_zip(fmu: Path, transform=None, member: str | None = None, extra: di
     tmp.replace(fmu)
 
 
-#: Subfolders of the package the FMUs bundle; the others (cosim/, scene/, sweep/, ...) are host-side
-#: helpers whose imports (fmpy, dask, matplotlib, ...) the slaves never need. Bundling them made the
-#: plain-C-host loader require those packages at start-up (python_env.txt require=).
-BUNDLED_SUBDIRS = {"data"}
-#: Of fmu/, the slaves need only the interface tables (pure data): these files, and models/*/variables.py.
-BUNDLED_FMU_FILES = {"__init__.py", "table.py"}
-
-
-def _physics_only(directory, names):
-    """copytree filter: no caches; below the package root only BUNDLED_SUBDIRS and, of fmu/, the
-    interface tables."""
-    ignored = set(shutil.ignore_patterns("__pycache__", "*.pyc", "*.egg-info")(directory, names))
-    here = Path(directory).resolve()
-    if here == PACKAGE.resolve():
-        ignored |= {n for n in names if (PACKAGE / n).is_dir() and n not in BUNDLED_SUBDIRS | {"fmu"}}
-    elif here == HERE:
-        ignored |= {n for n in names if n not in BUNDLED_FMU_FILES | {"models"}}
-    elif here == MODELS or here.parent == MODELS:
-        ignored |= {n for n in names if (here / n).is_file() and n not in ("__init__.py", "variables.py")}
-    return ignored
-
-
-def _table_files() -> list[Path]:
-    """The interface tables' files the FMUs bundle (see :func:`_physics_only`)."""
-    return ([HERE / name for name in sorted(BUNDLED_FMU_FILES)] + [MODELS / "__init__.py"]
-            + sorted(MODELS.glob("*/__init__.py")) + sorted(MODELS.glob("*/variables.py")))
-
-
-def source_files(model: str) -> list[Path]:
-    """Every file ``<model>.fmu`` is built from: the slave, the bundled physics modules and data,
-    this build module, the interface table's generator and the guard (C front and native-host loader)."""
-    files = [FMUS[model], SLAVE_SUPPORT, Path(__file__).resolve(), HERE / "interface.py", *_table_files()]
-    files += sorted((HERE / "cfront").glob("*.[ch]"))
-    files += sorted((HERE / "native_host").glob("*.[ch]")) + sorted((HERE / "native_host").glob("*.py"))
-    files += sorted(PACKAGE.glob("*.py"))
-    for sub in sorted(BUNDLED_SUBDIRS):
-        files += sorted(p for p in (PACKAGE / sub).rglob("*") if p.is_file() and "__pycache__" not in p.parts)
-    return files
-
-
-def source_hash(model: str) -> str:
-    """SHA-256 over the names and contents of :func:`source_files` (what makes an FMU stale)."""
-    digest = hashlib.sha256()
-    for path in source_files(model):
-        digest.update(path.relative_to(PACKAGE).as_posix().encode() + b"\0")
-        digest.update(path.read_bytes())
-        digest.update(b"\0")
-    return digest.hexdigest()
-
-
-def recorded_source_hash(fmu: Path) -> str | None:
-    """The source hash recorded in a built FMU, or None (not ours, older build, unreadable)."""
-    try:
-        with zipfile.ZipFile(fmu) as z:
-            return json.loads(z.read(BUILD_INFO)).get("source_hash")
-    except (OSError, KeyError, ValueError, zipfile.BadZipFile):
-        return None
-
-
 def _umask() -> int:
     mask = os.umask(0o022)
     os.umask(mask)
@@ -243,7 +172,9 @@ def build_one(model: str, out_dir: Path, standalone: bool = True, log=None) -> P
     out_dir = _writable_dir(out_dir)
     with tempfile.TemporaryDirectory(prefix=f".{model}-build-", dir=out_dir) as tmp:
         staged = Path(tmp) / "stage" / "restitution"
-        shutil.copytree(PACKAGE, staged, ignore=_physics_only)
+        shutil.copytree(PACKAGE, staged, ignore=bundle_filter)
+        if str(SLAVE_SUPPORT.parent) not in sys.path:  # pythonfmu imports the slave, which imports it by name
+            sys.path.append(str(SLAVE_SUPPORT.parent))
         fmu = Path(FmuBuilder.build_FMU(script, dest=tmp, project_files=[staged, SLAVE_SUPPORT],
                                         canGetAndSetFMUstate=True, canSerializeFMUstate=True))
         info = json.dumps({"model": model, "source_hash": source_hash(model)}, indent=1)
@@ -253,8 +184,8 @@ def build_one(model: str, out_dir: Path, standalone: bool = True, log=None) -> P
             log(f"warning: gcc not found: {model}.fmu is built for Python hosts only (fmpy, libcosimpy), "
                 "without the C guard that checks every FMI call; install gcc")
         elif standalone:
+            from .build_guard import make_standalone
             from .interface import c_header
-            from .native_host.make_standalone import make_standalone
             make_standalone(fmu, interface_header=c_header(model))
         problems = validate_fmu(str(fmu))
         if problems:
@@ -268,7 +199,7 @@ def build_one(model: str, out_dir: Path, standalone: bool = True, log=None) -> P
 def build_all(out_dir: Path, standalone: bool = True, log=None) -> list[Path]:
     """Build every FMU of the project into ``out_dir``, then their native twins into ``out_dir/native``."""
     built = [build_one(model, out_dir, standalone=standalone, log=log) for model in FMUS]
-    from .native.build_native import build_native  # native FMUs (issue 12): skipped with a message where they cannot be built
+    from .build_native import build_native  # skipped with a message where they cannot be built
     return built + build_native(out_dir, log=log)
 
 

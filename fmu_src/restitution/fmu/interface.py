@@ -28,7 +28,7 @@ def variables(model: str) -> tuple[Variable, ...]:
 
 def variables_from_model_description(xml_text: str) -> list[Variable]:
     """The variables of any pythonfmu FMU, from its modelDescription.xml, for FMUs without a
-    ``VARIABLES`` table (a foreign or toy FMU given to ``make_standalone``). Read at build time only.
+    interface table (a foreign or toy FMU given to ``make_standalone``). Read at build time only.
     Ranges are the declared min/max (closed), or any finite value; every input and parameter is
     part of the state, outputs and locals are not (pythonfmu cannot say which the model evolves)."""
     from xml.etree import ElementTree as ET

@@ -1,10 +1,10 @@
 /* The project's FMI 2.0 co-simulation front: one C implementation of everything an FMU owes its host
- * before any model code runs, shared by the guard in front of pythonfmu (native_host/) and by the
+ * before any model code runs, shared by the guard in front of pythonfmu (pythonfmu_guard/) and by the
  * native FMUs (native/).
  *
  * rst_front.c exports every FMI 2.0 co-simulation function. It checks each call against the FMI 2.0
  * co-simulation state machine and its arguments against the interface table (generated from the
- * slave's VARIABLES): unknown value references, wrong types, variables that may not be set in the
+ * model's interface table): unknown value references, wrong types, variables that may not be set in the
  * current mode, values outside their declared range or non-finite, NULL pointers, a wrong GUID, a
  * doStep whose time does not continue the previous one. Anything wrong is answered with fmi2Error and
  * a log message naming the variable, its value and what is allowed, and changes nothing. It keeps

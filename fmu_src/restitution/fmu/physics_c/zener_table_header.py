@@ -7,7 +7,7 @@ written as a C99 hexadecimal literal, so the C table holds the same bits as the 
 large-lambda constants (E_INF, the Chebyshev series of g) and the per-method tau0 at lambda = 0
 come from the package too.
 
-    python -m restitution.fmu.native.zener_table_header > rst_zener_table.h
+    python -m restitution.fmu.physics_c.zener_table_header > rst_zener_table.h
 """
 from __future__ import annotations
 
@@ -38,7 +38,7 @@ def zener_table_header() -> str:
         raise RuntimeError("too many pieces for an unsigned short index")
     lines = [
         "/* The \"exact\" Zener method's table: generated at build time by",
-        " * restitution.fmu.native.zener_table_header from restitution/data/zener_table.npz",
+        " * restitution.fmu.physics_c.zener_table_header from restitution/data/zener_table.npz",
         " * (the pieces restitution.zener_exact evaluates, bit for bit). Do not edit: rebuild. */",
         "#ifndef RST_ZENER_TABLE_H",
         "#define RST_ZENER_TABLE_H",

@@ -6,7 +6,7 @@
 
 #include <math.h>
 
-#include "rst_zener_table.h" /* generated at build time by restitution.fmu.native.zener_table_header */
+#include "rst_zener_table.h" /* generated at build time by restitution.fmu.physics_c.zener_table_header */
 
 #define RST_PI 3.14159265358979311600 /* math.pi */
 

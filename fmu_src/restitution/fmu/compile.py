@@ -1,4 +1,5 @@
-"""Compile the native physics: the generated table header, the C sources and the compiler flags.
+"""Compile the C physics (``physics_c/``): the generated table header, the C sources and the compiler
+flags every C build of the project uses.
 
 :func:`prepare_sources` writes every C file the native build needs into a directory (the physics
 sources shipped in this package and ``rst_zener_table.h`` generated from the package's table);
@@ -10,9 +11,10 @@ import shutil
 import subprocess
 from pathlib import Path
 
-from .zener_table_header import zener_table_header
+from .physics_c.zener_table_header import zener_table_header
 
-HERE = Path(__file__).resolve().parent
+PHYSICS_C = Path(__file__).resolve().parent / "physics_c"
+FRONT = Path(__file__).resolve().parent / "cfront"
 #: The hand-written C sources of the physics (the table header is generated, see :func:`prepare_sources`).
 PHYSICS_SOURCES = ("rst_physics.h", "rst_physics.c")
 TABLE_HEADER = "rst_zener_table.h"
@@ -31,8 +33,8 @@ def prepare_sources(directory: Path) -> Path:
     directory = Path(directory)
     directory.mkdir(parents=True, exist_ok=True)
     for name in PHYSICS_SOURCES:
-        shutil.copyfile(HERE / name, directory / name)
-    shutil.copyfile(HERE.parent / "cfront" / PREFIX_HEADER, directory / PREFIX_HEADER)
+        shutil.copyfile(PHYSICS_C / name, directory / name)
+    shutil.copyfile(FRONT / PREFIX_HEADER, directory / PREFIX_HEADER)
     (directory / TABLE_HEADER).write_text(zener_table_header(), encoding="ascii")
     return directory
 

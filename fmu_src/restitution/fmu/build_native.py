@@ -1,10 +1,11 @@
-"""Build ``DIR/native/SpherePlateImpact.fmu``: the same interface as ``DIR/SpherePlateImpact.fmu``,
-no Python at run time.
+"""Build ``DIR/native/<model>.fmu`` for every model: the same interface as ``DIR/<model>.fmu``, no
+Python at run time.
 
-The FMU is the project's generic C FMI front (``restitution/fmu/cfront``, the guard's state machine,
-checks, logging and value store, driven by the table :func:`restitution.fmu.interface.c_header`
-generates from the slave's ``VARIABLES``) with the native-physics backend of this directory. Its
-modelDescription.xml is the pythonfmu FMU's (which the build completed from the same ``VARIABLES``:
+Each native FMU is the project's C FMI front (``cfront/``: the state machine, checks, logging and
+value store, driven by the table :func:`restitution.fmu.interface.c_header` generates from the model's
+interface table) with the model's C backend and glue (``models/<model>/rst_native_*.c``) and, for
+SpherePlateImpact, the C physics (``physics_c/``). Its modelDescription.xml is the pythonfmu FMU's
+(which the build completed from the same interface table:
 names, value references, types, causalities, variabilities, units, starts, min/max, descriptions,
 ModelStructure), with what belongs to pythonfmu replaced (generation tool, needsExecutionTool) and
 the C sources declared in ``<SourceFiles>`` so a host on another platform can compile ``sources/``.
@@ -25,15 +26,13 @@ import zipfile
 from pathlib import Path
 from xml.etree import ElementTree as ET
 
-from ..interface import model_info_header
-from .compile import CFLAGS, prepare_sources
+from .compile import CFLAGS, PHYSICS_SOURCES, prepare_sources
+from .interface import c_header, model_info_header
+from .models import FOLDERS, native_sources
+from .sources import BUILD_INFO, FRONT, PHYSICS_C, native_source_hash
 
-HERE = Path(__file__).resolve().parent
-FRONT = HERE.parent / "cfront"
-#: Model identifier -> the C files of this directory that implement it: the backend and its glue to
-#: the front (which defines RST_MODEL).
-BACKENDS = {"SpherePlateImpact": ("rst_native_impact.h", "rst_native_impact.c", "rst_native_impact_fmu.c"),
-            "BouncingBall": ("rst_native_ball.h", "rst_native_ball.c", "rst_native_ball_fmu.c")}
+#: The models with a native backend (every one).
+BACKENDS = tuple(FOLDERS)
 #: Models whose backend calls the impact physics (rst_physics.c and the generated Zener table).
 PHYSICS_MODELS = {"SpherePlateImpact"}
 #: The FMI 2.0 headers fmpy ships (used at build time only; not copied into the FMU: FMI 2.0 hosts bring them).
@@ -74,13 +73,11 @@ def front_files() -> list[Path]:
 
 def write_sources(model: str, directory: Path) -> list[str]:
     """Every C file of ``model``'s native FMU into ``directory``; returns the .c files to compile."""
-    from .compile import PHYSICS_SOURCES
-
     front = front_files()
-    needed = (*PHYSICS_SOURCES, *BACKENDS[model]) if model in PHYSICS_MODELS else BACKENDS[model]
-    missing = [name for name in needed if not (HERE / name).is_file()]
-    if missing:  # an installed package without its C files (package-data)
-        raise NativeBuildSkipped(f"C sources missing from {HERE}: {', '.join(missing)}")
+    needed = [PHYSICS_C / name for name in PHYSICS_SOURCES] if model in PHYSICS_MODELS else []
+    missing = [str(path) for path in needed if not path.is_file()]
+    if missing or not native_sources(model):  # an installed package without its C files (package-data)
+        raise NativeBuildSkipped(f"C sources of native {model} missing: {', '.join(missing) or 'its backend'}")
     if model in PHYSICS_MODELS:
         prepare_sources(directory)
     else:
@@ -92,13 +89,12 @@ def write_sources(model: str, directory: Path) -> list[str]:
 
 
 def write_backend(model: str, directory: Path) -> None:
-    """The backend's C files and the interface header they include (generated from the slave's
-    VARIABLES, with the row type it needs, cfront/rst_variable.h, and the prefixing of external
+    """The backend's C files and the interface header they include (generated from the model's
+    interface table, with the row type it needs, cfront/rst_variable.h, and the prefixing of external
     names, cfront/rst_prefix.h)."""
-    from ..interface import c_header
-
-    for name in BACKENDS[model]:
-        shutil.copyfile(HERE / name, directory / name)
+    directory.mkdir(parents=True, exist_ok=True)
+    for path in native_sources(model):
+        shutil.copyfile(path, directory / path.name)
     for header in ("rst_variable.h", "rst_prefix.h"):
         shutil.copyfile(FRONT / header, directory / header)
     (directory / INTERFACE_HEADER.format(model=model)).write_text(c_header(model), encoding="utf-8")
@@ -137,18 +133,6 @@ def compile_binary(model: str, sources: Path, c_files: list[str], platform: str,
     return target
 
 
-def native_source_hash(model: str, python_hash: str) -> str:
-    """SHA-256 over the Python sources' hash (the interface and the physics the C follows) and every C
-    file and generator the native FMU is built from."""
-    import hashlib
-
-    digest = hashlib.sha256(python_hash.encode())
-    paths = front_files() + sorted(HERE.glob("*.[ch]")) + sorted(HERE.glob("*.py"))
-    for path in paths:
-        digest.update(path.name.encode() + b"\0" + path.read_bytes() + b"\0")
-    return digest.hexdigest()
-
-
 def _zip_dir(directory: Path, fmu: Path) -> None:
     with zipfile.ZipFile(fmu, "w", zipfile.ZIP_DEFLATED) as z:
         for path in sorted(directory.rglob("*")):
@@ -159,8 +143,6 @@ def _zip_dir(directory: Path, fmu: Path) -> None:
 def build_native_one(model: str, out_dir: Path, python_fmu: Path, log=None) -> Path:
     """Build and validate ``out_dir/native/<model>.fmu`` beside the pythonfmu ``python_fmu``."""
     from fmpy.validation import validate_fmu
-
-    from ..build import BUILD_INFO, source_hash
 
     log = log or (lambda message: print(message, file=sys.stderr))
     front_files()  # before anything is written: no empty native/ where the front is missing
@@ -184,7 +166,7 @@ def build_native_one(model: str, out_dir: Path, python_fmu: Path, log=None) -> P
                 log(f"warning: native {model}.fmu: {exc}")
         if not built:
             raise NativeBuildSkipped(f"no C compiler for any platform: native {model}.fmu not built")
-        info = {"model": model, "native": True, "source_hash": native_source_hash(model, source_hash(model)),
+        info = {"model": model, "native": True, "source_hash": native_source_hash(model),
                 "platforms": sorted(p.parent.name for p in built)}
         (stage / BUILD_INFO).parent.mkdir(parents=True, exist_ok=True)
         (stage / BUILD_INFO).write_text(json.dumps(info, indent=1), encoding="utf-8")

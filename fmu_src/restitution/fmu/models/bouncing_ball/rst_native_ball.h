@@ -1,4 +1,4 @@
-/* The native BouncingBall backend: the ball of restitution/fmu/slaves/bouncing_ball_slave.py (which is
+/* The native BouncingBall backend: the ball of restitution/fmu/models/bouncing_ball/bouncing_ball_slave.py (which is
  * authoritative) in C99, on a value store holding every variable by value reference.
  *
  * The ball's whole state is in the store (its outputs and the local flight.* variables, as in the

@@ -1,8 +1,8 @@
 /*
- * python_host.c - makes Python available to pythonfmu's binary in any host, and loads that binary.
+ * python_loader.c - makes Python available to pythonfmu's binary in any host, and loads that binary.
  *
  * Part of the guard in front of pythonfmu (pythonfmu_backend.c, on the C front of cfront/). pythonfmu's
- * binary (renamed to <modelIdentifier>_pythonfmu.so by make_standalone.py) does not link libpython: it
+ * binary (renamed to <modelIdentifier>_pythonfmu.so by build_guard.py) does not link libpython: it
  * expects a process that already contains a Python interpreter (fmpy, libcosimpy). In a C host,
  * dlopen fails with "undefined symbol: _Py_NoneStruct". On the first fmi2Instantiate:
  *
@@ -15,15 +15,15 @@
  *      PyGILState_Ensure on every call and skips its own Py_Initialize when Python is running), and
  *      the real binary is loaded.
  *
- * Every failure is logged through the instance's logger; pyhost_ensure_ready then returns 0.
+ * Every failure is logged through the instance's logger; pyloader_ensure_ready then returns 0.
  * The state here is process-wide by nature (one interpreter, one pythonfmu binary per process),
  * guarded by a mutex.
  *
- * With PYHOST_HAVE_PYTHON_H the interpreter is configured with PyConfig (clean error reporting, no
+ * With PYLOADER_HAVE_PYTHON_H the interpreter is configured with PyConfig (clean error reporting, no
  * change to the host's locale or signal handlers) when the loaded libpython has the same major.minor
  * version as the headers; otherwise the legacy Py_SetProgramName/Py_InitializeEx(0) path is used.
  */
-#ifdef PYHOST_HAVE_PYTHON_H
+#ifdef PYLOADER_HAVE_PYTHON_H
 #define PY_SSIZE_T_CLEAN
 #include <Python.h> /* must come first; only types and macros are used */
 #endif
@@ -31,7 +31,7 @@
 #ifndef _GNU_SOURCE
 #define _GNU_SOURCE
 #endif
-#include "python_host.h"
+#include "python_loader.h"
 
 #include <dlfcn.h>
 #include <errno.h>
@@ -47,17 +47,17 @@
 #include <sys/stat.h>
 #include <wchar.h>
 
-#ifndef PYHOST_REAL_BINARY
-#error "define PYHOST_REAL_BINARY, e.g. -DPYHOST_REAL_BINARY='\"Model_pythonfmu.so\"'"
+#ifndef PYLOADER_REAL_BINARY
+#error "define PYLOADER_REAL_BINARY, e.g. -DPYLOADER_REAL_BINARY='\"Model_pythonfmu.so\"'"
 #endif
-#ifndef PYHOST_CONFIG_NAME
-#define PYHOST_CONFIG_NAME "python_env.txt"
+#ifndef PYLOADER_CONFIG_NAME
+#define PYLOADER_CONFIG_NAME "python_env.txt"
 #endif
 
 static pythonfmu_api real;
 
 /* ------------------------------------------------------------------------ */
-/* Python C API, resolved with dlsym (the shim never links libpython)       */
+/* Python C API, resolved with dlsym (the guard never links libpython)       */
 /* ------------------------------------------------------------------------ */
 typedef void PyObj;
 static struct {
@@ -130,14 +130,14 @@ static const char *resolve_python_api(void *handle)
 static pthread_mutex_t g_lock = PTHREAD_MUTEX_INITIALIZER;
 static int g_ready = 0;          /* real binary loaded and forwarding works   */
 static int g_python_failed = 0;  /* our interpreter start failed: unrecoverable */
-static int g_shim_managed = 0;   /* Python started by a shim (this or another) */
+static int g_guard_managed = 0;   /* Python started by a guard (this or another) */
 static void *g_libpython = NULL; /* handle from dlopen(libpython, RTLD_GLOBAL) */
 static void *g_real = NULL;
 
-/* Per-thread Python thread states (only when a shim started the interpreter).
+/* Per-thread Python thread states (only when a guard started the interpreter).
  * pythonfmu wraps every call in PyGILState_Ensure/Release; on a thread that has
  * no Python thread state this creates and destroys one per call (about 10x the
- * cost of the call itself). The shim keeps one thread state per host thread
+ * cost of the call itself). The guard keeps one thread state per host thread
  * (gilstate counter held at 1, GIL released) and deletes it when the thread
  * exits (pthread key destructor). */
 static int g_cache_tstates = 0;
@@ -152,7 +152,7 @@ typedef struct {
     char home[PATH_MAX];       /* sys.base_prefix at build time */
     char version[64];          /* e.g. 3.11.7 */
     int use_environment;       /* honour PYTHONPATH/PYTHONHOME etc. (default 0) */
-} shim_config;
+} guard_config;
 
 /* ------------------------------------------------------------------------ */
 /* Helpers                                                                  */
@@ -165,12 +165,12 @@ static int file_exists(const char *path)
     return path && *path && stat(path, &st) == 0;
 }
 
-/* directory containing this shim library (binaries/linux64) */
-static int shim_directory(char *out, size_t size)
+/* directory containing this guard library (binaries/linux64) */
+static int guard_directory(char *out, size_t size)
 {
     Dl_info info;
     char resolved[PATH_MAX];
-    if (!dladdr((void *)&shim_directory, &info) || !info.dli_fname) return 0;
+    if (!dladdr((void *)&guard_directory, &info) || !info.dli_fname) return 0;
     if (!realpath(info.dli_fname, resolved)) return 0;
     char *slash = strrchr(resolved, '/');
     if (!slash) return 0;
@@ -188,7 +188,7 @@ static void trim(char *s)
     if (i) memmove(s, s + i, n - i + 1);
 }
 
-static int read_config(const char *file, shim_config *cfg)
+static int read_config(const char *file, guard_config *cfg)
 {
     FILE *f = fopen(file, "r");
     if (!f) return 0;
@@ -344,8 +344,8 @@ static void run_preflight(const char *cfg_file, const char *res_dir, char *msg, 
     py.Py_DecRef(sys);
 }
 
-/* Is the running interpreter one started by a shim (marker set in preflight)? */
-static int interpreter_is_shim_managed(void)
+/* Is the running interpreter one started by a guard (marker set in preflight)? */
+static int interpreter_is_guard_managed(void)
 {
     int managed = 0;
     int gil = py.PyGILState_Ensure();
@@ -378,14 +378,14 @@ static inline void attach_thread(void)
     if (!g_cache_tstates || t_attached) return;
     t_attached = 1;
     /* Thread state owned by someone else (the interpreter's main thread, another
-     * FMU's shim, the host)? Then leave it alone: its owner deletes it. */
+     * FMU's guard, the host)? Then leave it alone: its owner deletes it. */
     if (py.PyGILState_GetThisThreadState()) return;
     py.PyGILState_Ensure();                  /* creates this thread's state (counter 1), takes the GIL */
     void *tstate = py.PyEval_SaveThread();   /* releases the GIL, keeps the thread state */
     pthread_setspecific(g_tstate_key, tstate);
 }
 
-__attribute__((destructor)) static void shim_unload(void)
+__attribute__((destructor)) static void guard_unload(void)
 {
     /* the key destructor lives in this library: never call it once unloaded */
     g_cache_tstates = 0;
@@ -407,15 +407,15 @@ __attribute__((destructor)) static void shim_unload(void)
  * binary's static destructors (exit handlers run last-in, first-out): it empties the
  * shared_ptr (pointer and control block, two words), after which both the destructor and
  * onLibraryUnload do nothing; the PyState is left to the process exit (the interpreter is
- * never finalized anyway). make_standalone.py finds the symbol's offset in the binary's
+ * never finalized anyway). build_guard.py finds the symbol's offset in the binary's
  * symbol table at build time; the binary's size guards against a different binary.
  * atexit() from a shared library is tied to that library: glibc runs the handler when the
  * library is dlclosed (fmpy's freeInstance does), not at exit. It then emptied pyState at
  * every unload, leaking the PyState and its finished but never joined std::thread (an 8 MB
- * stack mapping per load/free cycle), and the next instance made a new one. So the shim
+ * stack mapping per load/free cycle), and the next instance made a new one. So the guard
  * pins itself (RTLD_NODELETE) before registering the handler: it stays loaded like the
  * pythonfmu binary, the handler runs once at process exit, and a reload reuses the state. */
-#if defined(PYHOST_PYSTATE_OFFSET) && defined(PYHOST_REAL_SIZE)
+#if defined(PYLOADER_PYSTATE_OFFSET) && defined(PYLOADER_REAL_SIZE)
 static void *g_pystate_slot = NULL;
 
 static void disarm_pythonfmu_pystate(void)
@@ -428,9 +428,9 @@ static void arm_pystate_exit_fix(const char *real_path)
 {
     struct stat st;
     struct link_map *map = NULL;
-    if (stat(real_path, &st) != 0 || st.st_size != (off_t)PYHOST_REAL_SIZE) return;
+    if (stat(real_path, &st) != 0 || st.st_size != (off_t)PYLOADER_REAL_SIZE) return;
     if (dlinfo(g_real, RTLD_DI_LINKMAP, &map) != 0 || !map) return;
-    g_pystate_slot = (void *)(map->l_addr + (uintptr_t)PYHOST_PYSTATE_OFFSET);
+    g_pystate_slot = (void *)(map->l_addr + (uintptr_t)PYLOADER_PYSTATE_OFFSET);
     Dl_info self;
     if (dladdr((void *)&disarm_pythonfmu_pystate, &self) && self.dli_fname)
         dlopen(self.dli_fname, RTLD_LAZY | RTLD_NOLOAD | RTLD_NODELETE); /* never unloaded from now on */
@@ -459,7 +459,7 @@ static void pin_self(void)
 }
 
 /* <home>/bin/python3.X (or python3) of the base installation, if it exists */
-static int base_executable(const shim_config *cfg, char *out, size_t size)
+static int base_executable(const guard_config *cfg, char *out, size_t size)
 {
     int major = 0, minor = 0;
     if (sscanf(cfg->version, "%d.%d", &major, &minor) == 2) {
@@ -470,8 +470,8 @@ static int base_executable(const shim_config *cfg, char *out, size_t size)
     return file_exists(out);
 }
 
-#ifdef PYHOST_HAVE_PYTHON_H
-static int init_with_pyconfig(const shim_config *cfg, rst_instance *inst)
+#ifdef PYLOADER_HAVE_PYTHON_H
+static int init_with_pyconfig(const guard_config *cfg, rst_instance *inst)
 {
     typedef void (*PreInitFn)(PyPreConfig *);
     typedef PyStatus (*PreInitializeFn)(const PyPreConfig *);
@@ -536,7 +536,7 @@ static int init_with_pyconfig(const shim_config *cfg, rst_instance *inst)
 }
 #endif
 
-static int init_legacy(const shim_config *cfg, rst_instance *inst)
+static int init_legacy(const guard_config *cfg, rst_instance *inst)
 {
     if (!py.Py_DecodeLocale || !py.Py_SetProgramName || !py.Py_InitializeEx) {
         LOG_ERROR("%s lacks Py_SetProgramName/Py_InitializeEx; rebuild the FMU with Python headers available",
@@ -574,21 +574,21 @@ static int ensure_ready(rst_instance *inst, const char *resource_dir)
 {
     char bindir[PATH_MAX] = "", cfg_a[PATH_MAX + 64] = "", cfg_b[PATH_MAX + 64] = "";
     char res_dir[PATH_MAX + 64] = "";
-    shim_config cfg;
+    guard_config cfg;
     int have_cfg = 0;
 
     if (g_ready) return 1; /* set up by an earlier fmi2Instantiate */
-    if (!shim_directory(bindir, sizeof bindir)) {
+    if (!guard_directory(bindir, sizeof bindir)) {
         LOG_ERROR("cannot determine the location of the FMU binary (dladdr failed)");
         return 0;
     }
     /* 1. resources next to the unpacked binary, 2. fmuResourceLocation */
-    snprintf(cfg_a, sizeof cfg_a, "%s/../../resources/" PYHOST_CONFIG_NAME, bindir);
+    snprintf(cfg_a, sizeof cfg_a, "%s/../../resources/" PYLOADER_CONFIG_NAME, bindir);
     if (read_config(cfg_a, &cfg)) {
         have_cfg = 1;
         snprintf(res_dir, sizeof res_dir, "%s/../../resources", bindir);
     } else if (resource_dir != NULL) {
-        snprintf(cfg_b, sizeof cfg_b, "%s/" PYHOST_CONFIG_NAME, resource_dir);
+        snprintf(cfg_b, sizeof cfg_b, "%s/" PYLOADER_CONFIG_NAME, resource_dir);
         if (read_config(cfg_b, &cfg)) {
             have_cfg = 1;
             snprintf(res_dir, sizeof res_dir, "%s", resource_dir);
@@ -603,7 +603,7 @@ static int ensure_ready(rst_instance *inst, const char *resource_dir)
         return 0;
     }
 
-    /* Python already in the process? (Python host, or another FMU's shim) */
+    /* Python already in the process? (Python host, or another FMU's guard) */
     void *is_init = dlsym(RTLD_DEFAULT, "Py_IsInitialized");
     if (is_init && ((int (*)(void))is_init)()) {
         const char *missing = resolve_python_api(RTLD_DEFAULT);
@@ -611,14 +611,14 @@ static int ensure_ready(rst_instance *inst, const char *resource_dir)
             LOG_ERROR("Python is running in this process but symbol %s is not visible", missing);
             return 0;
         }
-        g_shim_managed = interpreter_is_shim_managed();
-        rst_log(inst, fmi2OK, "native-host shim: using the Python %s already running "
-                     "in this process%s", py.Py_GetVersion(), g_shim_managed ? " (started by another FMU)" : "");
+        g_guard_managed = interpreter_is_guard_managed();
+        rst_log(inst, fmi2OK, "pythonfmu guard: using the Python %s already running "
+                     "in this process%s", py.Py_GetVersion(), g_guard_managed ? " (started by another FMU)" : "");
     } else {
         if (!have_cfg) {
             LOG_ERROR("this FMU contains Python code and needs a Python interpreter; the host process has none, "
                       "and the configuration file naming the interpreter was not found (looked for %s%s%s). "
-                      "Rebuild the FMU with make_standalone.py or restore that file.",
+                      "Rebuild the FMU with build_guard.py or restore that file.",
                       cfg_a, cfg_b[0] ? " and " : "", cfg_b);
             return 0;
         }
@@ -643,10 +643,10 @@ static int ensure_ready(rst_instance *inst, const char *resource_dir)
         if (cfg.version[0] && !same_major_minor(loaded, cfg.version))
             rst_log(inst, fmi2Warning,     "%s is Python %.10s but the FMU was built with Python %s", cfg.libpython, loaded, cfg.version);
         if (py.Py_IsInitialized()) {
-            g_shim_managed = interpreter_is_shim_managed();
+            g_guard_managed = interpreter_is_guard_managed();
         } else {
             int ok = 0;
-#ifdef PYHOST_HAVE_PYTHON_H
+#ifdef PYLOADER_HAVE_PYTHON_H
             if (same_major_minor(loaded, PY_VERSION))
                 ok = init_with_pyconfig(&cfg, inst);
             else
@@ -660,14 +660,14 @@ static int ensure_ready(rst_instance *inst, const char *resource_dir)
             }
             py.PyEval_SaveThread(); /* release the GIL; pythonfmu uses PyGILState_Ensure */
             t_attached = 1;         /* this thread keeps the main thread state */
-            g_shim_managed = 1;
-            rst_log(inst, fmi2OK, "native-host shim: started embedded Python %s from %s (config %s)",
+            g_guard_managed = 1;
+            rst_log(inst, fmi2OK, "pythonfmu guard: started embedded Python %s from %s (config %s)",
                          py.Py_GetVersion(), cfg.libpython, cfg.file);
         }
     }
 
-#ifndef PYHOST_NO_TSTATE_CACHE
-    if (g_shim_managed && !g_tstate_key_ok && py.PyEval_RestoreThread && py.PyThreadState_Clear &&
+#ifndef PYLOADER_NO_TSTATE_CACHE
+    if (g_guard_managed && !g_tstate_key_ok && py.PyEval_RestoreThread && py.PyThreadState_Clear &&
         py.PyThreadState_DeleteCurrent && py.PyGILState_GetThisThreadState) {
         if (pthread_key_create(&g_tstate_key, release_thread_state) == 0) {
             g_tstate_key_ok = 1;
@@ -677,7 +677,7 @@ static int ensure_ready(rst_instance *inst, const char *resource_dir)
 #endif
 
     /* Put the build environment's site-packages on sys.path and check imports. */
-    if (g_shim_managed && have_cfg) {
+    if (g_guard_managed && have_cfg) {
         char msg[16384];
         int gil = py.PyGILState_Ensure();
         run_preflight(cfg.file, res_dir, msg, sizeof msg);
@@ -691,30 +691,30 @@ static int ensure_ready(rst_instance *inst, const char *resource_dir)
 
     if (!g_real) {
         char path[PATH_MAX + 64];
-        snprintf(path, sizeof path, "%s/" PYHOST_REAL_BINARY, bindir);
+        snprintf(path, sizeof path, "%s/" PYLOADER_REAL_BINARY, bindir);
         g_real = dlopen(path, RTLD_NOW | RTLD_LOCAL);
         if (!g_real) {
             LOG_ERROR("cannot load the pythonfmu binary %s: %s", path, dlerror());
             return 0;
         }
         const char *missing = NULL;
-#define PYHOST_LOAD(field, name)                                                 \
+#define PYLOADER_LOAD(field, name)                                                 \
     if (!(*(void **)(&real.field) = dlsym(g_real, #name)) && !missing) missing = #name;
-        PYHOST_LOAD(Instantiate, fmi2Instantiate)
-        PYHOST_LOAD(FreeInstance, fmi2FreeInstance)
-        PYHOST_LOAD(SetupExperiment, fmi2SetupExperiment)
-        PYHOST_LOAD(EnterInitializationMode, fmi2EnterInitializationMode)
-        PYHOST_LOAD(ExitInitializationMode, fmi2ExitInitializationMode)
-        PYHOST_LOAD(Terminate, fmi2Terminate)
-        PYHOST_LOAD(Reset, fmi2Reset)
-        PYHOST_LOAD(GetReal, fmi2GetReal)
-        PYHOST_LOAD(GetInteger, fmi2GetInteger)
-        PYHOST_LOAD(GetBoolean, fmi2GetBoolean)
-        PYHOST_LOAD(SetReal, fmi2SetReal)
-        PYHOST_LOAD(SetInteger, fmi2SetInteger)
-        PYHOST_LOAD(SetBoolean, fmi2SetBoolean)
-        PYHOST_LOAD(DoStep, fmi2DoStep)
-#undef PYHOST_LOAD
+        PYLOADER_LOAD(Instantiate, fmi2Instantiate)
+        PYLOADER_LOAD(FreeInstance, fmi2FreeInstance)
+        PYLOADER_LOAD(SetupExperiment, fmi2SetupExperiment)
+        PYLOADER_LOAD(EnterInitializationMode, fmi2EnterInitializationMode)
+        PYLOADER_LOAD(ExitInitializationMode, fmi2ExitInitializationMode)
+        PYLOADER_LOAD(Terminate, fmi2Terminate)
+        PYLOADER_LOAD(Reset, fmi2Reset)
+        PYLOADER_LOAD(GetReal, fmi2GetReal)
+        PYLOADER_LOAD(GetInteger, fmi2GetInteger)
+        PYLOADER_LOAD(GetBoolean, fmi2GetBoolean)
+        PYLOADER_LOAD(SetReal, fmi2SetReal)
+        PYLOADER_LOAD(SetInteger, fmi2SetInteger)
+        PYLOADER_LOAD(SetBoolean, fmi2SetBoolean)
+        PYLOADER_LOAD(DoStep, fmi2DoStep)
+#undef PYLOADER_LOAD
         if (missing) {
             LOG_ERROR("%s does not export %s", path, missing);
             dlclose(g_real);
@@ -731,7 +731,7 @@ static int ensure_ready(rst_instance *inst, const char *resource_dir)
 /* ------------------------------------------------------------------------ */
 /* Public                                                                   */
 /* ------------------------------------------------------------------------ */
-const pythonfmu_api *pyhost_ensure_ready(rst_instance *inst, const char *resource_dir)
+const pythonfmu_api *pyloader_ensure_ready(rst_instance *inst, const char *resource_dir)
 {
     int ok;
     pthread_mutex_lock(&g_lock);
@@ -743,7 +743,7 @@ const pythonfmu_api *pyhost_ensure_ready(rst_instance *inst, const char *resourc
     return &real;
 }
 
-void pyhost_attach_thread(void) { attach_thread(); }
+void pyloader_attach_thread(void) { attach_thread(); }
 
 /* ------------------------------------------------------------------------ */
 /* Signal handlers that were due before a call (Python hosts only)          */
@@ -756,11 +756,11 @@ void pyhost_attach_thread(void) { attach_thread(); }
  * exception stops it, so it is called again until nothing more fails. */
 static int pending_ready(void)
 {
-    return !g_shim_managed && py.Py_MakePendingCalls && py.Py_AddPendingCall && py.PyErr_Fetch &&
+    return !g_guard_managed && py.Py_MakePendingCalls && py.Py_AddPendingCall && py.PyErr_Fetch &&
            py.PyErr_Restore;
 }
 
-void pyhost_enter_call(pyhost_call *call)
+void pyloader_enter_call(pyloader_call *call)
 {
     if (call == NULL)
         return;
@@ -768,8 +768,8 @@ void pyhost_enter_call(pyhost_call *call)
     call->n_raised = 0;
     if (!pending_ready())
         return;
-    call->gil = py.PyGILState_Ensure(); /* held until pyhost_leave_call: pythonfmu's Ensure only counts */
-    while (call->n_raised < PYHOST_MAX_RAISED && py.Py_MakePendingCalls() != 0) {
+    call->gil = py.PyGILState_Ensure(); /* held until pyloader_leave_call: pythonfmu's Ensure only counts */
+    while (call->n_raised < PYLOADER_MAX_RAISED && py.Py_MakePendingCalls() != 0) {
         void **kept = call->raised[call->n_raised];
         py.PyErr_Fetch((PyObj **)&kept[0], (PyObj **)&kept[1], (PyObj **)&kept[2]);
         if (kept[0] == NULL) /* failed without an exception: nothing to hand on, and nothing more to run */
@@ -787,7 +787,7 @@ static int raise_again(void *arg)
     return -1;
 }
 
-void pyhost_leave_call(pyhost_call *call)
+void pyloader_leave_call(pyloader_call *call)
 {
     int i;
     if (call == NULL || call->gil == -1)
@@ -810,4 +810,4 @@ void pyhost_leave_call(pyhost_call *call)
     call->gil = -1;
 }
 
-int pyhost_interpreter_is_hosts(void) { return !g_shim_managed; }
+int pyloader_interpreter_is_hosts(void) { return !g_guard_managed; }

@@ -1,4 +1,5 @@
-"""Make a pythonfmu FMU loadable by plain C/C++ FMI 2.0 hosts (Linux x86_64).
+"""Put the pythonfmu guard (``pythonfmu_guard/``) in front of a pythonfmu FMU's Linux binary: every FMI
+call checked, and the FMU loadable by plain C/C++ FMI 2.0 hosts (Linux x86_64).
 
 pythonfmu's Linux binary does not link libpython, so outside a Python process
 ``dlopen`` fails with ``undefined symbol: _Py_NoneStruct``. This module
@@ -7,7 +8,7 @@ post-processes a built FMU, in place:
 * ``binaries/linux64/<id>.so`` (pythonfmu) is renamed ``<id>_pythonfmu.so``;
 * the guard takes its place: the project's C FMI front (``cfront/``: state machine, argument and
   range checks from the interface table, FMU states, logging) with ``pythonfmu_backend.c``, which
-  forwards the checked calls to the pythonfmu binary, and ``python_host.c``. In a process without
+  forwards the checked calls to the pythonfmu binary, and ``python_loader.c``. In a process without
   Python the latter loads the libpython recorded below (RTLD_GLOBAL), starts the interpreter on the
   build environment (venv) and checks the required modules; in a Python host (fmpy, libcosimpy) it
   uses the running interpreter;
@@ -15,14 +16,14 @@ post-processes a built FMU, in place:
   home (base prefix), site-packages directories and required modules.
 
 Windows binaries are left unchanged. Running it again on an already processed
-FMU rebuilds the shim and the configuration file.
+FMU rebuilds the guard and the configuration file.
 
 Usage::
 
-    from make_standalone import make_standalone
+    from restitution.fmu.build_guard import make_standalone
     make_standalone(Path("build/Model.fmu"))            # this interpreter / venv
 
-    python -m restitution.fmu.native_host.make_standalone build/Model.fmu \
+    python -m restitution.fmu.build_guard build/Model.fmu \
         [--python /path/to/venv/bin/python] [--require numpy --require scipy]
 """
 from __future__ import annotations
@@ -41,11 +42,11 @@ from pathlib import Path
 from typing import Iterable, Optional, Sequence
 from xml.etree import ElementTree
 
-HERE = Path(__file__).resolve().parent
-FRONT = HERE.parent / "cfront"
-#: The guard's C sources: the front, then this directory's backend and Python loader.
-GUARD_SOURCES = (*sorted(FRONT.glob("*.c")), HERE / "pythonfmu_backend.c", HERE / "python_host.c")
-CONFIG_NAME = "python_env.txt"  # must match PYHOST_CONFIG_NAME in python_host.c
+FRONT = Path(__file__).resolve().parent / "cfront"
+GUARD = Path(__file__).resolve().parent / "pythonfmu_guard"
+#: The guard's C sources: the front, then the guard's backend (forwarding to pythonfmu) and Python loader.
+GUARD_SOURCES = (*sorted(FRONT.glob("*.c")), GUARD / "pythonfmu_backend.c", GUARD / "python_loader.c")
+CONFIG_NAME = "python_env.txt"  # must match PYLOADER_CONFIG_NAME in python_loader.c
 REAL_SUFFIX = "_pythonfmu"
 
 __all__ = ["make_standalone", "StandaloneError", "describe_interpreter"]
@@ -55,7 +56,7 @@ class StandaloneError(RuntimeError):
     """The FMU cannot be made standalone (missing compiler, static Python, ...)."""
 
 
-# Runs inside the target interpreter: everything the shim needs to know about it.
+# Runs inside the target interpreter: everything the guard needs to know about it.
 _PROBE = r"""
 import importlib.util, json, os, platform, site, sys, sysconfig
 cv = sysconfig.get_config_var
@@ -153,8 +154,8 @@ def _detect_requirements(entries: dict[str, bytes]) -> set[str]:
 
 def _config_text(info: dict, requires: Sequence[str]) -> str:
     lines = [
-        "# Written by restitution.fmu.native_host.make_standalone.",
-        "# Read by the FMU's binaries/linux64 shim when the host process has no Python",
+        "# Written by restitution.fmu.build_guard.",
+        "# Read by the FMU's binaries/linux64 guard when the host process has no Python",
         "# (plain C/C++ FMI hosts). Edit the paths to move the FMU to another Python",
         f"# {'.'.join(info['version'].split('.')[:2])} installation; ignored inside Python hosts (fmpy, libcosimpy).",
         f"python_version={info['version']}",
@@ -170,7 +171,7 @@ def _config_text(info: dict, requires: Sequence[str]) -> str:
 
 
 #: pythonfmu's ``(anonymous namespace)::pyState`` (a std::shared_ptr, two words): see
-#: arm_pystate_exit_fix in python_host.c, which empties it before pythonfmu's exit-time double release.
+#: arm_pystate_exit_fix in python_loader.c, which empties it before pythonfmu's exit-time double release.
 PYSTATE_SYMBOL = b"_ZN12_GLOBAL__N_17pyStateE"
 
 
@@ -203,7 +204,7 @@ GUARD_CFLAGS = ("-std=gnu99", "-O2", "-Wall", "-Wextra", "-Werror", "-shared", "
 
 
 def _fmi2_headers() -> Path:
-    from restitution.fmu.native.build_native import NativeBuildSkipped, fmi2_include_dir
+    from restitution.fmu.build_native import NativeBuildSkipped, fmi2_include_dir
 
     try:
         return fmi2_include_dir()
@@ -214,19 +215,19 @@ def _fmi2_headers() -> Path:
 def guard_command(output: Path, generated: Path, real_name: str, compiler: str = "gcc", include_dir: str = "",
                   real_binary: Optional[bytes] = None, extra_flags: Sequence[str] = ()) -> list[str]:
     """The compiler command for the guard; ``generated`` holds rst_interface.h and rst_model_info.h."""
-    cmd = [compiler, *GUARD_CFLAGS, *extra_flags, f'-DPYHOST_REAL_BINARY="{real_name}"',
-           f'-DPYHOST_CONFIG_NAME="{CONFIG_NAME}"', f"-I{generated}", f"-I{FRONT}", f"-I{HERE}", f"-I{_fmi2_headers()}"]
+    cmd = [compiler, *GUARD_CFLAGS, *extra_flags, f'-DPYLOADER_REAL_BINARY="{real_name}"',
+           f'-DPYLOADER_CONFIG_NAME="{CONFIG_NAME}"', f"-I{generated}", f"-I{FRONT}", f"-I{GUARD}", f"-I{_fmi2_headers()}"]
     offset = _pystate_offset(real_binary) if real_binary else None
     if offset is not None:
-        cmd += [f"-DPYHOST_PYSTATE_OFFSET={offset:#x}", f"-DPYHOST_REAL_SIZE={len(real_binary)}"]
+        cmd += [f"-DPYLOADER_PYSTATE_OFFSET={offset:#x}", f"-DPYLOADER_REAL_SIZE={len(real_binary)}"]
     if include_dir and (Path(include_dir) / "Python.h").is_file():
-        cmd += ["-DPYHOST_HAVE_PYTHON_H", f"-I{include_dir}"]
+        cmd += ["-DPYLOADER_HAVE_PYTHON_H", f"-I{include_dir}"]
     return cmd + [str(p) for p in GUARD_SOURCES] + ["-o", str(output), "-ldl", "-lpthread"]
 
 
 def write_guard_headers(directory: Path, model_description: str, interface_header: Optional[str] = None) -> None:
-    """rst_interface.h (``interface_header``, or one made from the modelDescription for an FMU without a
-    VARIABLES table) and rst_model_info.h into ``directory``."""
+    """rst_interface.h (``interface_header``, or one made from the modelDescription for an FMU without an
+    interface table of its own) and rst_model_info.h into ``directory``."""
     from restitution.fmu.interface import c_header, model_info, model_info_header, variables_from_model_description
 
     if interface_header is None:
@@ -263,11 +264,11 @@ def make_standalone(
     error message; by default they are the non-stdlib top-level modules
     imported by the FMU's Python files that are importable at build time.
     ``interface_header`` is the guard's variable table (:func:`restitution.fmu.interface.c_header`
-    of the slave's VARIABLES); without it the table is made from the FMU's modelDescription.xml.
+    of the model's interface table); without it the table is made from the FMU's modelDescription.xml.
     """
     fmu_path = Path(fmu_path)
     if not sys.platform.startswith("linux"):
-        raise StandaloneError("make_standalone builds a Linux x86_64 shim and must run on Linux")
+        raise StandaloneError("make_standalone builds a Linux x86_64 guard and must run on Linux")
     if shutil.which(compiler) is None:
         raise StandaloneError(f"C compiler '{compiler}' not found (install gcc)")
     missing = [str(p) for p in GUARD_SOURCES if not p.is_file()]
@@ -279,16 +280,16 @@ def make_standalone(
         entries = {i.filename: zin.read(i.filename) for i in infos}
 
     model_id = _model_identifier(entries["modelDescription.xml"])
-    shim_name = f"binaries/linux64/{model_id}.so"
+    guard_name = f"binaries/linux64/{model_id}.so"
     real_name = f"binaries/linux64/{model_id}{REAL_SUFFIX}.so"
-    if real_name in entries:  # already processed: rebuild shim and config
+    if real_name in entries:  # already processed: rebuild guard and config
         real_binary = entries[real_name]
-    elif shim_name in entries:
-        real_binary = entries[shim_name]
+    elif guard_name in entries:
+        real_binary = entries[guard_name]
     else:
-        raise StandaloneError(f"{fmu_path} has no {shim_name}")
+        raise StandaloneError(f"{fmu_path} has no {guard_name}")
     if b"Py_IsInitialized" not in real_binary:
-        raise StandaloneError(f"{shim_name} does not look like a pythonfmu binary")
+        raise StandaloneError(f"{guard_name} does not look like a pythonfmu binary")
 
     candidates = _detect_requirements(entries) if required_modules is None else set()
     info = describe_interpreter(python_executable, candidates)
@@ -312,16 +313,16 @@ def make_standalone(
     else:
         requires = list(dict.fromkeys(required_modules))
 
-    with tempfile.TemporaryDirectory(prefix="fmi2shim_") as tmp:
-        shim_so = Path(tmp) / f"{model_id}.so"
-        _compile_guard(shim_so, f"{model_id}{REAL_SUFFIX}.so", info["include"], compiler, real_binary,
+    with tempfile.TemporaryDirectory(prefix="fmi2guard_") as tmp:
+        guard_so = Path(tmp) / f"{model_id}.so"
+        _compile_guard(guard_so, f"{model_id}{REAL_SUFFIX}.so", info["include"], compiler, real_binary,
                        entries["modelDescription.xml"].decode("utf-8"), interface_header)
-        shim_binary = shim_so.read_bytes()
+        guard_binary = guard_so.read_bytes()
 
     new_entries: dict[str, bytes] = {}
     order: list[zipfile.ZipInfo] = []
     for zi in infos:
-        if zi.filename in (shim_name, real_name, f"resources/{CONFIG_NAME}"):
+        if zi.filename in (guard_name, real_name, f"resources/{CONFIG_NAME}"):
             continue
         order.append(zi)
         new_entries[zi.filename] = entries[zi.filename]
@@ -333,7 +334,7 @@ def make_standalone(
         order.append(zi)
         new_entries[name] = data
 
-    add(shim_name, shim_binary, 0o755)
+    add(guard_name, guard_binary, 0o755)
     add(real_name, real_binary, 0o755)
     add(f"resources/{CONFIG_NAME}", _config_text(info, requires).encode("utf-8"), 0o644)
 
@@ -363,7 +364,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     args = parser.parse_args(argv)
     for fmu in args.fmu:
         make_standalone(fmu, args.python, required_modules=args.require, compiler=args.cc)
-        print(f"{fmu}: standalone shim added ({CONFIG_NAME} records {args.python})")
+        print(f"{fmu}: guard added ({CONFIG_NAME} records {args.python})")
     return 0
 
 

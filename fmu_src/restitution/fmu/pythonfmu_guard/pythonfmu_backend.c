@@ -30,7 +30,7 @@
  *   or in ctypes or the front before the handler was set aside) is still pending, and the slave's first
  *   line would run its handler (this gave fmi2Fatal for 5-10 % of SIGINTs in a set/get loop,
  *   tests/test_fmu_interrupt.py): with the GIL taken and the handlers set aside, the pending handlers run
- *   first (python_host.c: pyhost_enter_call), and what they raise is raised again in the host's code
+ *   first (python_loader.c: pyloader_enter_call), and what they raise is raised again in the host's code
  *   once the call returns. Either way the host sees its exception between two FMI calls (fmpy:
  *   KeyboardInterrupt in fmpy's code right after the call) and the instance goes on. A single long call
  *   is not interrupted. Cost: one more system call per call (the SIGTERM disposition), about 0.4 us in
@@ -51,7 +51,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "python_host.h"
+#include "python_loader.h"
 #include "rst_front.h"
 #include "rst_interface.h"  /* generated: restitution.fmu.interface.c_header */
 #include "rst_model_info.h" /* generated: identifier and GUID of modelDescription.xml */
@@ -119,7 +119,7 @@ static void hold(int i, const struct sigaction *holder)
         if (sigaction(signum, NULL, &host_action[i]) != 0 || !is_handler(&host_action[i]))
             return;
         holding[i] = sigaction(signum, holder, NULL) == 0;
-        return; /* one arriving in between went to the host's handler: pyhost_enter_call runs it */
+        return; /* one arriving in between went to the host's handler: pyloader_enter_call runs it */
     }
     if (sigaction(signum, holder, &host_action[i]) != 0)
         return;
@@ -136,13 +136,13 @@ static void hold(int i, const struct sigaction *holder)
 
 /* Before a call into pythonfmu: in a Python host, the host's handlers of the held signals are set aside,
  * so a signal during the call cannot raise in the slave's code, then the Python handlers of signals that
- * came earlier run (pyhost_enter_call), before the slave's code can. */
-static void begin_call(pyhost_call *call)
+ * came earlier run (pyloader_enter_call), before the slave's code can. */
+static void begin_call(pyloader_call *call)
 {
     call->gil = -1;
     call->n_raised = 0;
-    pyhost_attach_thread();
-    if (!pyhost_interpreter_is_hosts())
+    pyloader_attach_thread();
+    if (!pyloader_interpreter_is_hosts())
         return;
     pthread_mutex_lock(&signal_lock);
     if (calls_inside++ == 0) {
@@ -155,15 +155,15 @@ static void begin_call(pyhost_call *call)
             hold(i, &holder);
     }
     pthread_mutex_unlock(&signal_lock);
-    pyhost_enter_call(call);
+    pyloader_enter_call(call);
 }
 
 /* After it: the host's handlers back, a signal held meanwhile raised again for them (Python: its flag is
  * set and the handler runs at the next check, in the host's code), and what an earlier signal's handler
- * raised in pyhost_enter_call raised again in the host's code. */
-static void end_call(pyhost_call *call)
+ * raised in pyloader_enter_call raised again in the host's code. */
+static void end_call(pyloader_call *call)
 {
-    if (!pyhost_interpreter_is_hosts())
+    if (!pyloader_interpreter_is_hosts())
         return;
     pthread_mutex_lock(&signal_lock);
     if (--calls_inside == 0) {
@@ -180,7 +180,7 @@ static void end_call(pyhost_call *call)
         }
     }
     pthread_mutex_unlock(&signal_lock);
-    pyhost_leave_call(call);
+    pyloader_leave_call(call);
 }
 
 /* ------------------------------------------------------------------------------------------------ */
@@ -233,7 +233,7 @@ static int pythonfmu_uri(rst_instance *inst, const char *dir, char *uri, size_t 
 static slot *new_slot(rst_instance *inst, const pythonfmu_api *api, const char *resource_dir, fmi2Boolean visible)
 {
     char uri[4200];
-    pyhost_call call;
+    pyloader_call call;
     slot *s = (slot *)calloc(1, sizeof(slot) + strlen(resource_dir));
     if (s == NULL) {
         rst_log(inst, fmi2Error, "fmi2Instantiate: out of memory");
@@ -309,7 +309,7 @@ static fmi2Status instantiate(rst_instance *inst, const char *resource_dir, fmi2
     }
     if (!check_resources(inst, resource_dir))
         return fmi2Error;
-    g->api = pyhost_ensure_ready(inst, resource_dir);
+    g->api = pyloader_ensure_ready(inst, resource_dir);
     if (g->api == NULL)
         return fmi2Error;
     g->slot = take_slot(inst, resource_dir);
@@ -323,7 +323,7 @@ static void free_instance(rst_instance *inst)
     guard *g = (guard *)rst_backend(inst);
     slot *s = g->slot;
     fmi2Status status = fmi2Fatal;
-    pyhost_call call;
+    pyloader_call call;
     if (s == NULL)
         return;
     if (rst_mode_of(inst) != RST_FATAL && !s->poisoned) {
@@ -342,7 +342,7 @@ static fmi2Status setup_experiment(rst_instance *inst, fmi2Boolean tolerance_def
                                    double start_time, fmi2Boolean stop_time_defined, double stop_time)
 {
     fmi2Status status;
-    pyhost_call call;
+    pyloader_call call;
     begin_call(&call);
     status = API(inst)->SetupExperiment(REAL(inst), tolerance_defined, tolerance, start_time, stop_time_defined,
                                         stop_time);
@@ -354,7 +354,7 @@ static fmi2Status setup_experiment(rst_instance *inst, fmi2Boolean tolerance_def
     static fmi2Status forward_##name(rst_instance *inst)      \
     {                                                         \
         fmi2Status status;                                    \
-        pyhost_call call;                                     \
+        pyloader_call call;                                     \
         begin_call(&call);                                    \
         status = API(inst)->name(REAL(inst));                 \
         end_call(&call);                                      \
@@ -372,7 +372,7 @@ static fmi2Status set_values(rst_instance *inst, rst_type type, const fmi2ValueR
     fmi2Boolean booleans[64];
     fmi2Status status = fmi2OK;
     size_t i0, i;
-    pyhost_call call;
+    pyloader_call call;
     begin_call(&call);
     for (i0 = 0; i0 < n && status <= fmi2Warning; i0 += 64) {
         size_t m = n - i0 < 64 ? n - i0 : 64;
@@ -399,7 +399,7 @@ static fmi2Status get_values(rst_instance *inst, rst_type type, const fmi2ValueR
     fmi2Boolean booleans[64];
     fmi2Status status = fmi2OK;
     size_t i0, i;
-    pyhost_call call;
+    pyloader_call call;
     begin_call(&call);
     for (i0 = 0; i0 < n && status <= fmi2Warning; i0 += 64) {
         size_t m = n - i0 < 64 ? n - i0 : 64;
@@ -422,7 +422,7 @@ static fmi2Status get_values(rst_instance *inst, rst_type type, const fmi2ValueR
 static fmi2Status do_step(rst_instance *inst, double t, double h)
 {
     fmi2Status status;
-    pyhost_call call;
+    pyloader_call call;
     begin_call(&call);
     status = API(inst)->DoStep(REAL(inst), t, h, fmi2True);
     end_call(&call);

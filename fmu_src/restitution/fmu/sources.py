@@ -1,0 +1,92 @@
+"""What each FMU is built from: which files of the package an FMU bundles, and the hash of its sources
+recorded inside it (``resources/build_info.json``), which decides whether a built FMU is stale.
+
+Read by the builds (:mod:`.build`, :mod:`.build_native`); imports nothing of them.
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+import shutil
+import zipfile
+from pathlib import Path
+
+from .models import HERE as MODELS, SLAVE_SUPPORT, native_sources, slave_script
+
+FMU_DIR = Path(__file__).resolve().parent
+PACKAGE = FMU_DIR.parent  # the restitution package the FMUs bundle
+FRONT = FMU_DIR / "cfront"
+GUARD = FMU_DIR / "pythonfmu_guard"
+PHYSICS_C = FMU_DIR / "physics_c"
+
+#: Where the build records what it was built from, inside the FMU.
+BUILD_INFO = "resources/build_info.json"
+
+#: Subfolders of the package the FMUs bundle; the others (cosim/, scene/, sweep/, ...) are host-side
+#: helpers whose imports (fmpy, dask, matplotlib, ...) the slaves never need. Bundling them made the
+#: guard's loader require those packages at start-up in a plain C host (python_env.txt require=).
+BUNDLED_SUBDIRS = {"data"}
+#: Of fmu/, the slaves need only the interface tables (pure data): these files, and models/*/variables.py.
+BUNDLED_FMU_FILES = {"__init__.py", "table.py"}
+
+
+def bundle_filter(directory, names):
+    """copytree filter: no caches; below the package root only BUNDLED_SUBDIRS and, of fmu/, the
+    interface tables."""
+    ignored = set(shutil.ignore_patterns("__pycache__", "*.pyc", "*.egg-info")(directory, names))
+    here = Path(directory).resolve()
+    if here == PACKAGE:
+        ignored |= {n for n in names if (PACKAGE / n).is_dir() and n not in BUNDLED_SUBDIRS | {"fmu"}}
+    elif here == FMU_DIR:
+        ignored |= {n for n in names if n not in BUNDLED_FMU_FILES | {"models"}}
+    elif here == MODELS or here.parent == MODELS:
+        ignored |= {n for n in names if (here / n).is_file() and n not in ("__init__.py", "variables.py")}
+    return ignored
+
+
+def _table_files() -> list[Path]:
+    """The interface tables' files the FMUs bundle (see :func:`bundle_filter`)."""
+    return ([FMU_DIR / name for name in sorted(BUNDLED_FMU_FILES)] + [MODELS / "__init__.py"]
+            + sorted(MODELS.glob("*/__init__.py")) + sorted(MODELS.glob("*/variables.py")))
+
+
+def source_files(model: str) -> list[Path]:
+    """Every file the pythonfmu ``<model>.fmu`` is built from: the slave, the bundled physics modules,
+    tables and data, the builds, the C header generator and the guard (C front and loader)."""
+    files = [slave_script(model), SLAVE_SUPPORT, *_table_files()]
+    files += [FMU_DIR / name for name in ("build.py", "build_guard.py", "sources.py", "interface.py")]
+    files += sorted(FRONT.glob("*.[ch]")) + sorted(GUARD.glob("*.[ch]"))
+    files += sorted(PACKAGE.glob("*.py"))
+    for sub in sorted(BUNDLED_SUBDIRS):
+        files += sorted(p for p in (PACKAGE / sub).rglob("*") if p.is_file() and "__pycache__" not in p.parts)
+    return files
+
+
+def source_hash(model: str) -> str:
+    """SHA-256 over the names and contents of :func:`source_files` (what makes an FMU stale)."""
+    digest = hashlib.sha256()
+    for path in source_files(model):
+        digest.update(path.relative_to(PACKAGE).as_posix().encode() + b"\0")
+        digest.update(path.read_bytes())
+        digest.update(b"\0")
+    return digest.hexdigest()
+
+
+def native_source_hash(model: str) -> str:
+    """SHA-256 over the pythonfmu FMU's source hash (the interface and the physics the C follows) and
+    every C file and generator the native ``<model>.fmu`` is built from."""
+    digest = hashlib.sha256(source_hash(model).encode())
+    paths = (sorted(FRONT.glob("*.[ch]")) + sorted(PHYSICS_C.glob("*.[ch]")) + sorted(PHYSICS_C.glob("*.py"))
+             + native_sources(model) + [FMU_DIR / "build_native.py", FMU_DIR / "compile.py"])
+    for path in paths:
+        digest.update(path.name.encode() + b"\0" + path.read_bytes() + b"\0")
+    return digest.hexdigest()
+
+
+def recorded_source_hash(fmu: Path) -> str | None:
+    """The source hash recorded in a built FMU, or None (not ours, older build, unreadable)."""
+    try:
+        with zipfile.ZipFile(fmu) as z:
+            return json.loads(z.read(BUILD_INFO)).get("source_hash")
+    except (OSError, KeyError, ValueError, zipfile.BadZipFile):
+        return None
