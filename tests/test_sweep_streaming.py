@@ -18,8 +18,10 @@ import pytest
 
 from restitution.sweep import SweepSpec, compare_results, read_table, run_sweep
 from restitution.sweep.__main__ import main as sweep_cli
-from restitution.sweep.run import (DiskSweepResult, SizeError, SweepInterrupted, check_memory, plan_size,
-                                   table_bytes)
+from restitution.sweep.parts import DiskSweepResult
+from restitution.sweep.run import SweepInterrupted
+from restitution.sweep.size import check_memory, plan_size, table_bytes
+from restitution.sweep.spec import SizeError
 
 from terminal import with_terminal_stderr
 

@@ -8,7 +8,10 @@ See docs/sweeps.md. Needs ``dask[distributed]`` (the ``sweep`` extra); the FMU b
 needs the ``fmu`` extra, the plot matplotlib, Parquet output pyarrow.
 """
 from .backends import Backend, FmuBackend, PackageBackend, code_fingerprint, get_backend, release_fmus
-from .run import COLUMNS, SweepResult, compare_results, machine_workers, open_client, read_table, run_sweep
+from .cluster import machine_workers, open_client
+from .compare import compare_results
+from .run import run_sweep
+from .table import COLUMNS, SweepResult, read_table
 from .spec import CODES, INPUTS, OUTPUTS, SweepSpec, canonical_name, load_spec, resolve_pair
 
 __all__ = ["SweepSpec", "run_sweep", "SweepResult", "open_client", "machine_workers", "compare_results",

@@ -182,7 +182,9 @@ def main(argv=None) -> int:
 
 
 def _main(parser, args) -> int:
-    from .run import SizeError, _keep, plan_size, table_bytes
+    from .size import plan_size, table_bytes
+    from .spec import SizeError
+    from .table import keep_columns
 
     try:
         spec, run = build_spec(args)
@@ -202,7 +204,7 @@ def _main(parser, args) -> int:
     if isinstance(columns, str):
         columns = [c.strip() for c in columns.split(",") if c.strip()]
     try:
-        _keep(columns)
+        keep_columns(columns)
     except ValueError as exc:
         parser.error(f"--columns: {exc}")
     if backend == "both" and columns is not None:
@@ -257,7 +259,9 @@ def _main(parser, args) -> int:
         except BuildError as exc:
             parser.error(str(exc))
 
-    from .run import ResumeError, SweepInterrupted, open_client, run_sweep
+    from .cluster import open_client
+    from .parts import ResumeError
+    from .run import SweepInterrupted, run_sweep
 
     if plan.stream:
         print(f"sweep: {plan.describe()}", file=sys.stderr)

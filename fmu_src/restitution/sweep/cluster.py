@@ -1,0 +1,106 @@
+"""The Dask side of a sweep: a client (an existing scheduler, or a LocalCluster sized to this machine
+whose workers ignore Ctrl-C and do not inherit pythonfmu's sys.path entries) and what it is."""
+from __future__ import annotations
+
+import contextlib
+import logging
+import os
+
+__all__ = ["machine_workers", "open_client", "count_workers", "describe_client"]
+
+def machine_workers() -> int:
+    """Worker processes for a local cluster: the cores this process may use."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:  # not Linux
+        return max(1, os.cpu_count() or 1)
+
+
+@contextlib.contextmanager
+def open_client(scheduler=None, n_workers: int | None = None, threads_per_worker: int = 1, **cluster_kwargs):
+    """A ``distributed.Client`` for a sweep, closed (with any cluster it started) on exit.
+
+    ``scheduler``: a ``Client`` (used as is, left open), a scheduler address
+    (``"tcp://host:8786"``), or None / ``"local"``: the scheduler named by Dask's config
+    (``DASK_SCHEDULER_ADDRESS``) if set, else a new ``LocalCluster`` of ``n_workers``
+    single-threaded processes (default: one per core).
+    """
+    from distributed import Client, LocalCluster
+
+    if isinstance(scheduler, Client):
+        yield scheduler
+        return
+    if scheduler in (None, "local"):
+        import dask
+
+        address = dask.config.get("scheduler-address", None) if scheduler is None else None
+        if address:
+            scheduler = address
+    if scheduler not in (None, "local"):
+        with Client(scheduler) as client:
+            yield client
+        return
+    kwargs = dict(n_workers=n_workers or machine_workers(), threads_per_worker=threads_per_worker,
+                  processes=True, dashboard_address=None, silence_logs=logging.ERROR)
+    kwargs.update(cluster_kwargs)
+    # the workers start with this process's sys.path, and ignoring Ctrl-C (see _workers_ignore_sigint)
+    with _without_fmu_resources_on_sys_path(), _workers_ignore_sigint():
+        cluster = LocalCluster(**kwargs)
+    with cluster, Client(cluster) as client:
+        yield client
+
+
+@contextlib.contextmanager
+def _workers_ignore_sigint():
+    """SIGINT ignored while a LocalCluster spawns its worker processes, which keep that disposition.
+
+    Ctrl-C in a terminal reaches every process of the foreground group: the workers' event loops
+    would die with a KeyboardInterrupt traceback each, and an FMU back end's worker would take it
+    inside an FMU call (fmi2Fatal). The client process alone takes Ctrl-C: it cancels the tasks,
+    keeps the finished chunks and closes the cluster, which stops the workers. A Ctrl-C during
+    these start-up seconds is ignored (press it again once the sweep runs)."""
+    import signal
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
+@contextlib.contextmanager
+def _without_fmu_resources_on_sys_path():
+    """sys.path minus the resources/ directories of pythonfmu FMUs loaded in this process.
+
+    pythonfmu prepends an FMU's resources/ to sys.path when it instantiates it; worker processes
+    started afterwards would inherit that entry and import the FMU's physics-only copy of
+    ``restitution`` (no ``restitution.sweep``) instead of this one, and die.
+    """
+    import sys
+
+    saved = list(sys.path)
+    sys.path[:] = [p for p in saved if not (p and os.path.isfile(os.path.join(p, "slavemodule.txt")))]
+    try:
+        yield
+    finally:
+        sys.path[:] = saved
+
+
+def count_workers(client) -> int:
+    try:
+        info = client.scheduler_info(n_workers=-1)
+    except TypeError:  # distributed before 2025.4 lists every worker anyway
+        info = client.scheduler_info()
+    return max(1, len(info["workers"]))
+
+
+def describe_client(client, scheduler) -> str:
+    from distributed import LocalCluster
+
+    if isinstance(getattr(client, "cluster", None), LocalCluster) and not isinstance(scheduler, str):
+        return f"a LocalCluster ({client.scheduler.address})"
+    return f"the Dask scheduler at {client.scheduler.address}"
