@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 import bench_accuracy as bench  # build_scripts/ is on sys.path (conftest.py)
+from accuracy_bench.reference import lambda_points, reference_solve
 from restitution.zener import zener_restitution
 from restitution.zener_exact import zener_exact
 
@@ -78,10 +79,10 @@ def test_bouncing_ball_state_restore_is_exact_and_plain_fixed_step_is_late(quick
 
 def test_reference_solver_is_accurate_and_independent_of_the_methods():
     """The reference (Radau) agrees with the closed form at lambda = 0 and with `exact` elsewhere."""
-    e0, tau0 = bench.reference_solve(0.0)
+    e0, tau0 = reference_solve(0.0)
     assert e0 == pytest.approx(1.0, rel=1e-12) and tau0 == pytest.approx(3.2180654597190425, rel=1e-12)
     for lam in (0.7, 4.0):
-        e, tau = bench.reference_solve(lam)
+        e, tau = reference_solve(lam)
         ex = zener_exact(lam)
         assert e == pytest.approx(ex[0], rel=1e-8) and tau == pytest.approx(ex[1], rel=1e-8)
         ode = zener_restitution(lam, "ode", 1e-6)  # a loose ode solve is visibly off the reference
@@ -89,7 +90,7 @@ def test_reference_solver_is_accurate_and_independent_of_the_methods():
 
 
 def test_lambda_points_avoid_the_table_nodes_and_cover_both_ranges():
-    pts = bench.lambda_points(bench.QUICK)
+    pts = lambda_points(bench.QUICK)
     small, large = pts[bench.RANGES[0]], pts[bench.RANGES[1]]
     assert small[0] == 0.0 and small[-1] == 1.5 and np.all((small >= 0.0) & (small <= 1.5))
     assert large[-1] == 100.0 and np.all((large > 1.5) & (large <= 100.0))

@@ -1,0 +1,51 @@
+"""The timing harness: variants interleaved batch by batch, CPU time of this thread, medians and
+median ratios (ratios compare like with like on a shared, noisy machine)."""
+from __future__ import annotations
+
+import statistics
+import time
+
+
+def clock() -> float:
+    return time.thread_time()
+
+
+def interleaved(variants: dict, reps: int, batch_seconds: float) -> dict:
+    """{name: [seconds per evaluation, one per batch]} for ``variants`` {name: run(n) -> evaluations}.
+
+    ``run(n)`` performs n repetitions of its work and returns how many evaluations that was.
+    Batch sizes are calibrated to ``batch_seconds``; the variants take turns batch by batch.
+    """
+    sizes = {}
+    for name, run in variants.items():
+        n = 1
+        while True:
+            t0 = clock()
+            run(n)
+            dt = clock() - t0
+            if dt >= batch_seconds / 4 or n >= 1 << 20:
+                break
+            n *= 4
+        sizes[name] = max(1, int(n * batch_seconds / max(dt, 1e-9)))
+    out = {name: [] for name in variants}
+    for _ in range(reps):
+        for name, run in variants.items():
+            t0 = clock()
+            count = run(sizes[name])
+            out[name].append((clock() - t0) / count)
+    return out
+
+
+def median(xs) -> float:
+    return float(statistics.median(xs))
+
+
+def median_ratio(num, den) -> float:
+    """Median over batches of num/den (the batches were taken in turn)."""
+    return median([a / b for a, b in zip(num, den)])
+
+
+def timed(run, n):
+    t0 = clock()
+    count = run(n)
+    return (clock() - t0) / count
