@@ -17,6 +17,8 @@ from xml.etree import ElementTree
 
 import pytest
 
+from toy_fmu import build_plain_toy
+
 ROOT = Path(__file__).resolve().parents[1]
 HOST_SOURCE = ROOT / "tests" / "c_host" / "fmi2_script_host.c"
 MAKE_STANDALONE = ROOT / "fmu_src" / "restitution" / "fmu" / "build_guard.py"
@@ -26,31 +28,9 @@ pytestmark = [
     pytest.mark.skipif(shutil.which("gcc") is None, reason="gcc not available"),
 ]
 
-MODULE = "chost_standalone_sqrt_slave"  # unique module name (FMUs sharing one clash)
-MODEL = "ChostStandaloneSqrt"
-SLAVE_SOURCE = f'''
-import numpy
-from pythonfmu import Fmi2Slave, Fmi2Causality, Fmi2Variability, Real
-
-
-class {MODEL}(Fmi2Slave):
-    author = "tests"
-    description = "y = numpy.sqrt(x)"
-
-    def __init__(self, **kwargs):
-        super().__init__(**kwargs)
-        self.x = 4.0
-        self.y = 2.0
-        self.register_variable(Real("x", causality=Fmi2Causality.input,
-                                    variability=Fmi2Variability.continuous))
-        self.register_variable(Real("y", causality=Fmi2Causality.output,
-                                    variability=Fmi2Variability.continuous))
-
-    def do_step(self, current_time, step_size):
-        self.y = float(numpy.sqrt(self.x))
-        return True
-'''
-VR_X, VR_Y = 0, 1
+MODULE = "toy_gain_slave"  # tests/toys/: y = gain * sqrt(x), gain 1; imports numpy
+MODEL = "ToyGain"
+VR_X, VR_Y = 0, 2  # x, gain, y, steps
 CLEAN_ENV = {"PATH": "/usr/bin:/bin"}
 
 
@@ -113,15 +93,7 @@ def _values(proc: subprocess.CompletedProcess) -> dict[int, float]:
 @pytest.fixture(scope="module")
 def built(tmp_path_factory):
     work = tmp_path_factory.mktemp("chost")
-    script = work / f"{MODULE}.py"
-    script.write_text(textwrap.dedent(SLAVE_SOURCE))
-    subprocess.run(
-        [sys.executable, "-m", "pythonfmu", "build", "-f", str(script), "-d", str(work / "plain")],
-        check=True,
-        cwd=work,
-        capture_output=True,
-    )
-    plain = work / "plain" / f"{MODEL}.fmu"
+    plain = build_plain_toy(work / "plain", MODULE)
     standalone = work / f"{MODEL}.fmu"
     shutil.copy(plain, standalone)
     _load_make_standalone().make_standalone(standalone)
@@ -143,7 +115,7 @@ def test_fmu_layout(built):
 
 
 def test_plain_pythonfmu_binary_fails_in_c_host(built, tmp_path):
-    """The problem being solved: without the shim, dlopen fails."""
+    """The problem being solved: without the guard, dlopen fails."""
     unpacked = _unpack(built["plain"], tmp_path / "plain")
     proc = _run_host(built["host"], unpacked, built["guid"], _scenario(2.0))
     assert proc.returncode == 2
@@ -159,7 +131,7 @@ def test_runs_in_plain_c_host(built, tmp_path, x):
 
 
 def test_runs_in_fmpy(built, tmp_path):
-    """Same standalone FMU in a Python host: the shim uses the running interpreter."""
+    """Same standalone FMU in a Python host: the guard uses the running interpreter."""
     code = textwrap.dedent(
         f"""
         import sys

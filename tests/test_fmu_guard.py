@@ -159,33 +159,10 @@ def test_missing_slave_script_or_resources_give_a_message_naming_the_path(impact
 
 
 # --- fmi2Fatal is latched -------------------------------------------------------------------------------
-TOY_MODULE = "guard_toy_raising_slave"
-TOY_SOURCE = '''
-import math
-from pythonfmu import Fmi2Causality, Fmi2Slave, Fmi2Variability, Real
-
-
-class GuardToyRaising(Fmi2Slave):
-    """y = 2 sqrt(x); a slave bug: do_step raises for x < 0."""
-    author = "tests"
-    description = "toy"
-
-    def __init__(self, **kwargs):
-        super().__init__(**kwargs)
-        self.x = 1.0
-        self.y = 2.0
-        self.register_variable(Real("x", causality=Fmi2Causality.input, variability=Fmi2Variability.continuous))
-        self.register_variable(Real("y", causality=Fmi2Causality.output, variability=Fmi2Variability.continuous))
-
-    def do_step(self, current_time, step_size):
-        self.y = 2.0 * math.sqrt(self.x)  # ValueError for x < 0: pythonfmu answers fmi2Fatal
-        return True
-'''
-
-
 @pytest.fixture(scope="module")
 def raising_fmu(tmp_path_factory):
-    return build_toy_fmu(tmp_path_factory.mktemp("toy"), TOY_MODULE, TOY_SOURCE, "GuardToyRaising")
+    """ToyGain (tests/toys/toy_gain_slave.py): its do_step raises for x < 0."""
+    return build_toy_fmu(tmp_path_factory.mktemp("toy"), "toy_gain_slave")
 
 
 def test_fatal_is_latched_and_never_reaches_freed_memory(raising_fmu, tmp_path):
@@ -214,7 +191,7 @@ def test_fatal_is_latched_and_never_reaches_freed_memory(raising_fmu, tmp_path):
     rep = run.report
     assert rep["fatal"] == FMI_FATAL
     assert rep["later"] == [FMI_ERROR] * 6
-    assert rep["values"] == [2.0 * math.sqrt(4.0 + k) for k in range(10)]
+    assert rep["values"] == [math.sqrt(4.0 + k) for k in range(10)]  # gain 1
     latched = [m for name, status, m in rep["log"] if name == "doomed" and "reported fmi2Fatal earlier" in m]
     assert len(latched) == 6, rep["log"]
 

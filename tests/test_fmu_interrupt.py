@@ -38,40 +38,7 @@ from toy_fmu import build_toy_fmu
 
 pytestmark = pytest.mark.skipif(not sys.platform.startswith("linux"), reason="the guard is the Linux binary")
 
-TOY_MODULE = "guard_toy_interrupt_slave"
-TOY_SOURCE = '''
-from pythonfmu import Boolean, Fmi2Causality, Fmi2Slave, Fmi2Variability, Integer, Real
-
-
-class GuardToyInterrupt(Fmi2Slave):
-    """Some Python work in every call: y = sum of x/k, count = n + steps, positive = flag xor (y > 3)."""
-    author = "tests"
-    description = "toy"
-
-    def __init__(self, **kwargs):
-        super().__init__(**kwargs)
-        self.x, self.n, self.flag = 1.0, 0, False
-        self.y, self.count, self.positive, self.time, self.steps = 0.0, 0, False, 0.0, 0
-        self.register_variable(Real("x", causality=Fmi2Causality.input, variability=Fmi2Variability.continuous))
-        self.register_variable(Integer("n", causality=Fmi2Causality.input, variability=Fmi2Variability.discrete))
-        self.register_variable(Boolean("flag", causality=Fmi2Causality.input, variability=Fmi2Variability.discrete))
-        self.register_variable(Real("y", causality=Fmi2Causality.output, variability=Fmi2Variability.continuous))
-        self.register_variable(Integer("count", causality=Fmi2Causality.output, variability=Fmi2Variability.discrete))
-        self.register_variable(Boolean("positive", causality=Fmi2Causality.output,
-                                       variability=Fmi2Variability.discrete))
-        self.register_variable(Real("time", causality=Fmi2Causality.output, variability=Fmi2Variability.continuous))
-
-    def do_step(self, current_time, step_size):
-        total = 0.0
-        for k in range(1, 40):
-            total += self.x / k
-        self.y = total
-        self.steps += 1
-        self.count = self.n + self.steps
-        self.positive = self.flag != (total > 3.0)
-        self.time = current_time + step_size
-        return True
-'''
+TOY_MODULE = "toy_interrupt_slave"  # tests/toys/
 
 #: The child: PRELUDE + this, argv = [fmu, unzip, signal name, handler ("default" or "raise"), signals, seed].
 LOOP_CODE = r"""
@@ -218,7 +185,7 @@ report(sent=shared["sent"], caught=caught, lost=shared["lost"], fatal=fatal, err
 @pytest.fixture(scope="module")
 def interrupt_fmu(tmp_path_factory):
     work = tmp_path_factory.mktemp("toy_interrupt")
-    fmu = build_toy_fmu(work, TOY_MODULE, TOY_SOURCE, "GuardToyInterrupt")
+    fmu = build_toy_fmu(work, TOY_MODULE)
     return fmu, extract(str(fmu), str(work / "unzipped"))
 
 

@@ -256,39 +256,10 @@ def test_eight_instances_interleaved_equal_one_at_a_time(any_impact_fmu, unzippe
 
 
 # --- next to another pythonfmu FMU ---------------------------------------------------------------
-TOY_MODULE = "robustness_toy_gain_counter_slave"  # unique: FMU scripts sharing a module name clash
-TOY_SOURCE = '''
-import math
-from pythonfmu import Fmi2Causality, Fmi2Slave, Fmi2Variability, Integer, Real
-
-
-class RobustnessToyGainCounter(Fmi2Slave):
-    """y = gain * x, steps = number of doStep calls (a different pythonfmu FMU)."""
-    author = "tests"
-    description = "toy"
-
-    def __init__(self, **kwargs):
-        super().__init__(**kwargs)
-        self.x = 1.0
-        self.gain = 3.0
-        self.y = 3.0
-        self.steps = 0
-        self.register_variable(Real("x", causality=Fmi2Causality.input, variability=Fmi2Variability.continuous))
-        self.register_variable(Real("gain", causality=Fmi2Causality.parameter, variability=Fmi2Variability.tunable))
-        self.register_variable(Real("y", causality=Fmi2Causality.output, variability=Fmi2Variability.continuous))
-        self.register_variable(Integer("steps", causality=Fmi2Causality.output,
-                                       variability=Fmi2Variability.discrete))
-
-    def do_step(self, current_time, step_size):
-        self.y = self.gain * math.sqrt(self.x)
-        self.steps += 1
-        return True
-'''
-
-
 @pytest.fixture(scope="module")
 def toy_fmu(tmp_path_factory):
-    return build_toy_fmu(tmp_path_factory.mktemp("toy"), TOY_MODULE, TOY_SOURCE, "RobustnessToyGainCounter")
+    """ToyGain (tests/toys/toy_gain_slave.py): y = gain * sqrt(x), a different pythonfmu FMU."""
+    return build_toy_fmu(tmp_path_factory.mktemp("toy"), "toy_gain_slave")
 
 
 def test_runs_next_to_a_different_pythonfmu_fmu(impact_fmu, toy_fmu):
@@ -304,7 +275,7 @@ def test_runs_next_to_a_different_pythonfmu_fmu(impact_fmu, toy_fmu):
             for fmu in (impact, toy, toy2):
                 fmu.do_step(step_size=1e-2)
             assert toy.get("y", "steps") == [2.5 * math.sqrt(x), k + 1]
-            assert toy2.get("y", "steps") == [3.0 * math.sqrt(4.0 * x), k + 1]
+            assert toy2.get("y", "steps") == [1.0 * math.sqrt(4.0 * x), k + 1]  # gain 1
             assert impact.get_reals(["e"])[0] == reference({**settings, "v_approach": x}).e
         assert not any(status >= FMI_ERROR for status, _ in impact.messages + toy.messages)
 

@@ -6,6 +6,9 @@ from pathlib import Path
 
 import numpy as np
 
+from restitution.cosim import FmuInstance
+from restitution.fmu.models import table
+
 from .config import Config, RANGES
 from .timing import timed, interleaved, median, median_ratio
 
@@ -82,80 +85,61 @@ def build_fmus(work: Path) -> dict:
     return out
 
 
-class _Slave:
-    """An instantiated FMU2Slave with the value references of its input and outputs."""
+def round_trips(fmu, speeds, full: bool = True):
+    """run(n): n passes of (setReal v, doStep, getReal outputs[, getBoolean outputs]) over ``speeds``,
+    raw fmpy calls on the instance ``fmu`` (a :class:`restitution.cosim.FmuInstance`)."""
+    variables = fmu.model_description.modelVariables
+    outs = [v for v in variables if v.causality == "output"]
+    reals = [v.valueReference for v in outs if v.type == "Real"]
+    bools = [v.valueReference for v in outs if v.type == "Boolean"]
+    s, vin = fmu.slave, [next(v.valueReference for v in variables if v.causality == "input")]
+    reals = reals if full else reals[:1]
+    values = [[float(x)] for x in speeds]
+    h = 1e-3
 
-    def __init__(self, path: Path, work: Path):
-        from fmpy import extract, read_model_description
-        from fmpy.fmi2 import FMU2Slave
-
-        md = read_model_description(str(path))
-        self.unzipped = extract(str(path), unzipdir=str(work / f"unzipped_{path.stem}"))
-        self.slave = FMU2Slave(guid=md.guid, unzipDirectory=self.unzipped,
-                               modelIdentifier=md.coSimulation.modelIdentifier, instanceName=path.stem)
-        self.slave.instantiate()
-        self.slave.setupExperiment(startTime=0.0)
-        self.slave.enterInitializationMode()
-        self.slave.exitInitializationMode()
-        self.vr = {v.name: v.valueReference for v in md.modelVariables}
-        outs = [v for v in md.modelVariables if v.causality == "output"]
-        self.reals = [v.valueReference for v in outs if v.type == "Real"]
-        self.bools = [v.valueReference for v in outs if v.type == "Boolean"]
-        self.input = next(v.valueReference for v in md.modelVariables if v.causality == "input")
-        self.t = 0.0
-
-    def round_trips(self, speeds, full: bool = True):
-        """run(n): n passes of (setReal v, doStep, getReal outputs[, getBoolean outputs]) over ``speeds``."""
-        s, vin, reals, bools = self.slave, [self.input], self.reals if full else self.reals[:1], self.bools
-        values = [[float(x)] for x in speeds]
-        h = 1e-3
-
-        def run(n):
-            t = self.t
-            for _ in range(n):
-                for value in values:
-                    s.setReal(vin, value)
-                    s.doStep(t, h)
-                    t += h
-                    s.getReal(reals)
-                    if full:
-                        s.getBoolean(bools)
-            self.t = t
-            return n * len(values)
-        return run
-
-    def close(self):
-        self.slave.terminate()
-        self.slave.freeInstance()
+    def run(n):
+        t = fmu.time
+        for _ in range(n):
+            for value in values:
+                s.setReal(vin, value)
+                s.doStep(t, h)
+                t += h
+                s.getReal(reals)
+                if full:
+                    s.getBoolean(bools)
+        fmu.time = t
+        return n * len(values)
+    return run
 
 
-def fmu_costs(cfg: Config, fmus: dict, work: Path) -> dict:
-    floor = _Slave(fmus["BenchWrapperFloor"], work)
-    floor_fast = _Slave(fmus["BenchWrapperFloorOnePass"], work)
-    spi = _Slave(fmus["SpherePlateImpact"], work)
+def fmu_costs(cfg: Config, fmus: dict) -> dict:
+    floor, floor_fast, spi = (FmuInstance(fmus[name], instance_name=name, logging_on=False)
+                              for name in ("BenchWrapperFloor", "BenchWrapperFloorOnePass", "SpherePlateImpact"))
+    vr = {name: spi.vr(name) for name in ("plate.t", "v_approach", "zener.lambda", "zener_method",
+                                          "zener.ode_tolerance")}
     d = 6.35e-3
     speeds = list(np.linspace(0.5, 5.0, 97))  # distinct consecutive values: every set is a new impact
     out = {"costs": {}, "ratios": {}, "exact_over_paper_fit": {}, "get_e_only": {}}
     s = spi.slave
-    codes = {"exact": 1, "paper_fit": 2, "linear": 3, "ode": 4}
+    codes = table("SpherePlateImpact")["zener_method"].codes
     try:
         for rng, t_over_d in zip(RANGES, (1.0, 0.1)):
-            s.setReal([spi.vr["plate.t"]], [t_over_d * d])
-            s.setReal([spi.vr["v_approach"]], [speeds[0]])
-            lam = s.getReal([spi.vr["zener.lambda"]])[0]
-            s.setReal([spi.vr["v_approach"]], [speeds[-1]])
-            lam_hi = s.getReal([spi.vr["zener.lambda"]])[0]
+            s.setReal([vr["plate.t"]], [t_over_d * d])
+            s.setReal([vr["v_approach"]], [speeds[0]])
+            lam = s.getReal([vr["zener.lambda"]])[0]
+            s.setReal([vr["v_approach"]], [speeds[-1]])
+            lam_hi = s.getReal([vr["zener.lambda"]])[0]
             out.setdefault("lambda_span", {})[rng] = (min(lam, lam_hi), max(lam, lam_hi), t_over_d)
 
             def with_method(method, rtol=None):
                 def run(n):
-                    s.setInteger([spi.vr["zener_method"]], [codes[method]])
+                    s.setInteger([vr["zener_method"]], [codes[method]])
                     if rtol is not None:
-                        s.setReal([spi.vr["zener.ode_tolerance"]], [rtol])
-                    return spi.round_trips(speeds)(n)
+                        s.setReal([vr["zener.ode_tolerance"]], [rtol])
+                    return round_trips(spi, speeds)(n)
                 return run
-            variants = {"trivial FMU (floor)": floor.round_trips(speeds),
-                        "trivial FMU, one-pass getters": floor_fast.round_trips(speeds),
+            variants = {"trivial FMU (floor)": round_trips(floor, speeds),
+                        "trivial FMU, one-pass getters": round_trips(floor_fast, speeds),
                         "exact": with_method("exact"), "paper_fit": with_method("paper_fit"),
                         "linear": with_method("linear")}
             timings = interleaved(variants, cfg.reps, cfg.batch_seconds)
@@ -169,17 +153,17 @@ def fmu_costs(cfg: Config, fmus: dict, work: Path) -> dict:
                 ode_speeds = speeds[:: max(1, len(speeds) // 8)]
 
                 def run_ode(n, rtol=rtol, ode_speeds=ode_speeds):
-                    s.setInteger([spi.vr["zener_method"]], [4])
-                    s.setReal([spi.vr["zener.ode_tolerance"]], [rtol])
-                    return spi.round_trips(ode_speeds)(n)
+                    s.setInteger([vr["zener_method"]], [codes["ode"]])
+                    s.setReal([vr["zener.ode_tolerance"]], [rtol])
+                    return round_trips(spi, ode_speeds)(n)
                 ts = [timed(run_ode, 1) for _ in range(cfg.ode_reps)]
                 out["costs"][(label, rng)] = median(ts)
                 out["ratios"][(label, rng)] = median(ts) / out["costs"][("trivial FMU (floor)", rng)]
-            s.setInteger([spi.vr["zener_method"]], [1])
+            s.setInteger([vr["zener_method"]], [codes["exact"]])
         # the same with a single output read (set v, step, get e)
-        s.setReal([spi.vr["plate.t"]], [d])
-        timings = interleaved({"floor": floor.round_trips(speeds, full=False),
-                               "exact": spi.round_trips(speeds, full=False)}, cfg.reps, cfg.batch_seconds)
+        s.setReal([vr["plate.t"]], [d])
+        timings = interleaved({"floor": round_trips(floor, speeds, full=False),
+                               "exact": round_trips(spi, speeds, full=False)}, cfg.reps, cfg.batch_seconds)
         out["get_e_only"] = {"floor": median(timings["floor"]), "exact": median(timings["exact"]),
                              "ratio": median_ratio(timings["exact"], timings["floor"])}
     finally:

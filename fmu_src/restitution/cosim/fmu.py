@@ -80,11 +80,12 @@ class FmuInstance:
     ...     e, = fmu.get("e")
 
     ``unzip_dir`` lets several instances share one extraction; ``logger(status, message)``
-    receives the FMU's log messages (default: collected in :attr:`messages`).
+    receives the FMU's log messages (default: collected in :attr:`messages`); ``logging_on=False``
+    asks the FMU for warnings and errors only (fmi2Instantiate's loggingOn), as a timing loop wants.
     """
 
     def __init__(self, fmu_path, instance_name: str = "instance", unzip_dir=None, logger=None,
-                 start_time: float = 0.0, parameters: dict | None = None):
+                 start_time: float = 0.0, parameters: dict | None = None, logging_on: bool = True):
         from fmpy import extract, read_model_description
         from fmpy.fmi2 import FMU2Slave
 
@@ -99,7 +100,7 @@ class FmuInstance:
         self._slave = FMU2Slave(guid=self.model_description.guid, unzipDirectory=self.unzip_dir,
                                 modelIdentifier=self.model_description.coSimulation.modelIdentifier,
                                 instanceName=self.instance_name)
-        self._slave.instantiate(loggingOn=True, callbacks=self._make_callbacks())
+        self._slave.instantiate(loggingOn=logging_on, callbacks=self._make_callbacks())
         self.time = start_time
         try:
             self._call(lambda: self._slave.setupExperiment(startTime=start_time))
