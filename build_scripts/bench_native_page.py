@@ -120,7 +120,7 @@ def render(res: dict) -> str:
         "## Through fmpy",
         "",
         "fmpy's `FMU2Slave` in this Python process, its raw FMI functions called with preallocated ctypes "
-        "arrays (as `tests/test_fmu_robustness.py`'s million-step test calls them). The *floor* is an FMU "
+        "arrays (as `tests/fmu/test_fmu_robustness.py`'s million-step test calls them). The *floor* is an FMU "
         "with the same modelDescription built from the same C front (`fmu_src/restitution/fmu/cfront/`), the "
         "same generated interface table and the same compiler flags as the native FMU, with a backend that "
         "does nothing (every hook returns at once, outputs are constants: `build_scripts/bench_c/floor_fmu.c`): "
@@ -131,7 +131,7 @@ def render(res: dict) -> str:
         "## In a plain C host",
         "",
         "A C timing host (`build_scripts/bench_c/timing_host.c`: dlopen of the FMU binary, the four calls in a loop, "
-        "`clock_gettime`) run under `env -i PATH=/usr/bin:/bin` as `tests/test_c_host_impact.py` runs its "
+        "`clock_gettime`) run under `env -i PATH=/usr/bin:/bin` as `tests/hosts/test_c_host_impact.py` runs its "
         "host, all three FMUs instantiated in the one process; the pythonfmu FMU's guard starts the "
         "interpreter recorded in `resources/python_env.txt`.",
         "",

@@ -66,7 +66,7 @@ def _interfaces(model_description: str):
 # ------------------------------------------------------------------------------------------------
 class _FmpyRoundTrip:
     """One initialised instance and its raw FMI functions: set v_approach, doStep, get every Real and
-    every Boolean output, as tests/test_fmu_robustness.py's million-step test calls them."""
+    every Boolean output, as tests/fmu/test_fmu_robustness.py's million-step test calls them."""
 
     def __init__(self, fmu: Unzipped, v_vr, real_vrs, bool_vrs):
         from fmpy.fmi2 import FMU2Slave, fmi2Boolean, fmi2Real, fmi2ValueReference
@@ -142,7 +142,7 @@ def fmpy_round_trips(built: Built, labels: tuple, reps: int, seconds: float) -> 
 # Round trips in the plain C host (one process, every FMU instantiated once, batches interleaved)
 # ------------------------------------------------------------------------------------------------
 def c_host_round_trips(built: Built, labels: tuple, reps: int, seconds: float, each_call: bool = False) -> Series:
-    """Seconds per round trip in the C timing host, run as tests/test_c_host_impact.py runs its host:
+    """Seconds per round trip in the C timing host, run as tests/hosts/test_c_host_impact.py runs its host:
     ``env -i PATH=/usr/bin:/bin`` (no virtual environment, PYTHONPATH or LD_PRELOAD; the pythonfmu
     FMU's guard finds its interpreter from resources/python_env.txt). ``each_call``: seconds per call
     of each of the four calls made alone (labels ``<fmu>/<fmi2 function>``)."""

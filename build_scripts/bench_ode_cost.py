@@ -38,7 +38,7 @@ RTOLS = (1e-14, 1e-13, 1e-12, 3e-12, 1e-11, 3e-11, 1e-10, 1e-9, 1e-8, 1e-6, 1e-4
 
 
 def lambda_max():
-    """The largest lambda [1] of the declared domain: Eq. (12) at its corner (see tests/test_ode_cost.py)."""
+    """The largest lambda [1] of the declared domain: Eq. (12) at its corner (see tests/physics/test_ode_cost.py)."""
     corner = dict(v=DOMAIN["v"][1], sphere_E=DOMAIN["sphere_E"][1], sphere_nu=0.4999, sphere_Sy=1e9,
                   sphere_rho=DOMAIN["sphere_rho"][1], sphere_d=DOMAIN["sphere_d"][1],
                   plate_E=DOMAIN["plate_E"][0], plate_nu=0.0, plate_Sy=1e9,
@@ -142,7 +142,7 @@ honours are raised to its floor (2.2e-14 for DOP853 at lambda <= 10, 1e-13 for L
 verified large-lambda form (e_ze = 0.6793 lambda^-5, accurate to ~1e-12, better than LSODA reaches there) replaces the
 solve. The most work here: {where(most_work)}; DOP853 at lambda = 10 and the tightest tolerance takes ~14 000
 evaluations (an explicit method needs ~4.5 lambda^(5/3) steps). A call that would pass {zo.MAX_RHS_EVALUATIONS} right-hand-side evaluations stops with an error (the FMU reports
-the evaluation as failed) - a guard that no point of the domain reaches. `tests/test_ode_cost.py` bounds the work
+the evaluation as failed) - a guard that no point of the domain reaches. `tests/physics/test_ode_cost.py` bounds the work
 (right-hand-side evaluations), not the time.
 
 Before this bound (same machine, earlier): LSODA failed below rtol ~2e-14 from lambda ~ 100 and its Radau fallback took

@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
 # System packages some tests need beyond Python, gcc and the lock:
 #   gcc-mingw-w64-x86-64  the native FMUs' binaries/win64 (x86_64-w64-mingw32-gcc)
-#   wine64, wine          running win64 programs (tests/test_native_win64.py)
-#   libtbb12              the ecos engine of the ecospy wheel (tests/test_native_hosts.py)
-#   cmake                 fmpy's rebuild of a native FMU from its sources/ (tests/test_native_fmu.py)
+#   wine64, wine          running win64 programs (tests/fmu/test_native_win64.py)
+#   libtbb12              the ecos engine of the ecospy wheel (tests/hosts/test_native_hosts.py)
+#   cmake                 fmpy's rebuild of a native FMU from its sources/ (tests/fmu/test_native_fmu.py)
 #
 #   bash build_scripts/system_packages.sh
 #
@@ -13,10 +13,10 @@
 set -u
 
 declare -A SKIPS=(
-    [gcc-mingw-w64-x86-64]="tests/test_native_win64.py skips, and the native FMUs are built without binaries/win64"
-    [wine64]="tests/test_native_win64.py skips (no Wine to run the win64 physics driver and FMU host)"
-    [libtbb12]="the ecos tests of tests/test_native_hosts.py skip (ecos needs libtbb.so.12)"
-    [cmake]="tests/test_native_fmu.py::test_rebuilt_from_sources_by_fmpy skips (fmpy's rebuild uses cmake)"
+    [gcc-mingw-w64-x86-64]="tests/fmu/test_native_win64.py skips, and the native FMUs are built without binaries/win64"
+    [wine64]="tests/fmu/test_native_win64.py skips (no Wine to run the win64 physics driver and FMU host)"
+    [libtbb12]="the ecos tests of tests/hosts/test_native_hosts.py skip (ecos needs libtbb.so.12)"
+    [cmake]="tests/fmu/test_native_fmu.py::test_rebuilt_from_sources_by_fmpy skips (fmpy's rebuild uses cmake)"
 )
 ORDER=(gcc-mingw-w64-x86-64 wine64 libtbb12 cmake)
 

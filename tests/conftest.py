@@ -1,4 +1,11 @@
-"""Shared fixtures: the FMU is built once per test session from the working tree."""
+"""Shared fixtures: the FMU is built once per test session from the working tree.
+
+The tests mirror the package: physics/ (the equations and the model), fmu/ (the FMUs: both
+implementations, the C front, the guard, the build), hosts/ (FMI hosts and co-simulation masters),
+tools/ (scenes, sweeps, examples, benchmarks). What several of them share lives here, in tests/:
+cases.py (case sets), agree.py (comparing within conditioning), independent.py (the references from
+outside the code), fmi_child.py (hostile FMI calls in a child process), toy_fmu.py and toys/, c_host/
+(C hosts and drivers), data/."""
 import sys
 from pathlib import Path
 
@@ -6,6 +13,7 @@ import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "build_scripts"))
+sys.path.insert(0, str(ROOT / "tests"))  # the shared helpers, from every folder
 # the slave modules (sphere_plate_impact_slave, ...) and what they share import by name, as in the FMUs
 MODELS = ROOT / "fmu_src" / "restitution" / "fmu" / "models"
 for _folder in (MODELS / "sphere_plate_impact", MODELS / "bouncing_ball", MODELS):

@@ -265,7 +265,7 @@ def _own_array(x, shape, dtype):
     A temporary that already is one is used as is (copying 1e5-element results cost as
     much as computing them); anything else (scalars, views) is broadcast and copied. Every value
     the pipeline hands over is a fresh temporary or a scalar, never an input and never the same
-    object twice (tests/test_model_contract.py checks that no field shares memory with an input
+    object twice (tests/physics/test_model_contract.py checks that no field shares memory with an input
     or another field, in every effect mode), so an owned array of the right kind is safe to keep.
     """
     if x.__class__ is np.ndarray and x.shape == shape and x.dtype == dtype and x.flags.owndata:

@@ -62,7 +62,7 @@ declares (lambda from 0 to ~6e18, tolerance 1e-14 ... 1e-2):
   cannot add accuracy.  The form's neglected terms are ~exp(-3 lambda^(5/3))
   (below double precision from lambda ~ 6) and its constants were fitted to
   rtol = 1e-13 solves: it agrees with independent direct solves to ~1e-12 in
-  e_ze and tau0 (tests/test_ode_cost.py checks 1e-10 at lambda = 1e3, 1e5,
+  e_ze and tau0 (tests/physics/test_ode_cost.py checks 1e-10 at lambda = 1e3, 1e5,
   1e10, 1e18 against a loose-enough reference), whereas LSODA at its tightest
   honoured tolerance reaches only ~5e-12-1e-11 there, at a cost growing
   like ln(lambda) (55 000 evaluations, ~0.9 s, at lambda = 1.3e18) and, at

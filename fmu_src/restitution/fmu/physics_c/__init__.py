@@ -1,5 +1,5 @@
 """The C physics of the native FMUs (C99, no Python at run time), following the ``restitution``
-package (the package is authoritative; tests/test_native_*.py keep the two together).
+package (the package is authoritative; tests/fmu/test_native_*.py keep the two together).
 
 * ``rst_physics.h`` / ``rst_physics.c``: JGM Eqs. (1)-(8), Zener Eqs. (9)-(13a), (22), fusion
   Eqs. (17)-(20) of I. Green, Nonlinear Dyn (2022), in the package's well-conditioned forms.

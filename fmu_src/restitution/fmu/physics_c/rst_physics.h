@@ -5,7 +5,7 @@
  * zener_exact.py, fusion.py), which is authoritative: where the two disagree, the C is wrong.
  * The same well-conditioned forms are used (e45 in log space, expm1 deficits 1 - e_ze, the fused
  * COR as a difference of two non-negative terms), so the two agree within each output's
- * conditioning (restitution.agreement), which tests/test_native_physics.py checks.
+ * conditioning (restitution.agreement), which tests/fmu/test_native_physics.py checks.
  *
  * Pure functions of their arguments: no global mutable state, safe from any thread. */
 #ifndef RST_PHYSICS_H

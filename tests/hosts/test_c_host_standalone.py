@@ -19,7 +19,7 @@ import pytest
 
 from toy_fmu import build_plain_toy
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 HOST_SOURCE = ROOT / "tests" / "c_host" / "fmi2_script_host.c"
 MAKE_STANDALONE = ROOT / "fmu_src" / "restitution" / "fmu" / "build_guard.py"
 

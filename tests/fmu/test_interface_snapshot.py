@@ -4,7 +4,7 @@ apart from what differs between builds (the GUID and the generation time).
 
 A deliberate change of the interface updates the copies in the same commit:
 
-    RESTITUTION_UPDATE_SNAPSHOTS=1 bash build_scripts/quickstart.sh test tests/test_interface_snapshot.py
+    RESTITUTION_UPDATE_SNAPSHOTS=1 bash build_scripts/quickstart.sh test tests/fmu/test_interface_snapshot.py
 
 and the diff of the copies is what a reviewer reads to see what hosts will see."""
 import difflib
@@ -15,7 +15,7 @@ from pathlib import Path
 
 import pytest
 
-SNAPSHOTS = Path(__file__).resolve().parent / "data" / "model_descriptions"
+SNAPSHOTS = Path(__file__).resolve().parents[1] / "data" / "model_descriptions"
 #: Attributes that differ between two builds of the same sources.
 PER_BUILD = re.compile(r'\s(guid|generationDateAndTime)="[^"]*"')
 

@@ -35,25 +35,10 @@ from restitution.model import DOMAIN, ZENER_SLOPE_BOUND
 from restitution.zener_exact import E_INF
 
 from agree import assert_agree, stack
+from cases import D, FMU_FLAGS, FMU_REALS, PAIRS, SPEEDS, T_OVER_D, params_for
 
 pytestmark = pytest.mark.filterwarnings("error")
 
-D = 6.35e-3  # [m]
-M = r.MATERIALS
-STIFF_NU0 = r.Material("stiff, nu = 0", 200e9, 0.0, 1.0e9, 7800.0)
-SOFT_NU499 = r.Material("soft, nu = 0.499", 70e9, 0.499, 0.3e9, 2700.0)
-PAIRS = {
-    "s2/al6061": (M["s2_tool_steel"], M["al_6061"]),  # Table 3, the paper's checkpoint
-    "T4-A1": r.table4_case("A1"),  # heavy stiff sphere, light soft plate: lambda up to ~1e4
-    "T4-B4": r.table4_case("B4"),
-    "glass/glass": (M["borosilicate_glass"], M["borosilicate_glass"]),  # Sy = 1e12 on both sides
-    "glass/al6061": (M["borosilicate_glass"], M["al_6061"]),  # brittle sphere
-    "wc/glass": (M["tungsten_carbide"], M["borosilicate_glass"]),  # brittle plate
-    "nu0/nu0.499": (STIFF_NU0, SOFT_NU499),
-    "nu0.499/nu0": (SOFT_NU499, STIFF_NU0),
-}
-SPEEDS = [0.0, 1e-12, 1e-9, 1e-6, 1e-3, 0.1, 1.0, 10.0, 100.0, 1e3]
-T_OVER_D = [0.01, 0.05, 0.2, 1.0, 10.0, 100.0, 1e3]
 MODELS, METHODS = r.RESTITUTION_MODELS, r.ZENER_METHODS
 TAU0_MIN = {"exact": zener.TAU0_HERTZ, "ode": zener.TAU0_HERTZ, "paper_fit": 3.215, "linear": math.pi}
 
@@ -61,19 +46,10 @@ REAL_FIELDS = ("e", "v_rebound", "e_ep", "V_c", "V_star", "eps_y", "e_ze", "lam"
                "m_a", "m_eff", "mass_ratio", "v_plate")
 FLAG_FIELDS = ("plasticity_used", "plate_waves_used", "lambda_in_range", "vstar_in_range", "e_negative",
                "contact_ends", "valid")
-# FMU output -> ImpactResult field (the public interface table)
-FMU_REALS = {"e": "e", "v_rebound": "v_rebound", "jgm.e": "e_ep", "jgm.V_c": "V_c", "jgm.V_star": "V_star",
-             "zener.e": "e_ze", "zener.lambda": "lam", "zener.tau0": "tau0", "zener.t_contact": "t_contact",
-             "plate.mass_ratio": "mass_ratio", "plate.v_after": "v_plate", "sphere.m": "m_a"}
-FMU_FLAGS = {"valid": "valid", "zener.in_range": "lambda_in_range", "jgm.in_range": "vstar_in_range",
-             "e_negative": "e_negative", "effects.plasticity": "plasticity_used",
-             "effects.plate_waves": "plate_waves_used", "zener.contact_ends": "contact_ends"}
 MODE_CODE = {"off": 0, "on": 1, "auto": 2}
 
 
-def params_for(pair, t_over_d=1.0, d=D):
-    sphere_mat, plate_mat = PAIRS[pair]
-    return {**r.Sphere(sphere_mat, d).params(), **r.Plate(plate_mat, t_over_d * d).params()}
+
 
 
 def run(v, params, **options):

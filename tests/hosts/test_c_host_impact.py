@@ -31,7 +31,7 @@ import restitution as r
 from restitution.agreement import tolerances
 from restitution.cosim import impact_fmu_parameters
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 HOST_SOURCE = ROOT / "tests" / "c_host" / "fmi2_script_host.c"
 MODEL = "SpherePlateImpact"
 

@@ -28,7 +28,7 @@ from restitution.zener_ode import solve_zener_ode
 
 pytestmark = pytest.mark.numerics
 
-#: lim lambda^5 e_ze (large-lambda limit of Eq. (10)), as pinned in tests/test_zener_exact.py
+#: lim lambda^5 e_ze (large-lambda limit of Eq. (10)), as pinned in tests/physics/test_zener_exact.py
 E_INF_LITERAL = 0.679293063936
 #: the declared range of zener.ode_tolerance (the FMU's min/max)
 RTOL_LOW, RTOL_HIGH = 1e-14, 1e-2

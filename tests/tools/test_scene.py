@@ -17,7 +17,7 @@ from restitution.scene.__main__ import main
 from restitution.scene.report import MARK_END, MARK_START, compare, report_scene
 from restitution.scene.runner import open_instance
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 SCENES = ROOT / "examples" / "scenes"
 EXAMPLES = sorted(SCENES.glob("*.toml"))
 G = 9.80665

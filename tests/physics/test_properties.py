@@ -8,12 +8,13 @@ import math
 import numpy as np
 import pytest
 from hypothesis import HealthCheck, example, given, settings
-from hypothesis import strategies as st
 
 import restitution as r
 from restitution.model import DOMAIN, published
 from restitution.sweep.spec import OUTPUTS as PUBLISHED_OUTPUTS  # (FMU name, field, type) of every FMU output
 from restitution.zener import TAU0_HERTZ, zener_linear, zener_paper_fit
+
+from cases import CASES
 
 pytestmark = pytest.mark.numerics
 
@@ -29,27 +30,7 @@ DOCUMENTED_INFINITE = {
 FLAGS = ("plasticity_used", "plate_waves_used", "lambda_in_range", "vstar_in_range", "e_negative", "contact_ends")
 
 
-def log_uniform(low, high):
-    """Floats spread evenly in log10 between low > 0 and high, with both ends as likely examples."""
-    return st.one_of(st.sampled_from([low, high]),
-                     st.floats(math.log10(low), math.log10(high)).map(lambda x: min(max(10.0 ** x, low), high)))
 
-
-def parameter(name):
-    low, high = DOMAIN[name]
-    if name == "v":
-        return st.one_of(st.just(0.0), log_uniform(1e-12, high))
-    return log_uniform(low, high)
-
-
-POISSON = st.one_of(st.sampled_from([0.0, 0.25, math.nextafter(0.5, 0.0)]), st.floats(0.0, 0.5, exclude_max=True))
-CASES = st.fixed_dictionaries({
-    **{name: parameter(name) for name in DOMAIN},
-    "sphere_nu": POISSON, "plate_nu": POISSON,
-    "restitution_model": st.sampled_from(r.RESTITUTION_MODELS),
-    "zener_method": st.sampled_from(("exact", "paper_fit", "linear")),
-    "plasticity": st.sampled_from(r.EFFECT_MODES), "plate_waves": st.sampled_from(r.EFFECT_MODES),
-})
 
 
 def check_properties(case):

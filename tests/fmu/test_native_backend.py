@@ -23,8 +23,7 @@ from restitution.model import published
 from restitution.fmu.build_native import write_backend
 from restitution.fmu.compile import CFLAGS, prepare_sources
 
-from test_hard_cases import FMU_FLAGS, FMU_REALS
-from test_native_physics import NAMES, random_cases
+from cases import FMU_FLAGS, FMU_REALS, NAMES, random_cases
 
 pytestmark = pytest.mark.skipif(shutil.which("gcc") is None, reason="gcc is needed to compile the native backend")
 

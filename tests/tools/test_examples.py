@@ -18,7 +18,7 @@ import restitution as r
 
 from independent import apparent_cor, table_material
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 EXAMPLES = ROOT / "examples"
 G = 9.80665
 

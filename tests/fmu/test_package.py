@@ -16,7 +16,7 @@ import pytest
 import restitution as r
 from restitution.fmu import build as fmu_build
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 LOCK = ROOT / "requirements" / "dev.lock"
 
 

@@ -9,7 +9,7 @@ is never asserted. A flag may differ only where a relative perturbation of STEP 
 
 Cases: a random sample over the FMU's declared domain (restitution.model.DOMAIN, log-uniform) for
 every Zener method the C implements, both JGM models and all nine effect-mode pairs; the hard-case
-matrix of tests/test_hard_cases.py; and the paper's checkpoint (V_c = 0.0265 m/s, V* = 86.9 at
+matrix of tests/physics/test_hard_cases.py; and the paper's checkpoint (V_c = 0.0265 m/s, V* = 86.9 at
 2.3 m/s for S2 tool steel on Al 6061, Green 2022 Sec. 7). A sanitizer build (ASan + UBSan) runs
 the same kinds of cases in a child process.
 """
@@ -19,6 +19,7 @@ import itertools
 import math
 import shutil
 import subprocess
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -27,41 +28,18 @@ import restitution as r
 from restitution.agreement import disagreements, tolerances
 from restitution.fmu.compile import CFLAGS, compile_shared, prepare_sources
 from restitution.fmu.physics_c.physics_ctypes import METHOD_CODE, MODE_CODE, MODEL_CODE, UNSUPPORTED, NativePhysics
-from restitution.model import DOMAIN, PARAMETERS
 
-from test_hard_cases import PAIRS, SPEEDS, T_OVER_D, params_for
+from cases import NAMES, PAIRS, SPEEDS, T_OVER_D, params_for, random_cases
 
 pytestmark = pytest.mark.skipif(shutil.which("gcc") is None, reason="gcc is needed to compile the native physics")
 
+PHYSICS_DRIVER = Path(__file__).resolve().parents[1] / "c_host" / "physics_driver.c"
 NATIVE_METHODS = ("exact", "paper_fit", "linear")  # `ode` is rejected by the native FMU (see docs/native.md)
-NAMES = tuple(name for name, _unit, _kind in PARAMETERS)
 
 
 @pytest.fixture(scope="module")
 def native(tmp_path_factory):
     return NativePhysics(compile_shared(tmp_path_factory.mktemp("native")))
-
-
-def random_cases(rng, n):
-    """n cases log-uniform over DOMAIN (nu uniform in [0, 0.5)), a few at v = 0 and at the bounds."""
-    def logu(lo, hi):
-        return np.exp(rng.uniform(math.log(lo), math.log(hi), n))
-
-    lo_v = 1e-9
-    v = logu(lo_v, DOMAIN["v"][1])
-    v[:3] = (0.0, DOMAIN["v"][1], 1e-300)
-    params = {}
-    for name in NAMES:
-        if name.endswith("_nu"):
-            params[name] = rng.uniform(0.0, 0.5, n)
-            params[name][0] = 0.0
-            params[name][1] = np.nextafter(0.5, 0.0)
-        else:
-            lo, hi = DOMAIN[name]
-            params[name] = logu(lo, hi)
-            params[name][1] = hi
-            params[name][2] = lo
-    return v, params
 
 
 def assert_same_model(native, v, params, **options):
@@ -125,33 +103,14 @@ def test_ode_and_bad_codes_are_rejected(native):
     assert status == UNSUPPORTED
 
 
-_DRIVER = r"""
-#include <stdio.h>
-#include "rst_physics.h"
-int main(void)
-{
-    rst_impact_inputs in;
-    rst_impact_result o;
-    while (scanf("%lf %lf %lf %lf %lf %lf %lf %lf %lf %lf %lf %d %d %d %d %lf %lf", &in.v, &in.sphere_E,
-                 &in.sphere_nu, &in.sphere_Sy, &in.sphere_rho, &in.sphere_d, &in.plate_E, &in.plate_nu,
-                 &in.plate_Sy, &in.plate_rho, &in.plate_t, &in.restitution_model, &in.zener_method,
-                 &in.plasticity, &in.plate_waves, &in.effect_tolerance, &in.ode_rtol) == 17) {
-        int status = rst_impact(&in, &o);
-        printf("%d %a %a %a %a %a %a %a %a %a %a %a %a %a %a %d %d %d %d %d %d\n", status, o.e, o.v_rebound,
-               o.e_ep, o.V_c, o.V_star, o.eps_y, o.e_ze, o.lam, o.tau0, o.T, o.t_contact, o.m_a, o.m_eff,
-               o.v_plate, o.plasticity_used, o.plate_waves_used, o.lambda_in_range, o.vstar_in_range,
-               o.e_negative, o.valid);
-    }
-    return 0;
-}
-"""
+
 
 
 def test_sanitizers(tmp_path):
     """ASan + UBSan build (any report aborts: -fno-sanitize-recover) over random and hard cases, every
     code (including bad ones); run in a child process; its results still agree with the package."""
     src = prepare_sources(tmp_path / "src")
-    (src / "driver.c").write_text(_DRIVER)
+    shutil.copyfile(PHYSICS_DRIVER, src / "driver.c")
     exe = tmp_path / "driver"
     build = subprocess.run(["gcc", *CFLAGS, "-g", "-fsanitize=address,undefined", "-fno-sanitize-recover=all",
                             "-o", str(exe), str(src / "driver.c"), str(src / "rst_physics.c"), "-lm"],
@@ -218,7 +177,7 @@ def test_paper_table_pairs(native):
 
 
 def test_hypothesis_search_over_the_declared_domain(native):
-    """A hypothesis search (the lead's strategy of tests/test_properties.py: the declared domain, its
+    """A hypothesis search (the lead's strategy of tests/physics/test_properties.py: the declared domain, its
     bounds, nu up to 0.5 - ulp) for a case where the C and the package disagree."""
     from hypothesis import HealthCheck, given, settings
 

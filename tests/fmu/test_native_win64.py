@@ -2,7 +2,7 @@
 bits: every comparison uses the per-case tolerances of restitution.agreement, from each output's
 conditioning, never bit identity).
 
-* The physics: the same stdin/stdout driver as the sanitizer test of tests/test_native_physics.py,
+* The physics: the same stdin/stdout driver as the sanitizer test of tests/fmu/test_native_physics.py,
   built with x86_64-w64-mingw32-gcc (static runtime), against restitution.impact.
 * The FMU: binaries/win64/SpherePlateImpact.dll of the native SpherePlateImpact.fmu (as built by
   ``python -m restitution.fmu build``), loaded with LoadLibrary by the plain C host of the other host
@@ -34,13 +34,13 @@ import restitution as r
 from restitution.agreement import disagreements, tolerances
 from restitution.fmu.compile import CFLAGS, prepare_sources
 
-from test_hard_cases import FMU_FLAGS, FMU_REALS, PAIRS, params_for
-from test_native_physics import _DRIVER, NAMES, random_cases
+from cases import FMU_FLAGS, FMU_REALS, NAMES, params_for, random_cases
 
 MINGW = "x86_64-w64-mingw32-gcc"
 WINE = shutil.which("wine64") or shutil.which("wine") or (
     "/usr/lib/wine/wine64" if os.access("/usr/lib/wine/wine64", os.X_OK) else None)
-HOST_SOURCE = Path(__file__).resolve().parent / "c_host" / "fmi2_script_host.c"
+HOST_SOURCE = Path(__file__).resolve().parents[1] / "c_host" / "fmi2_script_host.c"
+PHYSICS_DRIVER = Path(__file__).resolve().parents[1] / "c_host" / "physics_driver.c"
 MODEL = "SpherePlateImpact"
 REALS = ("e", "v_rebound", "e_ep", "V_c", "V_star", "eps_y", "e_ze", "lam", "tau0", "T", "t_contact", "m_a",
          "m_eff", "v_plate")
@@ -67,7 +67,7 @@ def wine_env(tmp_path_factory):
 
 def test_win64_physics_under_wine_equals_the_package(tmp_path, wine_env):
     src = prepare_sources(tmp_path / "src")
-    (src / "driver.c").write_text(_DRIVER)
+    shutil.copyfile(PHYSICS_DRIVER, src / "driver.c")
     exe = tmp_path / "driver.exe"
     subprocess.run([MINGW, *CFLAGS, "-D__USE_MINGW_ANSI_STDIO=1", "-static", "-static-libgcc", "-o", str(exe),
                     str(src / "driver.c"), str(src / "rst_physics.c")], check=True, capture_output=True, text=True)

@@ -27,7 +27,7 @@ from fmpy import extract, read_model_description
 
 from fmi_child import run_child
 
-HERE = Path(__file__).resolve().parent
+HERE = Path(__file__).resolve().parents[1]  # tests/
 WATCHDOG = 60  # [s] a child that has not finished by then hangs: the test fails
 
 #: Scenarios inside BouncingBall's declared ranges that never returned before: (parameters, start

@@ -24,8 +24,7 @@ from restitution.model import published
 from restitution.fmu.build_native import (GENERATION_TOOL, NativeBuildSkipped, front_files,
                                                  native_model_description)
 
-from test_hard_cases import FMU_FLAGS, FMU_REALS, params_for
-from test_properties import CASES  # the declared domain, drawn log-uniformly
+from cases import CASES, FMU_FLAGS, FMU_REALS, params_for  # CASES: the declared domain, drawn log-uniformly
 
 INTERFACE_ATTRIBUTES = ("name", "valueReference", "causality", "variability", "initial", "description")
 TYPE_ATTRIBUTES = ("unit", "start", "min", "max", "declaredType")
