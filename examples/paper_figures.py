@@ -28,7 +28,7 @@ import numpy as np
 import restitution as r
 from restitution.viz import write_png
 from restitution.cosim import FmuInstance, build_default_fmu
-from restitution.fmu.models.sphere_plate_impact.variables import fmu_values
+from restitution.fmu.models.sphere_plate_impact.variables import TABLE, fmu_values
 from restitution.materials import table4_case
 
 HERE = Path(__file__).resolve().parent
@@ -40,7 +40,7 @@ DIAMETERS = (4.76e-3, 6.35e-3)  #: sphere diameters of the experiments [m]
 PLATE_THICKNESSES = (1.6e-3, 3.18e-3, 4.76e-3, 6.35e-3, 9.53e-3, 12.7e-3)  #: Al 6061 plates [m]
 FIG6_SPHERES = ("tungsten_carbide", "s2_tool_steel", "borosilicate_glass")  # brass left out, as in the paper
 OUTPUTS = ("e", "jgm.e", "zener.e", "zener.lambda", "jgm.V_star", "jgm.V_c")
-KEYS = ("e", "e_ep", "e_ze", "lam", "V_star", "V_c")
+KEYS = tuple(TABLE[name].key for name in OUTPUTS)  # ("e", "e_ep", "e_ze", "lam", "V_star", "V_c")
 #: |e - e_JGM| within which a curve counts as having reached its asymptote (Fig. 5 statement).
 ASYMPTOTE_TOLERANCE = 0.01
 

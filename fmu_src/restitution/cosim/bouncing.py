@@ -27,15 +27,15 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..fmu.models.sphere_plate_impact.variables import TABLE
+
 __all__ = ["Bounces", "bounce", "impact_sequence", "fmu_rebound", "package_rebound", "RECORDED", "STANDARD_GRAVITY"]
 
 STANDARD_GRAVITY = 9.80665  # [m/s^2]
 
-#: FMU output name -> record field, read at every impact.
-RECORDED = {
-    "e": "e", "jgm.e": "e_ep", "zener.e": "e_ze", "zener.lambda": "lam", "zener.tau0": "tau0",
-    "zener.t_contact": "t_contact", "v_rebound": "v_rebound",
-}
+#: FMU output name -> record field (the output's ImpactResult field), read at every impact.
+RECORDED = {name: TABLE[name].key
+            for name in ("e", "jgm.e", "zener.e", "zener.lambda", "zener.tau0", "zener.t_contact", "v_rebound")}
 
 
 @dataclass

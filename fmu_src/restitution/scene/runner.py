@@ -35,7 +35,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..fmu.models.sphere_plate_impact.variables import fmu_values
+from ..fmu.models.sphere_plate_impact.variables import TABLE, fmu_values
 from ..model import ZENER_SLOPE_BOUND, impact
 from ..zener import ZENER_METHODS
 from ..cosim.bouncing import impact_sequence
@@ -45,11 +45,17 @@ from .loader import Drop, Scene, SceneError
 __all__ = ["DropResult", "SceneResult", "SceneInterrupted", "DropWriter", "run_scene", "ensure_fmu",
            "open_instance", "COLUMNS", "READ_OUTPUTS", "VALIDITY", "drop_parameters"]
 
+def _fmu_outputs(*names):
+    """(FMU output names, result column names, units) of the outputs ``names``, from the interface table."""
+    rows = [TABLE[name] for name in names]
+    return names, tuple(v.key for v in rows), tuple(v.unit for v in rows)
+
+
 #: requested output -> (FMU output names, result column names, units)
 READ_OUTPUTS = {
-    "bounce_heights": ((), ("apex",), ("m",)),
-    "cor": (("e", "jgm.e", "zener.e"), ("e", "e_ep", "e_ze"), ("1", "1", "1")),
-    "contact_durations": (("zener.t_contact",), ("t_contact",), ("s",)),
+    "bounce_heights": ((), ("apex",), ("m",)),  # from the impact speeds (host side), not an FMU output
+    "cor": _fmu_outputs("e", "jgm.e", "zener.e"),
+    "contact_durations": _fmu_outputs("zener.t_contact"),
 }
 #: column -> CSV header
 COLUMNS = {"apex": "apex_m", "e": "e", "e_ep": "e_ep", "e_ze": "e_ze", "t_contact": "t_contact_s"}
