@@ -82,10 +82,13 @@ class FmuInstance:
     ``unzip_dir`` lets several instances share one extraction; ``logger(status, message)``
     receives the FMU's log messages (default: collected in :attr:`messages`); ``logging_on=False``
     asks the FMU for warnings and errors only (fmi2Instantiate's loggingOn), as a timing loop wants.
+    ``instantiate(slave)``, when given, calls fmi2Instantiate on the ``fmpy.fmi2.FMU2Slave`` instead
+    (its own callbacks and module set-up: the sweep's FMU back end); ``fmu_path`` may be an unzipped FMU.
     """
 
     def __init__(self, fmu_path, instance_name: str = "instance", unzip_dir=None, logger=None,
-                 start_time: float = 0.0, parameters: dict | None = None, logging_on: bool = True):
+                 start_time: float = 0.0, parameters: dict | None = None, logging_on: bool = True,
+                 instantiate=None):
         from fmpy import extract, read_model_description
         from fmpy.fmi2 import FMU2Slave
 
@@ -100,7 +103,10 @@ class FmuInstance:
         self._slave = FMU2Slave(guid=self.model_description.guid, unzipDirectory=self.unzip_dir,
                                 modelIdentifier=self.model_description.coSimulation.modelIdentifier,
                                 instanceName=self.instance_name)
-        self._slave.instantiate(loggingOn=logging_on, callbacks=self._make_callbacks())
+        if instantiate is None:
+            self._slave.instantiate(loggingOn=logging_on, callbacks=self._make_callbacks())
+        else:
+            instantiate(self._slave)
         self.time = start_time
         try:
             self._call(lambda: self._slave.setupExperiment(startTime=start_time))

@@ -153,37 +153,37 @@ _INSTANCES: dict = {}  # (sha, thread id) -> _LoadedFmu
 
 
 class _LoadedFmu:
-    """One FMU2Slave with its value references, created with the FMU's own bundled code."""
+    """One instance of the FMU (a :class:`restitution.cosim.FmuInstance`) with its value references,
+    created with the FMU's own bundled code and a logger that drops messages (a bad case shows as NaN
+    outputs and ok = False)."""
 
     def __init__(self, unzip_dir: str):
-        from fmpy import read_model_description
-        from fmpy.fmi2 import FMU2Slave
+        from ..cosim.fmu import FmuInstance
 
         global _FMI_CALL_ERRORS
         _FMI_CALL_ERRORS = _fmi_call_errors()
-        md = read_model_description(unzip_dir)
         self.unzip_dir = unzip_dir
-        variables = {v.name: v for v in md.modelVariables}
+        self.instance = FmuInstance(unzip_dir, instance_name=f"sweep-{os.getpid()}-{threading.get_ident()}",
+                                    unzip_dir=unzip_dir, instantiate=self._instantiate)
+        self.slave = self.instance.slave
+        variables = self.instance.variables
         self.vr = {name: variables[name].valueReference for name in variables}
         missing = [name for name, _kw, _t, _s in INPUTS if name not in variables]
         missing += [name for name, _f, _t in OUTPUTS if name not in variables]
         if missing:
+            self.close()
             raise ValueError(f"{unzip_dir}: not a SpherePlateImpact FMU (no variable(s) {missing})")
-        self.slave = FMU2Slave(guid=md.guid, unzipDirectory=unzip_dir,
-                               modelIdentifier=md.coSimulation.modelIdentifier,
-                               instanceName=f"sweep-{os.getpid()}-{threading.get_ident()}")
-        if os.path.isfile(os.path.join(unzip_dir, "resources", "slavemodule.txt")):  # a pythonfmu FMU
-            self.code_file = _instantiate_with_bundled_code(self.slave, unzip_dir)
-            self.code = code_fingerprint(Path(self.code_file).parent)
-        else:  # a native FMU (C only): its binary is the code that runs
-            self.slave.instantiate(loggingOn=False, callbacks=_quiet_callbacks())
-            self.code_file = self.slave.dll._name
-            self.code = hashlib.sha256(Path(self.code_file).read_bytes()).hexdigest()[:12]
-        self.slave.setupExperiment(startTime=0.0)
-        self.slave.enterInitializationMode()
-        self.slave.exitInitializationMode()
         self.busy = False  #: a chunk is being evaluated (in the thread that owns the instance)
         self.doomed = None  #: released while busy: closed (and this directory removed) when the chunk returns
+
+    def _instantiate(self, slave):
+        if os.path.isfile(os.path.join(self.unzip_dir, "resources", "slavemodule.txt")):  # a pythonfmu FMU
+            self.code_file = _instantiate_with_bundled_code(slave, self.unzip_dir)
+            self.code = code_fingerprint(Path(self.code_file).parent)
+        else:  # a native FMU (C only): its binary is the code that runs
+            slave.instantiate(loggingOn=False, callbacks=_quiet_callbacks())
+            self.code_file = slave.dll._name
+            self.code = hashlib.sha256(Path(self.code_file).read_bytes()).hexdigest()[:12]
 
     def reset(self):
         s = self.slave
@@ -273,8 +273,7 @@ class _LoadedFmu:
     def close(self):
         if self.slave is not None:
             try:
-                self.slave.terminate()
-                self.slave.freeInstance()
+                self.instance.close()
             except Exception:  # noqa: BLE001 - best effort at shutdown
                 pass
             self.slave = None
