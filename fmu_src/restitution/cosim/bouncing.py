@@ -29,7 +29,7 @@ import numpy as np
 
 from ..fmu.models.sphere_plate_impact.variables import TABLE
 
-__all__ = ["Bounces", "bounce", "impact_sequence", "fmu_rebound", "package_rebound", "RECORDED", "STANDARD_GRAVITY"]
+__all__ = ["Bounces", "Trajectory", "bounce", "impact_sequence", "fmu_rebound", "package_rebound", "RECORDED", "STANDARD_GRAVITY"]
 
 STANDARD_GRAVITY = 9.80665  # [m/s^2]
 
@@ -38,8 +38,44 @@ RECORDED = {name: TABLE[name].key
             for name in ("e", "jgm.e", "zener.e", "zener.lambda", "zener.tau0", "zener.t_contact", "v_rebound")}
 
 
+class Trajectory:
+    """The ball's path over one drop, from its impacts: released from rest at ``drop_height`` [m], a
+    parabola under ``gravity`` [m/s2] from each impact (``time`` [s]) at the upward speed
+    ``v_rebound`` [m/s], at rest on the plate from ``rest_time`` [s] on. The one implementation behind
+    both drop results (:class:`Bounces`, and the scene's ``DropResult``)."""
+
+    @property
+    def n_impacts(self) -> int:
+        return int(self.time.size)
+
+    def _segments(self, t):
+        """(t, time since the flight's start, its upward start speed, its start height) at times ``t``."""
+        t = np.asarray(t, dtype=float)
+        starts = np.concatenate([[0.0], self.time])
+        v0 = np.concatenate([[0.0], np.maximum(self.v_rebound, 0.0)])
+        h0 = np.concatenate([[self.drop_height], np.zeros(self.time.size)])
+        k = np.clip(np.searchsorted(starts, t, side="right") - 1, 0, starts.size - 1)
+        return t, t - starts[k], v0[k], h0[k]
+
+    def height(self, t):
+        """Height of the ball [m] at times ``t`` [s] (piecewise parabolas between impacts, 0 once at rest)."""
+        t, dt, v0, h0 = self._segments(t)
+        h = np.where(t >= self.rest_time, 0.0, h0 + v0 * dt - 0.5 * self.gravity * dt * dt)
+        return np.maximum(h, 0.0)
+
+    def velocity(self, t):
+        """Upward velocity of the ball [m/s] at times ``t`` [s] (0 once at rest)."""
+        t, dt, v0, _h0 = self._segments(t)
+        return np.where(t >= self.rest_time, 0.0, v0 - self.gravity * dt)
+
+    def energy(self, t):
+        """Mechanical energy per unit mass g h + v^2/2 [J/kg] at times ``t`` [s]."""
+        v = self.velocity(t)
+        return self.gravity * self.height(t) + 0.5 * v * v
+
+
 @dataclass
-class Bounces:
+class Bounces(Trajectory):
     """Every impact of one drop; arrays are indexed by impact number. Units in brackets."""
 
     time: np.ndarray  #: impact instants [s]
@@ -57,41 +93,6 @@ class Bounces:
     drop_height: float  #: [m]
     gravity: float  #: [m/s^2]
     extra: dict = field(default_factory=dict)
-
-    @property
-    def n_impacts(self) -> int:
-        return int(self.time.size)
-
-    def _segments(self, t):
-        t = np.asarray(t, dtype=float)
-        starts = np.concatenate([[0.0], self.time])
-        v0 = np.concatenate([[0.0], self.v_rebound])
-        h0 = np.concatenate([[self.drop_height], np.zeros(self.time.size)])
-        k = np.clip(np.searchsorted(starts, t, side="right") - 1, 0, starts.size - 1)
-        return t, t - starts[k], v0[k], h0[k]
-
-    def velocity(self, t):
-        """Upward velocity of the ball [m/s] at times ``t`` [s] (0 once at rest)."""
-        t, dt, v0, _h0 = self._segments(t)
-        return np.where(t >= self.rest_time, 0.0, v0 - self.gravity * dt)
-
-    def energy(self, t):
-        """Mechanical energy per unit mass g h + v^2/2 [J/kg] at times ``t`` [s]."""
-        v = self.velocity(t)
-        return self.gravity * self.height(t) + 0.5 * v * v
-
-    def height(self, t):
-        """Height of the ball [m] at times ``t`` [s] (piecewise parabolas between impacts)."""
-        t = np.asarray(t, dtype=float)
-        g = self.gravity
-        starts = np.concatenate([[0.0], self.time])
-        v0 = np.concatenate([[0.0], self.v_rebound])
-        h0 = np.concatenate([[self.drop_height], np.zeros(self.time.size)])
-        k = np.clip(np.searchsorted(starts, t, side="right") - 1, 0, starts.size - 1)
-        dt = t - starts[k]
-        h = h0[k] + v0[k] * dt - 0.5 * g * dt * dt
-        h = np.where(t >= self.rest_time, 0.0, h)
-        return np.maximum(h, 0.0)
 
 
 def package_rebound(**options):

@@ -38,7 +38,7 @@ import numpy as np
 from ..fmu.models.sphere_plate_impact.variables import TABLE, fmu_values
 from ..model import ZENER_SLOPE_BOUND, impact
 from ..zener import ZENER_METHODS
-from ..cosim.bouncing import impact_sequence
+from ..cosim.bouncing import Trajectory, impact_sequence
 from ..cosim.interrupt import DeferredInterrupt
 from .loader import Drop, Scene, SceneError
 
@@ -111,7 +111,7 @@ def drop_parameters(scene: Scene, drop: Drop, plasticity: str, plate_waves: str,
 # --- results -----------------------------------------------------------------------------------
 
 @dataclass
-class DropResult:
+class DropResult(Trajectory):
     """Every impact of one drop; arrays indexed by impact number."""
 
     drop: Drop
@@ -132,24 +132,13 @@ class DropResult:
         return 0 if valid is None else int(np.count_nonzero(~valid))
 
     @property
-    def n_impacts(self) -> int:
-        return int(self.time.size)
-
-    @property
     def rest_time(self) -> float:
         return float(self.time[-1]) if self.time.size else 0.0
 
-    def height(self, t):
-        """Ball height [m] at times ``t`` [s] (parabolas between impacts)."""
-        g = self.gravity
-        t = np.asarray(t, dtype=float)
-        starts = np.concatenate([[0.0], self.time])
-        v0 = np.concatenate([[0.0], np.maximum(self.v_rebound, 0.0)])
-        h0 = np.concatenate([[self.drop.drop_height], np.zeros(self.time.size)])
-        k = np.clip(np.searchsorted(starts, t, side="right") - 1, 0, starts.size - 1)
-        dt = t - starts[k]
-        h = np.where(t >= self.rest_time, 0.0, h0[k] + v0[k] * dt - 0.5 * g * dt * dt)
-        return np.maximum(h, 0.0)
+    @property
+    def drop_height(self) -> float:
+        """[m]"""
+        return self.drop.drop_height
 
 
 @dataclass
