@@ -1,4 +1,4 @@
-"""What build_scripts/bench_native.py times, built into a scratch directory.
+"""What build_scripts/benchmarks/bench_native.py times, built into a scratch directory.
 
 * the pythonfmu ``SpherePlateImpact.fmu`` (behind the project's C guard) and the native one
   (``native/SpherePlateImpact.fmu``), by the project's own build functions;
@@ -20,7 +20,7 @@ import zipfile
 from dataclasses import dataclass
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 if str(ROOT / "fmu_src") not in sys.path:
     sys.path.insert(0, str(ROOT / "fmu_src"))
 

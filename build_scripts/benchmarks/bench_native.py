@@ -1,7 +1,7 @@
 #!/usr/bin/env python
 """What one impact costs in the native SpherePlateImpact FMU: write docs/native_cost.md.
 
-    .venv/bin/python build_scripts/bench_native.py [--quick] [--out DIR]
+    .venv/bin/python build_scripts/benchmarks/bench_native.py [--quick] [--out DIR]
 
 builds, in a scratch directory, the pythonfmu FMU (behind the C guard), the native FMU, a *floor*
 FMU (the same C front and generated interface table with a backend that does nothing) and two C
@@ -32,8 +32,8 @@ import tempfile
 import time
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parent.parent
-for _p in (ROOT / "fmu_src", ROOT / "build_scripts"):
+ROOT = Path(__file__).resolve().parents[2]
+for _p in (ROOT / "fmu_src", ROOT / "build_scripts" / "benchmarks"):
     if str(_p) not in sys.path:
         sys.path.insert(0, str(_p))
 

@@ -1,7 +1,7 @@
 #!/usr/bin/env python
 """What accuracy costs in time: measure every accuracy choice and write docs/accuracy.md.
 
-    .venv/bin/python build_scripts/bench_accuracy.py [--quick] [--out DIR] [--jobs N]
+    .venv/bin/python build_scripts/benchmarks/bench_accuracy.py [--quick] [--out DIR] [--jobs N]
 
 writes DIR/accuracy.md (Markdown tables) and DIR/img/accuracy_cost.png (error against cost,
 log-log); DIR defaults to docs/. ``--quick`` (a minute or so, used by the tests) measures
@@ -45,8 +45,8 @@ from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parent.parent
-for _p in (ROOT / "fmu_src", ROOT / "build_scripts"):
+ROOT = Path(__file__).resolve().parents[2]
+for _p in (ROOT / "fmu_src", ROOT / "build_scripts" / "benchmarks"):
     if str(_p) not in sys.path:
         sys.path.insert(0, str(_p))
 

@@ -1,6 +1,6 @@
 """Measure design-space sweep throughput and write the table in docs/sweeps.md.
 
-    .venv/bin/python build_scripts/bench_sweep.py [--no-write] [--fmu-cases N] [--package-cases N]
+    .venv/bin/python build_scripts/benchmarks/bench_sweep.py [--no-write] [--fmu-cases N] [--package-cases N]
 
 Builds SpherePlateImpact.fmu from the working tree into a temporary directory, then measures
 
@@ -31,8 +31,8 @@ import tempfile
 import time
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT / "build_scripts"))
+ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT / "build_scripts" / "benchmarks"))
 DOC = ROOT / "docs" / "sweeps.md"
 BEGIN, END = "<!-- bench_sweep:begin -->", "<!-- bench_sweep:end -->"
 
@@ -187,7 +187,7 @@ def main(argv=None) -> int:
     cpu = {(r["path"], r["where"], r["workers"]): r["total_cpu"] for r in rows}
     cpu_eff = {p: cpu[(p, "Dask LocalCluster", 1)] / cpu[(p, "Dask LocalCluster", 2)] for p in ("package", "fmu")}
     lines = [
-        f"Measured {time.strftime('%Y-%m-%d')} by `build_scripts/bench_sweep.py` on {machine_workers()} cores "
+        f"Measured {time.strftime('%Y-%m-%d')} by `build_scripts/benchmarks/bench_sweep.py` on {machine_workers()} cores "
         f"({platform.processor() or platform.machine()}), Python {platform.python_version()}, numpy {np.__version__}, "
         f"dask {dask.__version__}, fmpy {fmpy.__version__}. Sweep: 2 material pairs x approach speed x t/d "
         f"(40 values); the full 37-column table is gathered. Load average (1 min) before / after: "

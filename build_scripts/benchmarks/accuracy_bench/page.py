@@ -85,11 +85,11 @@ def markdown(res: dict, cfg_name: str, elapsed: float) -> str:
     lines = [
         "# What accuracy costs in time",
         "",
-        "Measured by `build_scripts/bench_accuracy.py`" + (" `--quick`" if cfg_name == "quick" else "")
+        "Measured by `build_scripts/benchmarks/bench_accuracy.py`" + (" `--quick`" if cfg_name == "quick" else "")
         + f" on {m['date']} ({elapsed / 60:.1f} min). Rerun it to measure your machine:",
         "",
         "```sh",
-        ".venv/bin/python build_scripts/bench_accuracy.py   # writes docs/accuracy.md and docs/img/accuracy_cost.png",
+        ".venv/bin/python build_scripts/benchmarks/bench_accuracy.py   # writes docs/accuracy.md and docs/img/accuracy_cost.png",
         "```",
         "",
         f"Machine: {m['cpu']}, {m['cores']} cores; Python {m['python']}, numpy {m['numpy']}, scipy {m['scipy']}, "
