@@ -4,6 +4,7 @@ model (Eqs. 1-8) fused with Zener's plate-wave model (Eqs. 9-13a) by Eq. (20).
 
 Plain numpy/scipy functions; nothing here knows about FMI. Start with :func:`impact`.
 """
+from .about import VERSION as __version__
 from .fusion import apparent_restitution, equivalent_plate_mass, velocities_after_impact
 from .jgm import (critical_velocity, effective_modulus, poisson_coefficient, restitution_e44,
                   restitution_e45, yield_strain)
@@ -12,8 +13,6 @@ from .materials import (BRITTLE_SY, MATERIALS, TABLE1_CASES, TABLE4_CASES, Mater
 from .model import EFFECT_MODES, RESTITUTION_MODELS, ImpactResult, impact
 from .zener import (TAU0_HERTZ, ZENER_METHODS, inelasticity_parameter, zener_linear, zener_paper_fit,
                     zener_restitution)
-
-__version__ = "0.1.0"
 
 
 def impact_between(sphere: Sphere, plate: Plate, v, **options) -> ImpactResult:

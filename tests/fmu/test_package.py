@@ -141,11 +141,17 @@ def test_installed_package_builds_the_fmus_and_runs_a_scene_outside_the_checkout
     where = subprocess.run([str(py), "-c", "import restitution; print(restitution.__file__)"], cwd=work,
                            capture_output=True, text=True, check=True).stdout
     assert where.startswith(site), where
+    installed = subprocess.run([str(py), "-c", "from importlib import metadata; m = metadata.metadata('restitution'); "
+                                "print(m['Version'], m['License-Expression'])"],
+                               cwd=work, capture_output=True, text=True, check=True).stdout.split()
+    assert installed == [r.__version__, "MIT"]
     out = work / "fmus"
     proc = subprocess.run([str(venv / "bin" / "restitution-fmu"), "build", "--out", str(out)], cwd=work,
                           capture_output=True, text=True)
     assert proc.returncode == 0, proc.stderr
     assert (out / "SpherePlateImpact.fmu").is_file() and (out / "BouncingBall.fmu").is_file()
+    with zipfile.ZipFile(out / "SpherePlateImpact.fmu") as z:  # the license travels with an installed package
+        assert "Permission is hereby granted" in z.read("documentation/licenses/license.txt").decode()
     scene = ROOT / "examples" / "scenes" / "steel_ball_thin_aluminium.toml"
     proc = subprocess.run([str(venv / "bin" / "restitution-scene"), "run", str(scene), "--fmu",
                            str(out / "SpherePlateImpact.fmu"), "--out", str(work / "scene"), "--no-plot",

@@ -32,6 +32,8 @@ import zipfile
 from pathlib import Path
 from xml.etree import ElementTree as ET
 
+from ..about import AUTHOR, COPYRIGHT, LICENSE, VERSION
+from .documentation import license_files
 from .models import FOLDERS, SLAVE_SUPPORT, slave_script, table
 from .sources import BUILD_INFO, PACKAGE, bundle_filter, recorded_source_hash, source_hash
 
@@ -59,10 +61,13 @@ PARAMETER_CAUSALITIES = ("parameter", "input")
 
 
 def complete_model_description(xml_text: str, table) -> str:
-    """modelDescription.xml with units, descriptions, limits and a full ModelStructure, from the
-    model's interface ``table`` (:class:`restitution.fmu.table.Table`): each output's dependence on
+    """modelDescription.xml with the package's version, author, copyright and license, and units,
+    descriptions, limits and a full ModelStructure, from the model's interface ``table`` (:class:`restitution.fmu.table.Table`): each output's dependence on
     the inputs is its ``feedthrough``."""
     root = ET.fromstring(xml_text)
+    for attribute, value in (("author", AUTHOR), ("version", VERSION), ("copyright", COPYRIGHT),
+                             ("license", LICENSE)):
+        root.set(attribute, value)
     model_variables = root.find("ModelVariables")
     scalar_variables = list(model_variables)
     index = {sv.get("name"): i + 1 for i, sv in enumerate(scalar_variables)}
@@ -179,7 +184,7 @@ def build_one(model: str, out_dir: Path, standalone: bool = True, log=None) -> P
                                         canGetAndSetFMUstate=True, canSerializeFMUstate=True))
         info = json.dumps({"model": model, "source_hash": source_hash(model)}, indent=1)
         _rewrite_zip(fmu, lambda xml: complete_model_description(xml, table(model)),
-                     member="modelDescription.xml", extra={BUILD_INFO: info})
+                     member="modelDescription.xml", extra={BUILD_INFO: info, **license_files(True)})
         if standalone and shutil.which("gcc") is None:
             log(f"warning: gcc not found: {model}.fmu is built for Python hosts only (fmpy, libcosimpy), "
                 "without the C guard that checks every FMI call; install gcc")

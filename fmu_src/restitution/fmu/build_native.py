@@ -27,6 +27,7 @@ from pathlib import Path
 from xml.etree import ElementTree as ET
 
 from .compile import CFLAGS, PHYSICS_SOURCES, prepare_sources
+from .documentation import license_files
 from .interface import c_header, model_info_header
 from .models import FOLDERS, native_sources
 from .sources import BUILD_INFO, FRONT, PHYSICS_C, native_source_hash
@@ -170,6 +171,9 @@ def build_native_one(model: str, out_dir: Path, python_fmu: Path, log=None) -> P
                 "platforms": sorted(p.parent.name for p in built)}
         (stage / BUILD_INFO).parent.mkdir(parents=True, exist_ok=True)
         (stage / BUILD_INFO).write_text(json.dumps(info, indent=1), encoding="utf-8")
+        for name, data in license_files(bundles_pythonfmu=False).items():
+            (stage / name).parent.mkdir(parents=True, exist_ok=True)
+            (stage / name).write_bytes(data)
         fmu = Path(tmp) / f"{model}.fmu"
         _zip_dir(stage, fmu)
         problems = validate_fmu(str(fmu))

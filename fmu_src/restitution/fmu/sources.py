@@ -52,9 +52,12 @@ def _table_files() -> list[Path]:
 
 def source_files(model: str) -> list[Path]:
     """Every file the pythonfmu ``<model>.fmu`` is built from: the slave, the bundled physics modules,
-    tables and data, the builds, the C header generator and the guard (C front and loader)."""
+    tables and data, the builds, the C header generator, the guard (C front and loader) and the
+    license it carries."""
     files = [slave_script(model), SLAVE_SUPPORT, *_table_files()]
-    files += [FMU_DIR / name for name in ("build.py", "build_guard.py", "sources.py", "interface.py")]
+    files += [FMU_DIR / name for name in ("build.py", "build_guard.py", "sources.py", "interface.py",
+                                          "documentation.py")]
+    files += [PACKAGE / "LICENSE.txt"]
     files += sorted(FRONT.glob("*.[ch]")) + sorted(GUARD.glob("*.[ch]"))
     files += sorted(PACKAGE.glob("*.py"))
     for sub in sorted(BUNDLED_SUBDIRS):
