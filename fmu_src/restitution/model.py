@@ -106,6 +106,31 @@ class ImpactResult:
         d["valid"] = self.valid
         return d
 
+    def __repr__(self) -> str:
+        """The answer and what qualifies it: e and its two parts, the rebound speed, where the impact
+        sits in each model's range, and every flag (for arrays: the range of e and how many impacts
+        raise each flag). Every field is also an attribute; :meth:`as_dict` gives them all."""
+        if is_scalar(self.lam):
+            return (f"ImpactResult: e = {self.e:.4g} (e_ep = {self.e_ep:.4g} elastoplastic, "
+                    f"e_ze = {self.e_ze:.4g} plate waves), v_rebound = {self.v_rebound:.4g} m/s\n"
+                    f"  V* = {self.V_star:.4g} (V_c = {self.V_c:.4g} m/s), lambda = {self.lam:.4g}, "
+                    f"t_contact = {self.t_contact:.4g} s\n"
+                    f"  valid = {self.valid}: lambda <= 1.5 (lambda_in_range) {self.lambda_in_range}, "
+                    f"V* <= 1000 (vstar_in_range) {self.vstar_in_range}\n"
+                    + "  " + ", ".join(f"{name} = {getattr(self, name)}" for name in _REPR_FLAGS))
+        e = np.asarray(self.e)
+        n = e.size
+        counts = ", ".join(f"{name} {int(np.count_nonzero(getattr(self, name)))}"
+                           for name in ("lambda_in_range", "vstar_in_range") + _REPR_FLAGS)
+        finite = e[np.isfinite(e)]
+        span = f"e in [{finite.min():.4g}, {finite.max():.4g}]" if finite.size else "no finite e"
+        return (f"ImpactResult of {n} impacts, shape {e.shape}: {span}; valid at "
+                f"{int(np.count_nonzero(self.valid))} of {n}\n  impacts with each flag true: {counts}")
+
+
+#: The flags shown by ``repr`` beside ``valid`` and its two parts.
+_REPR_FLAGS = ("plasticity_used", "plate_waves_used", "e_negative", "contact_ends")
+
 
 #: Outputs that are +inf where the contact never ends (``contact_ends`` False: the linear method at
 #: lambda >= 2, whose oscillator never returns to zero force).

@@ -176,6 +176,41 @@ def test_as_dict_has_every_field_in_order_then_valid():
         assert np.array_equal(d["valid"], np.logical_and(res.lambda_in_range, res.vstar_in_range))
 
 
+
+def _shown(text: str, label: str) -> str:
+    import re
+
+    match = re.search(rf"(?<![\w*]){re.escape(label)} = (\S+?)[,)\s]", text + " ")
+    assert match, f"{label} not shown in:\n{text}"
+    return match.group(1)
+
+
+@pytest.mark.parametrize("options", [{}, {"zener_method": "linear"}], ids=["exact", "linear"])
+@pytest.mark.parametrize("v", [0.0, 2.0, 3e4], ids=["at_rest", "usual", "beyond_fit"])
+def test_printing_one_result_shows_the_answer_and_every_flag(v, options):
+    """What a user sees without looking for it: e, its two parts, the rebound speed and the validity
+    flags (with the condition each checks), each the result's own value to the 4 digits printed."""
+    res = r.impact(v, **{**PARAMS, "plate_t": 1e-4}, **options)
+    text = repr(res)
+    assert text == str(res) and text.startswith("ImpactResult: ")
+    for label in ("e", "e_ep", "e_ze", "v_rebound", "V*", "V_c", "lambda", "t_contact"):
+        field = {"V*": "V_star", "lambda": "lam"}.get(label, label)
+        assert float(_shown(text, label)) == pytest.approx(getattr(res, field), rel=5e-4, abs=0.0), label
+    for flag in ("valid", "plasticity_used", "plate_waves_used", "e_negative", "contact_ends"):
+        assert _shown(text, flag).rstrip(":") == str(getattr(res, flag)), flag
+    assert f"(lambda_in_range) {res.lambda_in_range}" in text and f"(vstar_in_range) {res.vstar_in_range}" in text
+
+
+def test_printing_an_array_result_counts_each_flag():
+    v = np.array([[0.0, 2.0, 3e4], [1.0, 5.0, np.nextafter(0.0, 1.0)]])
+    res = r.impact(v, **PARAMS)
+    text = repr(res)
+    assert text.startswith(f"ImpactResult of 6 impacts, shape (2, 3): e in [{res.e.min():.4g}, {res.e.max():.4g}]")
+    assert f"valid at {np.count_nonzero(res.valid)} of 6" in text
+    for flag in ("lambda_in_range", "vstar_in_range", "plasticity_used", "plate_waves_used", "e_negative",
+                 "contact_ends"):
+        assert f"{flag} {np.count_nonzero(getattr(res, flag))}" in text, flag
+
 # --- the Zener back ends: the same contract for every way a lambda can arrive
 
 @pytest.mark.parametrize("lam", [0, 1, 100, np.float32(0.5), np.int64(3), Fraction(1, 2), Decimal("0.5"), 150, 1e3])
