@@ -3,6 +3,8 @@
 import csv
 import gc
 import math
+import re
+import subprocess
 import tomllib
 import types
 from dataclasses import replace
@@ -115,7 +117,6 @@ def test_contact_durations_force_plate_waves_on():
      ["m/s is a unit of speed"]),
     ('diameter = "6.35 mm"\n', '', "balls[0].diameter", ["missing required key"]),
     ('drop_heights = "0.1 m"\n', '', "balls[0].drop_heights", ["missing required key"]),
-    ('tolerance = 1e-6\n', '', "outputs.tolerance", ["missing required key"]),
     ('tolerance = 1e-6', 'tolerance = "1e-6 m"', "outputs.tolerance", ["plain number", "dimensionless"]),
     ('["bounce_heights"]', '["bounce_height"]', "outputs.requested", ["unknown output", "did you mean 'bounce_heights'"]),
     ('material = "al_6061"', 'material = "al_6016"', "plates[0].material", ["unknown material", "al_6061"]),
@@ -134,6 +135,13 @@ def test_loader_errors_name_the_key(old, new, key, words):
     assert message.startswith(f"t.toml: {key}: ")
     for word in words:
         assert word in message, message
+
+
+def test_a_scene_without_outputs_gets_bounce_heights_and_cor():
+    scene = scene_from(MINIMAL.replace('[outputs]\nrequested = ["bounce_heights"]\ntolerance = 1e-6\n', ""))
+    assert scene.outputs == ("bounce_heights", "cor") and scene.tolerance == 1e-3
+    scene = scene_from(MINIMAL.replace("tolerance = 1e-6\n", ""))  # either key alone
+    assert scene.outputs == ("bounce_heights",) and scene.tolerance == 1e-3
 
 
 def test_model_choices_and_file_errors(tmp_path):
@@ -314,3 +322,88 @@ def test_command_line_run_and_report(any_impact_fmu, tmp_path, capsys):
     text = doc.read_text()
     assert text.startswith("# intro\n") and text.rstrip().endswith("tail text") and "old table" not in text
     assert "| `glass_marble_glass_plate` | heights, durations | 22 | 0/22 | 22/22 |" in text
+
+
+BOUNCE_TABLE = "bounce height after each impact [mm] (e [1])"
+CELL = re.compile(r"(\S+) \((\S+)\)")
+
+
+def test_run_prints_the_bounce_heights_and_cor_of_each_drop(any_impact_fmu, tmp_path, capsys):
+    """The answer on screen: per drop, the height after each of the first impacts and its COR. The
+    first is checked against the package alone: e at v0 = sqrt(2 g h0), and the rebound apex e^2 h0
+    (energy), to the 4 and 3 digits printed."""
+    path = SCENES / "steel_ball_thin_aluminium.toml"
+    assert main(["run", str(path), "--fmu", str(any_impact_fmu), "--out", str(tmp_path), "--no-plot",
+                 "--no-progress"]) == 0
+    table = capsys.readouterr().out.split(BOUNCE_TABLE, 1)[1].splitlines()
+    for drop in load_scene(path).drops():
+        line = next(row for row in table if row.strip().startswith(drop.label))
+        cells = CELL.findall(line[len(drop.label) + 2:])
+        assert cells, line
+        h0 = drop.drop_height
+        e = r.impact_between(r.Sphere(drop.ball.material, drop.ball.diameter),
+                             r.Plate(drop.plate.material, drop.plate.thickness), math.sqrt(2 * G * h0)).e
+        apex_mm, cor = map(float, cells[0])
+        assert cor == pytest.approx(e, rel=5e-3), drop.label
+        assert apex_mm == pytest.approx(max(e, 0.0) ** 2 * h0 * 1e3, rel=5e-4, abs=0.0), drop.label
+
+
+ENDLESS_SCENE = """
+[scene]
+name = "glass marble on a 3 m glass block"
+
+[simulation]
+max_bounces = 50
+
+[[plates]]
+name = "block"
+material = "borosilicate_glass"
+thickness = "3 m"
+
+[[balls]]
+name = "marble"
+material = "borosilicate_glass"
+diameter = "16 mm"
+drop_heights = "1 m"
+"""
+
+
+def test_a_drop_still_bouncing_at_its_limit_warns_and_exits_3(any_impact_fmu, tmp_path, capsys):
+    """Glass on a 3 m glass block loses almost nothing per impact (neither body yields, the plate is
+    a half-space for Zener: e within 1e-4 of 1), so the ball never comes to rest: everything is
+    written, a warning says why and what to change, and the exit status is not 0."""
+    scene = tmp_path / "endless.toml"
+    scene.write_text(ENDLESS_SCENE)
+    status = main(["run", str(scene), "--fmu", str(any_impact_fmu), "--out", str(tmp_path / "out"), "--no-plot",
+                   "--no-progress"])
+    captured = capsys.readouterr()
+    assert status == 3
+    assert "1 of 1 drops did not come to rest within simulation.max_bounces = 50 impacts" in captured.err
+    assert "Raise simulation.max_bounces" in captured.err
+    with (tmp_path / "out" / "endless.csv").open() as f:
+        assert len(list(csv.DictReader(f))) == 50
+    assert "max_bounces" in captured.out  # the summary's stop column
+
+
+def test_the_height_axis_turns_logarithmic_when_bounces_span_decades():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from restitution.scene.runner import _readable_heights
+
+    fig, (wide, narrow) = plt.subplots(2)
+    _readable_heights(wide, [np.array([0.3, 1.35e-3, 1.1e-4, 0.0]), [1.0]])  # 1 m drop, 0.11 mm bounce
+    _readable_heights(narrow, [np.array([0.045, 0.04]), [0.05]])
+    assert wide.get_yscale() == "log" and wide.get_ylim()[0] <= 0.11 < 1000.0 <= wide.get_ylim()[1]
+    assert narrow.get_yscale() == "linear"
+    plt.close(fig)
+
+
+def test_default_scene_results_are_ignored_by_git():
+    """`run` writes scene-results/<stem>/ by default; in a checkout that leaves `git status` clean."""
+    if not (ROOT / ".git").exists():
+        pytest.skip("not a git checkout")
+    probe = subprocess.run(["git", "check-ignore", "-q", "scene-results/any/any.csv"], cwd=ROOT)
+    assert probe.returncode == 0

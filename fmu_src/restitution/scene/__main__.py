@@ -2,7 +2,8 @@
 
     check FILE...                      load and check scene files, print what they contain
     run FILE [--out DIR] [--all-on] [--zener-method M] [--fmu PATH] [--rebuild] [--no-plot]
-                                       simulate a scene; write DIR/<stem>.csv, <stem>_summary.csv, <stem>.png
+                                       simulate a scene; write DIR/<stem>.csv, <stem>_summary.csv, <stem>.png;
+                                       exit status 3 when a drop stops at its bounce limit still bouncing
     report FILE... [--out docs/scenes.md] [--repeat N] [--methods exact,ode]
                                        auto vs every effect on: effect counts, wall times, differences
 """
@@ -30,6 +31,8 @@ def _check(args) -> int:
 
 #: Exit status of an interrupted run (128 + SIGINT, as a shell reports Ctrl-C).
 EXIT_INTERRUPTED = 130
+#: `run` finished and wrote everything, but some drop stopped at its bounce limit still bouncing.
+EXIT_NOT_AT_REST = 3
 
 
 class UsageError(Exception):
@@ -104,9 +107,10 @@ def _run(args) -> int:
         written.append(result.plot(out / f"{scene.stem}{suffix}.png"))
     print(result.summary())
     print("wrote " + ", ".join(str(p) for p in written))
-    if result.warning():
-        print(result.warning(), file=sys.stderr)
-    return 0
+    for warning in (result.warning(), result.rest_warning()):
+        if warning:
+            print(warning, file=sys.stderr)
+    return EXIT_NOT_AT_REST if result.not_at_rest() else 0
 
 
 def _report(args) -> int:

@@ -76,6 +76,14 @@ OUTPUTS = {
 }
 
 
+#: What a scene without ``[outputs] requested`` gets: what a user dropping a ball wants to see.
+DEFAULT_OUTPUTS = ("bounce_heights", "cor")
+#: ``[outputs] tolerance`` when not given: the largest difference ``report`` accepts between the scene as
+#: run (effects skipped where ``auto`` allows) and every effect on, relative for heights and contact
+#: durations, absolute for CORs. Well above what effect_tolerance = 1e-6 leaves over a drop's bounces.
+DEFAULT_TOLERANCE = 1e-3
+
+
 class SceneError(ValueError):
     """A problem in a scene file; ``key`` is the dotted path of the offending key."""
 
@@ -317,7 +325,7 @@ def _material(ctx, value, where, custom) -> Material:
     return Material(label or where, source=source or "scene file", **props)
 
 
-_TOP = {"scene": "table: name, description", "outputs": "table: requested, tolerance",
+_TOP = {"scene": "table: name, description", "outputs": "optional table: requested, tolerance",
         "model": "optional table: effect_tolerance, zener_method, restitution_model, plasticity, plate_waves",
         "simulation": "optional table: gravity, v_min, max_bounces",
         "materials": "optional table of named materials", "plates": "array of tables [[plates]]",
@@ -341,15 +349,15 @@ _BALL = {"name": "a unique name", "material": "a material name or table", "diame
 def parse_scene(data: dict, source: str = "<scene>", path: Path | None = None) -> Scene:
     """A :class:`Scene` from the parsed TOML ``data`` (``source`` names it in error messages)."""
     ctx = _Ctx(source)
-    _check_keys(ctx, data, "", _TOP, ("scene", "outputs", "plates", "balls"))
+    _check_keys(ctx, data, "", _TOP, ("scene", "plates", "balls"))
 
     _check_keys(ctx, data["scene"], "scene", _SCENE, ("name",))
     name = _string(ctx, data["scene"], "scene", "name")
     description = _string(ctx, data["scene"], "scene", "description", default="")
 
-    out = data["outputs"]
-    _check_keys(ctx, out, "outputs", _OUTPUT_KEYS, ("requested", "tolerance"))
-    requested = _string_list(ctx, out, "outputs", "requested")
+    out = data.get("outputs", {})
+    _check_keys(ctx, out, "outputs", _OUTPUT_KEYS)
+    requested = _string_list(ctx, out, "outputs", "requested") if "requested" in out else list(DEFAULT_OUTPUTS)
     for item in requested:
         if item not in OUTPUTS:
             close = difflib.get_close_matches(item, list(OUTPUTS), n=1)
@@ -357,7 +365,7 @@ def parse_scene(data: dict, source: str = "<scene>", path: Path | None = None) -
             raise ctx.error("outputs.requested", f"unknown output {item!r}{hint}; one of {', '.join(OUTPUTS)}")
     if len(set(requested)) != len(requested):
         raise ctx.error("outputs.requested", f"{requested!r} lists an output twice")
-    tolerance = _number(ctx, out, "outputs", "tolerance", low=0.0, low_open=True)
+    tolerance = _number(ctx, out, "outputs", "tolerance", low=0.0, low_open=True, default=DEFAULT_TOLERANCE)
 
     m = data.get("model", {})
     _check_keys(ctx, m, "model", _MODEL)

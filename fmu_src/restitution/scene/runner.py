@@ -40,7 +40,7 @@ from ..model import ZENER_SLOPE_BOUND, impact
 from ..zener import ZENER_METHODS
 from ..cosim.bouncing import Trajectory, impact_sequence
 from ..cosim.interrupt import DeferredInterrupt
-from .loader import Drop, Scene, SceneError
+from .loader import MAX_BOUNCES, Drop, Scene, SceneError
 
 __all__ = ["DropResult", "SceneResult", "SceneInterrupted", "DropWriter", "run_scene", "ensure_fmu",
            "open_instance", "COLUMNS", "READ_OUTPUTS", "VALIDITY", "drop_parameters"]
@@ -110,6 +110,13 @@ def drop_parameters(scene: Scene, drop: Drop, plasticity: str, plate_waves: str,
 
 # --- results -----------------------------------------------------------------------------------
 
+def apex_heights(v_rebound, gravity: float) -> np.ndarray:
+    """Height reached after each impact [m] from the rebound speeds [m/s]: v^2 / (2 g), 0 where the
+    ball does not leave the plate (v_rebound <= 0)."""
+    v = np.asarray(v_rebound, dtype=float)
+    return np.where(v > 0.0, v * v / (2.0 * gravity), 0.0)
+
+
 @dataclass
 class DropResult(Trajectory):
     """Every impact of one drop; arrays indexed by impact number."""
@@ -130,6 +137,21 @@ class DropResult(Trajectory):
         """Impacts outside the models' validated ranges (``valid`` false)."""
         valid = self.validity.get("valid")
         return 0 if valid is None else int(np.count_nonzero(~valid))
+
+    @property
+    def apex(self) -> np.ndarray:
+        """Height the ball reaches after each impact [m] (0 where it does not leave the plate)."""
+        return apex_heights(self.v_rebound, self.gravity)
+
+    @property
+    def cor(self) -> np.ndarray:
+        """The COR applied at each impact, rebound over approach speed [1] (the FMU's e)."""
+        return self.v_rebound / self.v_approach
+
+    @property
+    def at_rest(self) -> bool:
+        """False when the drop stopped at its bounce limit with the ball still bouncing."""
+        return self.stop_reason != "max_bounces"
 
     @property
     def rest_time(self) -> float:
@@ -169,6 +191,26 @@ class SceneResult:
     def out_of_range(self) -> int:
         """Impacts outside the models' validated ranges (``valid`` false), over every drop."""
         return sum(d.out_of_range for d in self.drops)
+
+    def not_at_rest(self) -> list:
+        """The drops that stopped at ``simulation.max_bounces`` with the ball still bouncing."""
+        return [d for d in self.drops if not d.at_rest]
+
+    def rest_warning(self) -> str | None:
+        """What to do when some drops did not come to rest within their bounce limit, else None."""
+        stuck = self.not_at_rest()
+        if not stuck:
+            return None
+        sim = self.scene.simulation
+        first = stuck[0]
+        why = (" With e this close to 1 the model loses almost no energy per impact (little plastic deformation "
+               "and almost none into the plate's waves), so the ball would bounce for a long time."
+               if first.cor[-1] > 0.99 else "")
+        return (f"warning: {len(stuck)} of {len(self.drops)} drops did not come to rest within "
+                f"simulation.max_bounces = {sim.max_bounces} impacts (first: {first.drop.label}, last e = "
+                f"{first.cor[-1]:.6g}, last rebound {first.v_rebound[-1]:.3g} m/s > v_min = {sim.v_min:g} m/s); "
+                f"their rows end at the bounce limit.{why} Raise simulation.max_bounces (at most {MAX_BOUNCES}) "
+                f"or simulation.v_min")
 
     def warning(self) -> str | None:
         """One line when any impact lies outside the validated ranges, else None."""
@@ -211,7 +253,21 @@ class SceneResult:
             lines.append(f"  {d.drop.label:<{width}}  {d.n_impacts:7d}  {int(d.plasticity.sum()):10d}  "
                          f"{int(d.plate_waves.sum()):11d}  {d.out_of_range:12d}  {d.stop_reason}")
         lines += [f"  {line}" for line in explain(self)]
+        lines += self._bounce_table()
         return "\n".join(lines)
+
+    def _bounce_table(self, shown: int = 5) -> list:
+        """Per drop, the height reached and the COR at its first ``shown`` impacts."""
+        width = max([len(d.drop.label) for d in self.drops] + [4])
+        n = min(shown, max([d.n_impacts for d in self.drops] + [0]))
+        rows = [[f"{h * 1e3:.4g} ({e:.3g})" for h, e in zip(d.apex[:n], d.cor[:n])] for d in self.drops]
+        cell = 2 + max([len(c) for row in rows for c in row] + [len(f"impact {n}")])
+        lines = ["  bounce height after each impact [mm] (e [1]); every impact is in the CSV",
+                 f"  {'drop':<{width}}" + "".join(f"{'impact ' + str(k + 1):>{cell}}" for k in range(n))]
+        for d, row in zip(self.drops, rows):
+            more = f"  ... {d.n_impacts - n} more" if d.n_impacts > n else ""
+            lines.append(f"  {d.drop.label:<{width}}" + "".join(f"{c:>{cell}}" for c in row) + more)
+        return lines
 
     def plot(self, path) -> Path:
         """One panel per requested output (bounce heights vs time, COR and contact durations vs speed)."""
@@ -240,6 +296,7 @@ class SceneResult:
                             label=d.drop.label)
             if out == "bounce_heights":
                 ax.set(xlabel="time [s]", ylabel="height [mm]", title="bounce heights")
+                _readable_heights(ax, [d.apex for d in self.drops] + [[d.drop_height for d in self.drops]])
             elif out == "cor":
                 ax.set(xlabel="approach speed [m/s]", ylabel="COR [1]",
                        title="COR: e (o, solid), e_ep (v, dotted), e_ze (^, dashed)")
@@ -256,6 +313,17 @@ class SceneResult:
         fig.savefig(path, dpi=120)
         plt.close(fig)
         return path
+
+
+def _readable_heights(ax, heights) -> None:
+    """A logarithmic height axis [mm] when the bounces span more than a decade and a half, so that
+    a 0.1 mm bounce after a 1 m drop stays visible; its floor is half the lowest bounce."""
+    positive = np.concatenate([np.asarray(h, dtype=float).ravel() for h in heights]) * 1e3
+    positive = positive[positive > 0.0]
+    if positive.size and positive.max() > 30.0 * positive.min():
+        ax.set_yscale("log")
+        ax.set_ylim(positive.min() / 2.0, positive.max() * 1.5)
+        ax.set_ylabel("height [mm], logarithmic")
 
 
 class DropWriter:
@@ -412,7 +480,7 @@ def _run_drop(instance, scene: Scene, drop: Drop, params: dict, read_names, read
     v_reb = data[:, 0]
     columns = {}
     if "bounce_heights" in scene.outputs:
-        columns["apex"] = np.where(v_reb > 0.0, v_reb * v_reb / (2.0 * g), 0.0)
+        columns["apex"] = apex_heights(v_reb, g)
     for j, col in enumerate(read_cols):
         columns[col] = data[:, 1 + j]
     return DropResult(drop=drop, time=np.array(times), v_approach=np.array(speeds), v_rebound=v_reb,
