@@ -192,7 +192,7 @@ def test_each_example_scene_runs_and_matches_the_package(runs):
             assert d.stop_reason == ("e<=0" if last <= 0 else "v_min")
             assert (d.v_rebound[:-1] >= scene.simulation.v_min).all()
             # only the requested outputs were read
-            from restitution.scene.runner import READ_OUTPUTS
+            from restitution.scene.results import READ_OUTPUTS
             assert set(d.columns) == {c for o in scene.outputs for c in READ_OUTPUTS[o][1]}
 
 
@@ -391,7 +391,7 @@ def test_the_height_axis_turns_logarithmic_when_bounces_span_decades():
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from restitution.scene.runner import _readable_heights
+    from restitution.scene.plot import _readable_heights
 
     fig, (wide, narrow) = plt.subplots(2)
     _readable_heights(wide, [np.array([0.3, 1.35e-3, 1.1e-4, 0.0]), [1.0]])  # 1 m drop, 0.11 mm bounce

@@ -9,7 +9,8 @@ nothing in the physics modules or the FMU imports this subpackage. See docs/scen
 """
 from .loader import (OUTPUTS, BallSpec, Drop, ModelSpec, PlateSpec, Scene, SceneError, SimulationSpec,
                      load_scene, parse_scene, resolve_material)
-from .runner import DropResult, SceneResult, ensure_fmu, run_scene
+from .results import DropResult, SceneResult
+from .runner import ensure_fmu, run_scene
 
 __all__ = ["OUTPUTS", "BallSpec", "Drop", "ModelSpec", "PlateSpec", "Scene", "SceneError", "SimulationSpec",
            "load_scene", "parse_scene", "resolve_material", "DropResult", "SceneResult", "ensure_fmu", "run_scene"]

@@ -84,7 +84,8 @@ def _fmu(args) -> Path:
 
 
 def _run(args) -> int:
-    from .runner import DropWriter, SceneInterrupted, run_scene
+    from .results import DropWriter
+    from .runner import SceneInterrupted, run_scene
 
     scene = load_scene(args.file)
     out = _output_dir(Path(args.out) if args.out else Path("scene-results") / scene.stem)

@@ -139,6 +139,11 @@ class Drop:
     def label(self) -> str:
         return f"{self.ball.name} on {self.plate.name}, h = {self.drop_height:g} m"
 
+    def package_params(self) -> dict:
+        """The ball and the plate as :func:`restitution.impact` keywords [SI units]."""
+        return dict(**self.ball.material.params("sphere"), sphere_d=self.ball.diameter,
+                    **self.plate.material.params("plate"), plate_t=self.plate.thickness)
+
 
 @dataclass(frozen=True)
 class Scene:

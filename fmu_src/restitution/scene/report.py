@@ -18,7 +18,9 @@ from pathlib import Path
 import numpy as np
 
 from .loader import Scene, load_scene
-from .runner import READ_OUTPUTS, SceneResult, explain, open_instance, run_scene, ensure_fmu
+from .explain import explain
+from .results import READ_OUTPUTS, SceneResult
+from .runner import ensure_fmu, open_instance, run_scene
 
 __all__ = ["compare", "SceneReport", "report_scene", "markdown", "write_report", "RELATIVE"]
 
