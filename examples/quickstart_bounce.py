@@ -2,11 +2,14 @@
 
     python examples/quickstart_bounce.py [--fmu dist/SpherePlateImpact.fmu] [--height 0.3]
 
-Uses the event-exact fmpy master (restitution.cosim.bouncing) and prints the first bounces.
+Uses the event-exact fmpy master (restitution.cosim.bouncing) and prints the first bounces. Without
+--fmu it uses dist/SpherePlateImpact.fmu (outside a checkout, ~/.cache/restitution/fmus/), building and
+validating the FMUs first when they are missing or were built from other sources.
 """
 from __future__ import annotations
 
 import argparse
+import sys
 from pathlib import Path
 
 import restitution as r
@@ -15,7 +18,10 @@ from restitution.cosim import FmuInstance, bounce, build_default_fmu, fmu_reboun
 
 def run(fmu_path=None, height: float = 0.3, thickness: float = 6.35e-3, show: int = 5):
     """Bounce the default ball; return the :class:`~restitution.cosim.Bounces` record."""
-    fmu_path = Path(fmu_path) if fmu_path else build_default_fmu()
+    if fmu_path is None:
+        fmu_path = build_default_fmu(log=lambda message: print(message, file=sys.stderr, flush=True))
+        print(f"FMU: {fmu_path} (built from the installed sources; python -m restitution.fmu build rebuilds)")
+    fmu_path = Path(fmu_path)
     sphere = r.Sphere(r.MATERIALS["s2_tool_steel"], 6.35e-3)
     plate = r.Plate(r.MATERIALS["al_6061"], thickness)
     with FmuInstance(fmu_path, parameters=impact_fmu_parameters(sphere, plate)) as fmu:
