@@ -13,7 +13,7 @@ from dataclasses import dataclass, replace
 
 from .validation import check_poisson, check_positive
 
-__all__ = ["Material", "Sphere", "Plate", "BRITTLE_SY", "MATERIALS", "TABLE4_CASES", "table4_case"]
+__all__ = ["Material", "Sphere", "Plate", "BRITTLE_SY", "MATERIALS", "ALIASES", "TABLE4_CASES", "table4_case"]
 
 #: Yield strength the paper assigns to brittle materials [Pa].
 BRITTLE_SY = 1.0e12
@@ -139,8 +139,13 @@ MATERIALS: dict[str, Material] = MaterialTable({
     "stainless_440c": Material("Stainless steel 440C", 200e9, 0.30, 0.448e9, 7750,
                                f"{_T2}; E = 200 GPa is a {_HB} (AISI 440C)"),
 })
-# Table 1 repeats these Table 3 materials with the same values.
-MATERIALS["al_110_h16"] = MATERIALS["al_1100_h16"]
+#: Other keys for a preset: alias -> (preset key, why the alias exists).
+ALIASES = {
+    "al_110_h16": ("al_1100_h16", "Table 1 prints the alloy as 'Aluminum, 110-H16'; it is Table 3's Aluminum "
+                                  "1100-H16, with the same values, so the key as printed names the same preset"),
+}
+for _alias, (_key, _why) in ALIASES.items():
+    MATERIALS[_alias] = MATERIALS[_key]
 
 _T4 = "Green (2022) Table 4 (Patil & Higgs 2017), nu = 0.3"
 _T4_SPHERE_SY = (f"{_T4}; sphere Sy not given (elastic in the FEA of [11]): "

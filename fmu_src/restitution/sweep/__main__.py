@@ -8,7 +8,7 @@ import sys
 import tempfile
 from pathlib import Path
 
-from ..materials import MATERIALS, TABLE4_CASES
+from ..materials_table import text as materials_text
 from .spec import CODES, INPUT_NAMES, INPUTS, MAX_SAMPLES, MAX_SEED, T_OVER_D, SweepSpec, canonical_name, load_spec
 
 #: Exit status of an interrupted sweep (128 + SIGINT, as a shell reports Ctrl-C).
@@ -94,9 +94,8 @@ def _list() -> str:
         codes = f"  codes: {', '.join(f'{k}={v}' for k, v in CODES[name].items())}" if name in CODES else ""
         lines.append(f"  {name:22s} {kw:18s} {start!r:>10}{codes}")
     lines.append(f"  {T_OVER_D:22s} (derived: plate.t = t_over_d * sphere.d)")
-    lines.append("material keys (pairs are sphere/plate, or table4:A1 ... table4:B4):")
-    lines.append("  " + ", ".join(sorted(MATERIALS)))
-    lines.append("  " + ", ".join(f"table4:{c}" for c in TABLE4_CASES))
+    lines.append("materials (pairs are sphere/plate keys, or table4:A1 ... table4:B4):")
+    lines += [("  " + line).rstrip() for line in materials_text().splitlines()]
     return "\n".join(lines)
 
 
