@@ -227,3 +227,34 @@ def test_fewer_columns_same_numbers(serial, impact_fmu):
             assert np.array_equal(res[name], serial[backend][name], equal_nan=name == "e"), (backend, name)
     with pytest.raises(ValueError, match="unknown column"):
         run_sweep(spec, scheduler="serial", columns=["E"])
+
+
+@pytest.mark.parametrize("few, many", [("v_approach", "t_over_d"), ("t_over_d", "v_approach")])
+def test_a_few_values_of_one_input_are_drawn_as_curves(tmp_path, monkeypatch, few, many):
+    """COR against thickness at 1, 3 and 5 m/s: one labelled curve per speed through every case of
+    that speed (not a colour map of three wide blocks); and the same the other way round."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from matplotlib.figure import Figure
+
+    from restitution.sweep.plot import plot_cor_map
+
+    grid = {few: [1.0, 3.0, 5.0] if few == "v_approach" else [0.2, 0.5, 1.0],
+            many: {"linspace": [0.1, 2.0, 40]} if many == "t_over_d" else {"linspace": [0.5, 8.0, 40]}}
+    res = run_sweep(SweepSpec(pairs=["s2_tool_steel/al_6061"], grid=grid), scheduler="serial")
+    saved = []
+    monkeypatch.setattr(Figure, "savefig", lambda fig, path, **kw: saved.append(fig))
+    plot_cor_map(res, tmp_path / "map.png")
+    ax = saved[0].axes[0]
+    assert not ax.collections, "a colour map or scatter was drawn"
+    curves = [line for line in ax.lines if line.get_label() and not line.get_label().startswith("_")
+              and len(line.get_xdata()) > 1]
+    unit = " m/s" if few == "v_approach" else ""
+    assert sorted(line.get_label() for line in curves) == sorted(
+        f"{'v' if few == 'v_approach' else 't/d'} = {value:g}{unit}" for value in grid[few])
+    for line in curves:
+        value = float(line.get_label().split("= ")[1].split()[0])
+        sel = res.columns[few] == value
+        assert np.array_equal(np.sort(line.get_xdata()), np.sort(res.columns[many][sel]))
+        assert np.array_equal(np.sort(line.get_ydata()), np.sort(res.columns["e"][sel]))  # the data as computed

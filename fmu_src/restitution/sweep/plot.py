@@ -29,6 +29,29 @@ def _edges(centres, log):
     return 10 ** e if log else e
 
 
+#: Up to this many values of one input over more of the other, a grid is drawn as curves.
+MAX_CURVES = 6
+
+
+def _curves(ax, x, key, e, valid, xname: str, label: str) -> None:
+    """e against ``x``, one line per value of ``key`` (labelled ``label.format(value)``); cases outside
+    the validated range marked."""
+    for value in np.unique(key):
+        sel = key == value
+        order = np.argsort(x[sel], kind="stable")
+        ax.plot(x[sel][order], e[sel][order], "-", lw=1.2, label=label.format(value))
+        bad = sel & ~valid
+        if bad.any():
+            ax.plot(x[bad], e[bad], "rx", ms=4)
+    if not valid.all():
+        ax.plot([], [], "rx", ms=4, label="outside validated range")
+    ax.set_xscale("log" if _log_axis(x) else "linear")
+    ax.set(xlabel=xname, ylabel="apparent COR e")
+    ax.axhline(0.0, color="0.6", lw=0.5)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7)
+
+
 def fit_title(fig, title: str, fontsize: float = 10):
     """``fig``'s suptitle, wrapped at word boundaries so that every line fits the figure's width
     (measured as drawn; a single pair's map is narrower than the default title)."""
@@ -48,9 +71,9 @@ def plot_cor_map(result, path, title: str | None = None, dpi: int = 120) -> Path
     """Draw e over (v_approach, t/d) for each material pair of a :class:`SweepResult` into ``path``.
 
     A grid sweep gives a colour map (each cell the mean e of its cases, with e contours and
-    a dashed line where the validity range ends: lambda <= 1.5 and V* <= 1000); scattered
-    (random) cases are drawn as coloured points; a sweep over only one of the two is drawn
-    as curves.
+    a dashed line where the validity range ends: lambda <= 1.5 and V* <= 1000), or curves when one
+    of the two takes at most :data:`MAX_CURVES` values (one curve per value); scattered (random)
+    cases are drawn as coloured points; a sweep over only one of the two is drawn as a curve.
     """
     import matplotlib
 
@@ -95,6 +118,14 @@ def plot_cor_map(result, path, title: str | None = None, dpi: int = 120) -> Path
             logv, logt = _log_axis(uv), _log_axis(ut)
             cells = uv.size * ut.size
             gridded = not scattered and cells <= 4 * e.size and np.unique(iv * ut.size + it).size == cells
+            if gridded and min(uv.size, ut.size) <= MAX_CURVES and uv.size != ut.size:
+                # a few values of one input over many of the other (COR against thickness at 1, 3 and
+                # 5 m/s): one curve per value, not a colour map of a few wide blocks
+                if uv.size < ut.size:
+                    _curves(ax, td, v, e, valid, "plate thickness / sphere diameter t/d", "v = {:g} m/s")
+                else:
+                    _curves(ax, v, td, e, valid, "approach speed v [m/s]", "t/d = {:g}")
+                continue
             if gridded:
                 flat = iv.ravel() * ut.size + it.ravel()
                 count = np.bincount(flat, minlength=cells)
