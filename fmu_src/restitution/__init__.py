@@ -2,7 +2,8 @@
 thickness, after I. Green, Nonlinear Dyn (2022): the Jackson-Green-Marghitu elastoplastic
 model (Eqs. 1-8) fused with Zener's plate-wave model (Eqs. 9-13a) by Eq. (20).
 
-Plain numpy/scipy functions; nothing here knows about FMI. Start with :func:`impact`.
+Plain numpy/scipy functions; nothing here knows about FMI. Start with :func:`impact`. Physical
+inputs are SI numbers or pint Quantities of any compatible unit (:mod:`restitution.quantities`).
 """
 from .about import VERSION as __version__
 from .fusion import apparent_restitution, equivalent_plate_mass, velocities_after_impact
@@ -10,11 +11,13 @@ from .jgm import (critical_velocity, effective_modulus, poisson_coefficient, res
                   restitution_e45, yield_strain)
 from .materials import (BRITTLE_SY, MATERIALS, TABLE1_CASES, TABLE4_CASES, Material, Plate, Sphere,
                         table4_case)
+from .quantities import with_units
 from .model import EFFECT_MODES, RESTITUTION_MODELS, ImpactResult, impact
 from .zener import (TAU0_HERTZ, ZENER_METHODS, inelasticity_parameter, zener_linear, zener_paper_fit,
                     zener_restitution)
 
 
+@with_units(v="m/s")
 def impact_between(sphere: Sphere, plate: Plate, v, **options) -> ImpactResult:
     """:func:`impact` for a :class:`Sphere` and a :class:`Plate` at approach speed ``v`` [m/s]."""
     return impact(v, **sphere.params(), **plate.params(), **options)

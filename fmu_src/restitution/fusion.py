@@ -11,6 +11,7 @@ from __future__ import annotations
 import math
 
 from ._num import where
+from .quantities import with_units
 
 __all__ = ["apparent_restitution", "equivalent_plate_mass", "mass_ratio", "velocities_after_impact"]
 
@@ -30,6 +31,7 @@ def apparent_restitution(e_ep, e_ze):
     return 0.5 * (e_ze * (1.0 + e_ep) - (1.0 - e_ep))
 
 
+@with_units(m_a="kg")
 def equivalent_plate_mass(m_a, e_ze, deficit=None):
     """m_b = (1 + e_ze) m_a / (1 - e_ze) [kg], Eq. (19). +inf for e_ze = 1 (a half-space).
 
@@ -56,6 +58,7 @@ def mass_ratio(e_ze, deficit=None):
     return gap / (1.0 + e_ze)
 
 
+@with_units(v_a1="m/s")
 def velocities_after_impact(v_a1, e_ep, e_ze, deficit=None):
     """(v_a2, v_b2) [m/s], Eq. (17), positive in the direction of approach, plate at rest before.
 

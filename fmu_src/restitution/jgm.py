@@ -9,6 +9,7 @@ from __future__ import annotations
 import math
 
 from ._num import exp, log, minimum, maximum, sqrt, where
+from .quantities import si_only, with_units
 
 __all__ = [
     "reduced_modulus", "effective_modulus", "poisson_coefficient", "critical_pressure",
@@ -27,15 +28,17 @@ _LOG60 = math.log(60.0)
 _EXP_ARG_CAP = 700.0
 
 
+@with_units(E="Pa", nu="dimensionless")
 def reduced_modulus(E, nu):
     """E_i' = E_i / (1 - nu_i^2) [Pa], Eq. (1) right."""
     return E / (1.0 - nu * nu)
 
 
+@with_units(E_a="Pa", nu_a="dimensionless", E_b="Pa", nu_b="dimensionless")
 def effective_modulus(E_a, nu_a, E_b, nu_b):
     """E' = E_a' E_b' / (E_a' + E_b') [Pa], Eq. (1) left."""
-    Ea = reduced_modulus(E_a, nu_a)
-    Eb = reduced_modulus(E_b, nu_b)
+    Ea = _reduced_modulus(E_a, nu_a)
+    Eb = _reduced_modulus(E_b, nu_b)
     return Ea * Eb / (Ea + Eb)
 
 
@@ -44,6 +47,7 @@ def poisson_coefficient(nu):
     return 1.295 * exp(0.736 * nu)
 
 
+@with_units(nu_a="dimensionless", Sy_a="Pa", nu_b="dimensionless", Sy_b="Pa")
 def critical_pressure(nu_a, Sy_a, nu_b, Sy_b):
     """C S_y = min[C(nu_a) S_ya, C(nu_b) S_yb] [Pa], Eq. (2): the body with the smaller value yields first."""
     return minimum(poisson_coefficient(nu_a) * Sy_a, poisson_coefficient(nu_b) * Sy_b)
@@ -54,26 +58,30 @@ def vstar_in_fit_range(v_star):
     return v_star <= VSTAR_FIT_MAX
 
 
+@with_units(nu_a="dimensionless", Sy_a="Pa", nu_b="dimensionless", Sy_b="Pa")
 def sphere_yields_first(nu_a, Sy_a, nu_b, Sy_b):
     """True where C(nu_a) S_ya <= C(nu_b) S_yb, the condition of Eq. (3)."""
     return poisson_coefficient(nu_a) * Sy_a <= poisson_coefficient(nu_b) * Sy_b
 
 
+@with_units(E_prime="Pa", nu_a="dimensionless", Sy_a="Pa", nu_b="dimensionless", Sy_b="Pa")
 def yield_strain(E_prime, nu_a, Sy_a, nu_b, Sy_b):
     """eps_y = S_y / E' [1], Eq. (3), with S_y of the body that yields first.
 
     Not C S_y / E' as some public scripts use (docs/paper_departures.md).
     """
-    Sy = where(sphere_yields_first(nu_a, Sy_a, nu_b, Sy_b), Sy_a, Sy_b)
+    Sy = where(_sphere_yields_first(nu_a, Sy_a, nu_b, Sy_b), Sy_a, Sy_b)
     return Sy / E_prime
 
 
+@with_units(CSy="Pa", E_prime="Pa", R="m")
 def critical_interference(CSy, E_prime, R):
     """omega_c = (pi C S_y / (2 E'))^2 R [m], Eq. (4); R = d/2 for a sphere on a plate."""
     x = math.pi * CSy / (2.0 * E_prime)
     return x * x * R
 
 
+@with_units(CSy="Pa", E_prime="Pa", R="m")
 def critical_load(CSy, E_prime, R):
     """P_c = 4/3 (R/E')^2 (pi/2 C S_y)^3 [N], Eq. (5)."""
     r = R / E_prime
@@ -81,11 +89,13 @@ def critical_load(CSy, E_prime, R):
     return (4.0 / 3.0) * r * r * p * p * p
 
 
+@with_units(rho_a="kg/m**3", d="m")
 def sphere_mass(rho_a, d):
     """m_a = rho_a pi d^3 / 6 [kg]."""
     return rho_a * math.pi * d * d * d / 6.0
 
 
+@with_units(omega_c="m", P_c="N", m_a="kg")
 def critical_velocity(omega_c, P_c, m_a):
     """V_c = sqrt(4 omega_c P_c / (5 m_a)) [m/s], Eq. (6): impact speed at the onset of yielding.
 
@@ -145,3 +155,8 @@ def restitution_e44(v_star):
     high = 1.0 - 0.1 * _LOG60 - 0.11 * log(v_hi / E44_BRANCH_JOIN) * exp(minimum(2.366 * log(where(upper, ratio, 1.0)), _EXP_ARG_CAP))
     e = where(upper, high, low)
     return where(above, maximum(e, 0.0), 1.0)
+
+
+# the module's own calls pass SI numbers: the equations without their unit layer
+_reduced_modulus = si_only(reduced_modulus)
+_sphere_yields_first = si_only(sphere_yields_first)

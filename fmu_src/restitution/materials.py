@@ -1,6 +1,7 @@
 """Materials, spheres and plates, with the material presets of I. Green, Nonlinear Dyn (2022).
 
-Units: E [Pa], nu [1], Sy [Pa], rho [kg/m^3], d and t [m].
+Units: E [Pa], nu [1], Sy [Pa], rho [kg/m^3], d and t [m]; each also accepts a pint Quantity of any
+compatible unit (:mod:`restitution.quantities`), stored in SI.
 
 Brittle materials carry Sy = 1e12 Pa "to ward off yielding", as the paper does
 (Table 1 footnote). Tables 1 and 2 give no elastic moduli: E is taken from
@@ -11,6 +12,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 
+from .quantities import to_si
 from .validation import check_poisson, check_positive
 
 __all__ = ["Material", "Sphere", "Plate", "BRITTLE_SY", "MATERIALS", "ALIASES", "TABLE4_CASES", "table4_case"]
@@ -31,6 +33,8 @@ class Material:
     source: str = ""  #: where each value comes from
 
     def __post_init__(self):
+        for field, unit in (("E", "Pa"), ("nu", "dimensionless"), ("Sy", "Pa"), ("rho", "kg/m**3")):
+            object.__setattr__(self, field, to_si(f"{self.name}.{field}", getattr(self, field), unit))
         check_positive(f"{self.name}.E", self.E, "Pa")
         check_poisson(f"{self.name}.nu", self.nu)
         check_positive(f"{self.name}.Sy", self.Sy, "Pa")
@@ -56,6 +60,7 @@ class Sphere:
     d: float
 
     def __post_init__(self):
+        object.__setattr__(self, "d", to_si("sphere.d", self.d, "m"))
         check_positive("sphere.d", self.d, "m")
 
     def params(self) -> dict:
@@ -71,6 +76,7 @@ class Plate:
     t: float
 
     def __post_init__(self):
+        object.__setattr__(self, "t", to_si("plate.t", self.t, "m"))
         check_positive("plate.t", self.t, "m")
 
     def params(self) -> dict:

@@ -12,15 +12,24 @@ from functools import lru_cache
 
 import numpy as np
 
+from . import fusion, jgm, zener
 from ._num import is_scalar, where
-from .fusion import apparent_restitution, equivalent_plate_mass, mass_ratio, velocities_after_impact
-from .jgm import (critical_interference, critical_load, critical_pressure,
-                  critical_velocity, effective_modulus, restitution_e44, restitution_e45,
-                  sphere_mass, vstar_in_fit_range, yield_strain)
+from .fusion import apparent_restitution, mass_ratio
+from .jgm import restitution_e44, restitution_e45, vstar_in_fit_range
+from .quantities import si_only, with_units
 from .validation import check_choice, check_nonnegative, check_poisson, check_positive
-from .zener import (TAU0_HERTZ, ZENER_METHODS, contact_duration, hertz_stiffness, inelasticity_parameter,
-                    lambda_in_studied_range, time_scale, zener_linear, zener_paper_fit,
+from .zener import (TAU0_HERTZ, ZENER_METHODS, lambda_in_studied_range, zener_linear, zener_paper_fit,
                     zener_solution)
+
+# The pipeline passes SI numbers it has checked: it calls the equations without their unit layer
+# (restitution.quantities), which would cost more than the equations on the scalar path.
+(critical_interference, critical_load, critical_pressure, critical_velocity, effective_modulus, sphere_mass,
+ yield_strain) = map(si_only, (jgm.critical_interference, jgm.critical_load, jgm.critical_pressure,
+                               jgm.critical_velocity, jgm.effective_modulus, jgm.sphere_mass, jgm.yield_strain))
+(contact_duration, hertz_stiffness, inelasticity_parameter, time_scale) = map(
+    si_only, (zener.contact_duration, zener.hertz_stiffness, zener.inelasticity_parameter, zener.time_scale))
+equivalent_plate_mass, velocities_after_impact = map(si_only, (fusion.equivalent_plate_mass,
+                                                              fusion.velocities_after_impact))
 
 __all__ = ["ImpactResult", "impact", "published", "RESTITUTION_MODELS", "EFFECT_MODES", "ZENER_SLOPE_BOUND",
            "PARAMETERS", "DOMAIN", "validate_parameters"]
@@ -160,6 +169,7 @@ def _mode(name, value):
     return check_choice(name, value, EFFECT_MODES)
 
 
+@with_units(v="m/s", sphere_E="Pa", sphere_nu="dimensionless", sphere_Sy="Pa", sphere_rho="kg/m**3", sphere_d="m", plate_E="Pa", plate_nu="dimensionless", plate_Sy="Pa", plate_rho="kg/m**3", plate_t="m")
 def impact(v, sphere_E, sphere_nu, sphere_Sy, sphere_rho, sphere_d,
            plate_E, plate_nu, plate_Sy, plate_rho, plate_t, *,
            restitution_model: str = "e45", zener_method: str = "exact",

@@ -16,6 +16,7 @@ import math
 import numpy as np
 
 from ._num import exp, expm1, is_scalar, minimum, sqrt, where
+from .quantities import si_only, with_units
 from .jgm import reduced_modulus
 from .zener_exact import zener_exact_solution
 from .zener_ode import solve_zener_ode
@@ -34,11 +35,13 @@ LAMBDA_STUDIED_MAX = 1.5
 TAU0_HERTZ = 2.0 * 1.25 ** 0.4 * 0.4 * math.gamma(0.4) * math.gamma(0.5) / math.gamma(0.9)
 
 
+@with_units(E_b="Pa", nu_b="dimensionless", rho_b="kg/m**3")
 def plate_wave_speed(E_b, nu_b, rho_b):
     """v' = sqrt(E_b' / rho_b) [m/s], the plate's sound speed under Eq. (12)."""
-    return sqrt(reduced_modulus(E_b, nu_b) / rho_b)
+    return sqrt(_reduced_modulus(E_b, nu_b) / rho_b)
 
 
+@with_units(v0="m/s", E_a="Pa", nu_a="dimensionless", rho_a="kg/m**3", d="m", E_b="Pa", nu_b="dimensionless", rho_b="kg/m**3", t="m")
 def inelasticity_parameter(v0, E_a, nu_a, rho_a, d, E_b, nu_b, rho_b, t):
     """Zener's "inelasticity" parameter lambda [1], Eq. (12).
 
@@ -46,21 +49,23 @@ def inelasticity_parameter(v0, E_a, nu_a, rho_a, d, E_b, nu_b, rho_b, t):
     with v0 the impact speed [m/s], d the sphere diameter [m], t = 2h the plate thickness [m].
     It depends on t/d only, not on t and d separately.
     """
-    Ea = reduced_modulus(E_a, nu_a)
-    Eb = reduced_modulus(E_b, nu_b)
+    Ea = _reduced_modulus(E_a, nu_a)
+    Eb = _reduced_modulus(E_b, nu_b)
     r_over_t = 0.5 * d / t
-    return (_LAMBDA_PREFACTOR * r_over_t * r_over_t * (v0 / plate_wave_speed(E_b, nu_b, rho_b)) ** 0.2
+    return (_LAMBDA_PREFACTOR * r_over_t * r_over_t * (v0 / _plate_wave_speed(E_b, nu_b, rho_b)) ** 0.2
             * (rho_a / rho_b) ** 0.6 * (Ea / (Ea + Eb)) ** 0.4)
 
 
 _LAMBDA_PREFACTOR = math.pi ** 0.6 / math.sqrt(3.0)
 
 
+@with_units(E_prime="Pa", d="m")
 def hertz_stiffness(E_prime, d):
     """k = (4/3) r^(1/2) E' [N/m^1.5], with r = d/2 (text after Eq. 10): F = k s^(3/2)."""
     return (4.0 / 3.0) * sqrt(0.5 * d) * E_prime
 
 
+@with_units(m_a="kg", k="N/m**1.5", v0="m/s")
 def time_scale(m_a, k, v0):
     """Zener's time unit T = (m / (k v0^(1/2)))^(2/5) [s], Eq. (9). Infinite at v0 = 0."""
     return (m_a / (k * sqrt(v0))) ** 0.4
@@ -71,6 +76,7 @@ def lambda_in_studied_range(lam):
     return lam <= LAMBDA_STUDIED_MAX
 
 
+@with_units(T="s", tau0="dimensionless")
 def contact_duration(T, tau0):
     """t_contact = T tau0 [s]: the time sphere and plate stay in compressive contact."""
     return T * tau0
@@ -179,3 +185,8 @@ def zener_restitution(lam, method: str = "exact", rtol: float = 1e-10):
     """(e_ze, tau0) [1] for Zener's parameter lambda [1] by ``method`` (see module doc)."""
     e, _, tau0 = zener_solution(lam, method, rtol)
     return e, tau0
+
+
+# the module's own calls pass SI numbers: the equations without their unit layer
+_reduced_modulus = si_only(reduced_modulus)
+_plate_wave_speed = si_only(plate_wave_speed)

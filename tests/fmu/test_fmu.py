@@ -105,8 +105,8 @@ def test_nothing_is_recomputed_when_nothing_changed(impact_fmu, monkeypatch):
     import sphere_plate_impact_slave as slave_module  # the module the FMU imported in this process
 
     calls = []
-    real_impact = slave_module.impact
-    monkeypatch.setattr(slave_module, "impact", lambda *a, **k: calls.append(1) or real_impact(*a, **k))
+    real_impact = slave_module._impact_si
+    monkeypatch.setattr(slave_module, "_impact_si", lambda *a, **k: calls.append(1) or real_impact(*a, **k))
     with FmuInstance(impact_fmu) as fmu:
         calls.clear()  # initialisation evaluated the start values
         fmu.set(v_approach=2.0)
@@ -168,9 +168,9 @@ def test_a_non_finite_output_is_an_evaluation_failure(impact_fmu, monkeypatch):
 
     import sphere_plate_impact_slave as slave_module  # the module the FMU imported in this process
 
-    real_impact = slave_module.impact
+    real_impact = slave_module._impact_si
     broken = {}
-    monkeypatch.setattr(slave_module, "impact",
+    monkeypatch.setattr(slave_module, "_impact_si",
                         lambda *a, **k: dataclasses.replace(real_impact(*a, **k), **broken))
     for field, value, name in (("tau0", math.nan, "zener.tau0"), ("v_plate", math.inf, "plate.v_after")):
         broken.clear()

@@ -181,7 +181,7 @@ def test_hypothesis_search_over_the_declared_domain(native):
     bounds, nu up to 0.5 - ulp) for a case where the C and the package disagree."""
     from hypothesis import HealthCheck, given, settings
 
-    from test_properties import CASES
+    from cases import CASES
 
     @settings(max_examples=300, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])
     @given(CASES)

@@ -34,11 +34,15 @@ if os.path.isdir(os.path.join(_HERE, "restitution")) and sys.path[0] != _HERE:
 
 from restitution.fmu.models.sphere_plate_impact.variables import TABLE  # noqa: E402
 from restitution.model import PARAMETERS, impact, published  # noqa: E402
+from restitution.quantities import si_only  # noqa: E402
 from restitution_slave_support import (checked_setter, restore_state, state_check,  # noqa: E402
                                        state_from_bytes, state_schema, state_to_bytes)
 
 #: FMU name of each Real output, by ImpactResult key
 _REAL_OUTPUTS = {v.key: v.name for v in TABLE.outputs if v.type == "Real"}
+#: impact() without its unit layer: the FMU's values are SI floats
+_impact_si = si_only(impact)
+
 #: impact()'s keyword arguments that are Integer choices, and the words their codes stand for
 _CHOICES = {v.name: v for v in TABLE.settable if v.choices is not None}
 #: impact()'s positional arguments after v: the material and geometry parameters, by FMU name
@@ -140,7 +144,7 @@ class SpherePlateImpact(Fmi2Slave):
                          effect_tolerance=float(v["effect_tolerance"]), ode_rtol=float(v["zener.ode_tolerance"]),
                          validate=False))
             args, kwargs = self._call
-            result = impact(float(v["v_approach"]), *args, **kwargs)
+            result = _impact_si(float(v["v_approach"]), *args, **kwargs)
         except Exception as exc:  # a numerical failure must not become fmi2Fatal
             return self._fail(f"{type(exc).__name__}: {exc}")
         outputs = published(result.as_dict())
