@@ -98,6 +98,35 @@ def test_units_and_materials_convert():
     assert s4.plates[0].material == plate4 and s4.balls[0].material == sphere
 
 
+@pytest.mark.parametrize("key, written, si", [
+    ("thickness", "1 ft", 0.3048), ("thickness", "3.18 millimeter", 3.18e-3), ("thickness", "0.5 µm", 5e-7),
+    ("v_min", "0.36 km/h", 0.1), ("gravity", "32.174 ft/s^2", 9.8066),
+    ("rho", "0.0975 lb/in3", 2698.7), ("E", "10 Mpsi", 68.95e9),
+])
+def test_any_unit_of_the_right_kind_is_read(key, written, si):
+    """Units are pint's: besides the usual ones, imperial and spelled-out units convert (factors
+    exact by definition: 1 ft = 0.3048 m, 1 lb = 0.45359237 kg, 1 psi = 1 lbf/in2)."""
+    text = MINIMAL + '\n[simulation]\nv_min = "0.1 m/s"\n'
+    if key in ("v_min", "gravity"):
+        text = text.replace('v_min = "0.1 m/s"', f'{key} = "{written}"')
+    elif key == "thickness":
+        text = text.replace('thickness = "3.18 mm"', f'thickness = "{written}"')
+    else:
+        props = {"E": '"70 GPa"', "nu": "0.3", "Sy": '"250 MPa"', "rho": '"2700 kg/m3"', key: f'"{written}"'}
+        text = text.replace('material = "al_6061"', "material = { " + ", ".join(f"{k} = {v}" for k, v in props.items()) + " }")
+    scene = scene_from(text)
+    value = {"thickness": scene.plates[0].thickness, "v_min": scene.simulation.v_min,
+             "gravity": scene.simulation.gravity, "rho": scene.plates[0].material.rho,
+             "E": scene.plates[0].material.E}[key]
+    assert value == pytest.approx(si, rel=1e-4)
+
+
+def test_a_unit_of_no_scene_kind_is_named_by_its_dimension():
+    with pytest.raises(SceneError, match=r"'3\.18 J': J is a unit of \[mass\] \* \[length\] \*\* 2 / \[time\] \*\* 2, "
+                                         r"but thickness is a length"):
+        scene_from(MINIMAL.replace('thickness = "3.18 mm"', 'thickness = "3.18 J"'))
+
+
 def test_contact_durations_force_plate_waves_on():
     scene = scene_from(MINIMAL.replace('["bounce_heights"]', '["bounce_heights", "contact_durations"]'))
     assert scene.effect_modes() == ("auto", "on")
@@ -111,7 +140,7 @@ def test_contact_durations_force_plate_waves_on():
     ('[scene]', '[scenery]\n[scene]', "scenery", ["unknown key", "did you mean 'scene'"]),
     ('thickness = "3.18 mm"', 'thickness = "3.18 GPa"', "plates[0].thickness", ["GPa is a unit of pressure", "length"]),
     ('thickness = "3.18 mm"', 'thickness = 3.18', "plates[0].thickness", ["has no unit", '"3.18 mm"']),
-    ('thickness = "3.18 mm"', 'thickness = "3.18 furlongs"', "plates[0].thickness", ["unknown unit 'furlongs'"]),
+    ('thickness = "3.18 mm"', 'thickness = "3.18 blargs"', "plates[0].thickness", ["unknown unit 'blargs'"]),
     ('thickness = "3.18 mm"', 'thickness = "-1 mm"', "plates[0].thickness", ["must be > 0"]),
     ('drop_heights = "0.1 m"', 'drop_heights = ["0.1 m", "20 m/s"]', "balls[0].drop_heights[1]",
      ["m/s is a unit of speed"]),
@@ -267,7 +296,7 @@ def test_impact_model_evaluated_only_at_impact_events(instance):
                if isinstance(m, types.ModuleType) and m.__name__ == "sphere_plate_impact_slave"]
     assert modules
     calls = []
-    originals = [m.impact for m in modules]
+    originals = [m._impact_si for m in modules]
 
     def counting(original):
         def impact(v, *args, **kwargs):
@@ -276,13 +305,13 @@ def test_impact_model_evaluated_only_at_impact_events(instance):
         return impact
 
     for m, original in zip(modules, originals):
-        m.impact = counting(original)
+        m._impact_si = counting(original)
     try:
         scene = load_scene(SCENES / "steel_ball_thick_steel_table.toml")
         result = run_scene(scene, instance=instance, progress=False)
     finally:
         for m, original in zip(modules, originals):
-            m.impact = original
+            m._impact_si = original
     speeds = np.concatenate([d.v_approach for d in result.drops])
     assert len(calls) == result.n_impacts == 52
     np.testing.assert_array_equal(np.array(calls), speeds)

@@ -2,38 +2,47 @@
 
 A dimensional value in a scene is a string "<number> <unit>"; a bare number is refused
 (``thickness = 3.18`` could mean metres or millimetres). Dimensionless values (Poisson's
-ratio, tolerances) are plain numbers. Everything is converted to SI on load.
+ratio, tolerances) are plain numbers. Units are read by pint, so any unit of the right kind works
+(``"0.125 in"``, ``"1/8 inch"`` is not a number but ``"0.3175 cm"`` is; ``"2.7 g/cm3"``, ``"9.81 m/s2"``);
+a digit right after a unit's letters is its exponent (``m3`` is m**3). Everything is converted to SI
+on load.
 """
 from __future__ import annotations
 
 import math
 import re
+from functools import lru_cache
 
-__all__ = ["UNITS", "QUANTITIES", "parse_quantity", "UnitError", "format_quantity"]
+__all__ = ["QUANTITIES", "EXAMPLES", "parse_quantity", "UnitError", "format_quantity"]
 
 
 class UnitError(ValueError):
     """A value whose unit is missing, unknown or of the wrong kind (the message says which)."""
 
 
-#: quantity kind -> {unit spelling: factor to SI}
-UNITS: dict[str, dict[str, float]] = {
-    "length": {"m": 1.0, "cm": 1e-2, "mm": 1e-3, "um": 1e-6, "µm": 1e-6, "in": 0.0254},
-    "pressure": {"Pa": 1.0, "kPa": 1e3, "MPa": 1e6, "GPa": 1e9},
-    "density": {"kg/m3": 1.0, "kg/m^3": 1.0, "g/cm3": 1e3, "g/cm^3": 1e3},
-    "speed": {"m/s": 1.0, "cm/s": 1e-2, "mm/s": 1e-3},
-    "acceleration": {"m/s2": 1.0, "m/s^2": 1.0},
-}
-#: SI unit of each kind (what the loader converts to).
+#: SI unit of each kind of quantity (what the loader converts to; shown in messages).
 QUANTITIES = {"length": "m", "pressure": "Pa", "density": "kg/m3", "speed": "m/s", "acceleration": "m/s2"}
+#: Units named in the messages as examples of each kind (any unit pint knows of that kind works).
+EXAMPLES = {"length": "m, cm, mm, um, in", "pressure": "Pa, kPa, MPa, GPa", "density": "kg/m3, g/cm3",
+            "speed": "m/s, cm/s, mm/s, km/h", "acceleration": "m/s2"}
+_EXAMPLE_VALUE = {"length": "3.18 mm", "pressure": "69 GPa", "density": "2700 kg/m3", "speed": "0.1 m/s",
+                  "acceleration": "9.81 m/s2"}
 
-_KIND_OF = {unit: kind for kind, units in UNITS.items() for unit in units}
 # ASCII digits only: float() would take "٣.١٨" (Arabic-Indic digits) as 3.18.
 _NUMBER = re.compile(r"^\s*([-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][-+]?[0-9]+)?)\s*(\S.*?)?\s*$", re.ASCII)
+# "kg/m3", "m/s2": an exponent written as digits right after a unit's letters
+_EXPONENT = re.compile(r"(?<=[A-Za-zµμ])([0-9]+)\b")
 
 
-def _examples(kind: str) -> str:
-    return ", ".join(u for u in UNITS[kind] if "^" not in u and u != "µm")
+@lru_cache(maxsize=1)
+def _registry():
+    import pint
+
+    return pint.UnitRegistry()
+
+
+def _pint_units(unit: str) -> str:
+    return _EXPONENT.sub(r"**\1", unit)
 
 
 def parse_quantity(key: str, value, kind: str) -> float:
@@ -43,36 +52,36 @@ def parse_quantity(key: str, value, kind: str) -> float:
     caller prefixes the full key). Raises :class:`UnitError` for a bare number,
     an unknown unit or a unit of another kind.
     """
-    units = UNITS[kind]
     short = key.rsplit(".", 1)[-1]
-    example = f'{short} = "{_example_value(kind)}"'
+    example = f'{short} = "{_EXAMPLE_VALUE[kind]}"'
     if isinstance(value, bool) or not isinstance(value, (str, int, float)):
         raise UnitError(f"{value!r}: expected a {kind} with its unit, as a string, e.g. {example}")
     if not isinstance(value, str):
         raise UnitError(f"{value!r} has no unit: write the {kind} with its unit, e.g. {example} "
-                        f"(units: {_examples(kind)})")
+                        f"(units: {EXAMPLES[kind]})")
     match = _NUMBER.match(value)
     if match is None:
         raise UnitError(f"{value!r} is not '<number> <unit>' (a number in ASCII digits), e.g. {example}")
     number, unit = float(match.group(1)), match.group(2)
     if unit is None:
         raise UnitError(f"{value!r} has no unit: write the {kind} with its unit, e.g. {example} "
-                        f"(units: {_examples(kind)})")
-    if unit not in units:
-        other = _KIND_OF.get(unit)
-        if other is not None:
-            raise UnitError(f"{value!r}: {unit} is a unit of {other}, but {short} is a {kind} "
-                            f"(units: {_examples(kind)})")
-        raise UnitError(f"{value!r}: unknown unit {unit!r} for a {kind} (units: {_examples(kind)})")
-    si = number * units[unit]
+                        f"(units: {EXAMPLES[kind]})")
+    ureg = _registry()
+    try:
+        given = ureg.parse_units(_pint_units(unit))
+    except Exception:  # noqa: BLE001 - pint raises several kinds for a unit it cannot read
+        raise UnitError(f"{value!r}: unknown unit {unit!r} for a {kind} (units: {EXAMPLES[kind]})") from None
+    target = ureg.parse_units(_pint_units(QUANTITIES[kind]))
+    if given.dimensionality != target.dimensionality:
+        other = next((k for k, si in QUANTITIES.items()
+                      if ureg.parse_units(_pint_units(si)).dimensionality == given.dimensionality),
+                     f"{given.dimensionality}" if given.dimensionality else "a dimensionless number")
+        raise UnitError(f"{value!r}: {unit} is a unit of {other}, but {short} is a {kind} "
+                        f"(units: {EXAMPLES[kind]})")
+    si = float(ureg.Quantity(number, given).to(target).magnitude)
     if not math.isfinite(si):
         raise UnitError(f"{value!r} is not finite")
     return si
-
-
-def _example_value(kind: str) -> str:
-    return {"length": "3.18 mm", "pressure": "69 GPa", "density": "2700 kg/m3", "speed": "0.1 m/s",
-            "acceleration": "9.81 m/s2"}[kind]
 
 
 def format_quantity(value: float, kind: str) -> str:
