@@ -3,7 +3,7 @@
 A dimensional value in a scene is a string "<number> <unit>"; a bare number is refused
 (``thickness = 3.18`` could mean metres or millimetres). Dimensionless values (Poisson's
 ratio, tolerances) are plain numbers. Units are read by pint, so any unit of the right kind works
-(``"0.125 in"``, ``"1/8 inch"`` is not a number but ``"0.3175 cm"`` is; ``"2.7 g/cm3"``, ``"9.81 m/s2"``);
+(``"0.125 in"``, ``"1 ft"``, ``"2.7 g/cm3"``, ``"9.81 m/s2"``);
 a digit right after a unit's letters is its exponent (``m3`` is m**3). Everything is converted to SI
 on load.
 """
