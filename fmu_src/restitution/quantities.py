@@ -44,8 +44,9 @@ def to_si(name: str, value, unit: str):
     unchanged (a plain number is already SI). ValueError naming ``name`` for a wrong dimension."""
     if not is_quantity(value):
         return value
-    import pint
-
+    # A Quantity exists, so pint is loaded: taken from sys.modules, with no import statement that the
+    # FMU build would list among the modules the bundled package needs.
+    pint = _MODULES["pint"]
     try:
         return value.to(unit).magnitude
     except pint.DimensionalityError:

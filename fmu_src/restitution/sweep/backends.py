@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import atexit
 import hashlib
+import inspect
 import os
 import shutil
 import sys
@@ -322,6 +323,7 @@ def _instantiate_with_bundled_code(slave, unzip_dir: str) -> str:
             slave.instantiate(loggingOn=False, callbacks=_quiet_callbacks())
             fmu_module = sys.modules.get(slave_module) if slave_module else None
             impact_fn = getattr(fmu_module, "impact", None)
+            impact_fn = inspect.unwrap(impact_fn) if impact_fn is not None else None  # past the unit layer
             code_file = getattr(getattr(impact_fn, "__code__", None), "co_filename", None)
         finally:
             for k in [k for k in sys.modules if shadowed(k)]:
