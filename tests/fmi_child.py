@@ -24,7 +24,8 @@ from fmpy.fmi2 import (FMU2Slave, calloc, fmi2CallbackAllocateMemoryTYPE, fmi2Ca
 FMU, UNZIP, ARGS = sys.argv[1], sys.argv[2], sys.argv[3:]
 MD = read_model_description(FMU)
 VR = {v.name: v.valueReference for v in MD.modelVariables}
-TYPE = {v.name: v.type for v in MD.modelVariables}
+# the FMI type a variable is got and set with (an Enumeration with the Integer functions)
+TYPE = {v.name: "Integer" if v.type == "Enumeration" else v.type for v in MD.modelVariables}
 LOG = []  # (instance name, status, message) of every logger call
 
 

@@ -23,8 +23,8 @@ def _assert_round_trip(fmu, model):
     back = variables_from_model_description(text)
     assert [v.name for v in back] == [v.name for v in rows]
     for row, got in zip(rows, back):
-        assert (got.vr, got.type, got.causality, got.variability, got.unit, got.description) == (
-            row.vr, row.type, row.causality, row.variability, row.unit, row.description), row.name
+        assert (got.vr, got.type, got.causality, got.variability, got.unit, got.description, got.enumeration) == (
+            row.vr, row.type, row.causality, row.variability, row.unit, row.description, row.enumeration), row.name
         if row.start is None:
             assert got.start is None, row.name
         else:
@@ -35,6 +35,9 @@ def _assert_round_trip(fmu, model):
                                         pytest.approx(high, rel=1e-15) if math.isfinite(high) else math.inf), row.name
     root = ET.fromstring(text)
     assert root.get("description") == table(model).description
+    declared = {t.get("name"): {i.get("name"): int(i.get("value")) for i in t.find("Enumeration")}
+                for t in root.findall("TypeDefinitions/SimpleType")}
+    assert declared == {name: var.codes for name, var in table(model).enumerations.items()}
     index = {sv.get("name"): i + 1 for i, sv in enumerate(root.find("ModelVariables"))}
     outputs = {int(u.get("index")): u.get("dependencies") for u in root.find("ModelStructure/Outputs")}
     assert sorted(outputs) == sorted(index[v.name] for v in table(model).outputs)

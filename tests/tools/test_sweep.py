@@ -11,6 +11,8 @@ import pytest
 import restitution as r
 
 from independent import apparent_cor, table_material
+from restitution.fmu.models.sphere_plate_impact.variables import MATERIAL_SELECTORS
+from restitution.fmu.models.sphere_plate_impact.variables import TABLE as IMPACT_TABLE
 from restitution.model import PARAMETERS, published
 from restitution.sweep import (INPUTS, OUTPUTS, SweepSpec, code_fingerprint, compare_results, open_client,
                                read_table, release_fmus, run_sweep)
@@ -102,6 +104,10 @@ def test_parameter_table_matches_the_fmu(impact_fmu):
     expected = {name: ("input" if name == "v_approach" else "parameter", vtype, start)
                 for name, _kw, vtype, start in INPUTS}
     expected.update({name: ("output", vtype, None) for name, _f, vtype in OUTPUTS})
+    # what a sweep leaves alone: the material selectors (custom: a sweep sets the properties) and
+    # the properties used that they show
+    expected.update({name: ("parameter", "Enumeration", 0) for name in MATERIAL_SELECTORS})
+    expected.update({v.name: ("calculatedParameter", "Real", None) for v in IMPACT_TABLE.calculated})
     assert set(found) == set(expected)
     for name, (causality, vtype, start) in expected.items():
         assert found[name][:2] == (causality, vtype), name

@@ -135,12 +135,15 @@ class FmuInstance:
         return self.variables[name].valueReference
 
     def set(self, **values):
-        """Set variables by name; dotted FMI names are passed as ``**{"sphere.E": 2e11}``. A value the
-        FMU refuses raises FmiStatusError (status fmi2Error, the FMU's message): the FMU keeps the
-        previous values of the call's variables of that type."""
+        """Set variables by name; dotted FMI names are passed as ``**{"sphere.E": 2e11}``, an Enumeration
+        by its item's name or code (``**{"plate.material": "al_6061"}``). A value the FMU refuses raises
+        FmiStatusError (status fmi2Error, the FMU's message): the FMU keeps the previous values of the
+        call's variables of that type."""
         reals, ints, bools = {}, {}, {}
         for name, value in values.items():
             kind = self.variables[name].type
+            if kind == "Enumeration" and isinstance(value, str):
+                value = self.item_code(name, value)
             target = reals if kind == "Real" else ints if kind in ("Integer", "Enumeration") else bools
             target[self.vr(name)] = value
         if reals:
@@ -149,6 +152,13 @@ class FmuInstance:
             self._call(self._slave.setInteger, list(ints), [int(v) for v in ints.values()])
         if bools:
             self._call(self._slave.setBoolean, list(bools), [bool(v) for v in bools.values()])
+
+    def item_code(self, name: str, item: str) -> int:
+        """The code of the item ``item`` of the Enumeration variable ``name`` (ValueError listing the items)."""
+        items = {i.name: int(i.value) for i in self.variables[name].declaredType.items}
+        if item not in items:
+            raise ValueError(f"{name} = {item!r} is not one of its items: {', '.join(items)}")
+        return items[item]
 
     def _call(self, function, *args):
         """An fmpy call; a status above fmi2Warning becomes FmiStatusError with the FMU's last message."""

@@ -77,6 +77,9 @@ def complete_model_description(xml_text: str, table) -> str:
         var = table[sv.get("name")]
         sv.set("description", var.description)
         type_node = sv[0]
+        if var.enumeration is not None:  # an Integer choice declared as an Enumeration (same get/set calls)
+            type_node.tag = "Enumeration"
+            type_node.set("declaredType", var.enumeration)
         if var.type == "Real" and var.unit is not None:
             type_node.set("unit", var.unit)
             used_units.add(var.unit)
@@ -95,6 +98,8 @@ def complete_model_description(xml_text: str, table) -> str:
     # FMI 2.0 element order: CoSimulation, UnitDefinitions, TypeDefinitions, LogCategories, ...
     position = list(root).index(root.find("CoSimulation")) + 1
     root.insert(position, unit_defs)
+    if table.enumerations:
+        root.insert(position + 1, _type_definitions(table))
 
     inputs = [index[var.name] for var in table if var.causality == "input"]
     structure = root.find("ModelStructure")
@@ -108,6 +113,8 @@ def complete_model_description(xml_text: str, table) -> str:
         if deps:
             attrs["dependenciesKind"] = " ".join("dependent" for _ in inputs)
         ET.SubElement(outputs, "Unknown", attrs)
+    # InitialUnknowns: the outputs, then the calculated parameters, in value-reference order
+    for var in sorted(table.outputs + table.calculated, key=lambda v: index[v.name]):
         ET.SubElement(initial, "Unknown", {"index": str(index[var.name])})
     for element in root.iter():
         if element.text is not None and not element.text.strip():
@@ -115,6 +122,18 @@ def complete_model_description(xml_text: str, table) -> str:
         element.tail = None
     ET.indent(root, "  ")
     return '<?xml version="1.0" encoding="UTF-8"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
+
+
+def _type_definitions(table) -> ET.Element:
+    """<TypeDefinitions> with an Enumeration type for each ``enumeration`` of the table: its items are
+    the variable's choices, valued by their codes."""
+    node = ET.Element("TypeDefinitions")
+    for name, var in table.enumerations.items():
+        simple = ET.SubElement(node, "SimpleType", name=name)
+        items = ET.SubElement(simple, "Enumeration")
+        for (word, code), text in zip(var.codes.items(), var.item_descriptions or [""] * len(var.codes)):
+            ET.SubElement(items, "Item", {"name": word, "value": str(code), "description": text})
+    return node
 
 
 def _rewrite_zip(fmu: Path, transform=None, member: str | None = None, extra: dict | None = None) -> None:

@@ -37,6 +37,9 @@ def variables_from_model_description(xml_text: str) -> list[Variable]:
     for sv in ET.fromstring(xml_text).find("ModelVariables"):
         node = sv[0]
         vtype = node.tag
+        enumeration = node.get("declaredType") if vtype == "Enumeration" else None
+        if enumeration is not None:
+            vtype = "Integer"  # an Enumeration is set and got as an Integer
         if vtype not in ("Real", "Integer", "Boolean"):
             raise ValueError(f"variable {sv.get('name')}: type {vtype} is not supported by the C front")
         causality = sv.get("causality", "local")
@@ -53,7 +56,7 @@ def variables_from_model_description(xml_text: str) -> list[Variable]:
             name=sv.get("name"), key=sv.get("name"), type=vtype, causality=causality,
             variability=sv.get("variability", "continuous"), unit=node.get("unit"),
             description=sv.get("description", ""), start=start, interval=interval, range_text=text,
-            state=causality in ("parameter", "input"), vr=int(sv.get("valueReference"))))
+            state=causality in ("parameter", "input"), vr=int(sv.get("valueReference")), enumeration=enumeration))
     return sorted(out, key=lambda v: v.vr)
 
 
@@ -158,6 +161,10 @@ def c_header(model: str, rows: list[Variable] | None = None) -> str:
               f"#define RST_MODEL_VARIABLES RST_{upper}_VARIABLES"]
     if enums:
         lines += _c_enums(upper, rows)
+        for name, values in table(model).constants.items():
+            lines += [f"/* {name}, by code */",
+                      f"static const double RST_{upper}_{name}[{len(values)}] = {{"
+                      + ", ".join("NAN" if math.isnan(x) else _c_double(x) for x in values) + "};"]
     lines += ["#endif", ""]
     return "\n".join(lines)
 

@@ -11,9 +11,9 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, replace
 
-__all__ = ["Variable", "Table", "parameter", "input_", "output", "local"]
+__all__ = ["Variable", "Table", "parameter", "input_", "output", "local", "calculated_parameter"]
 
-CAUSALITIES = ("parameter", "input", "output", "local")
+CAUSALITIES = ("parameter", "input", "output", "local", "calculatedParameter")
 TYPES = ("Real", "Integer", "Boolean")
 
 
@@ -43,11 +43,15 @@ class Variable:
     #: (the others are recomputed from the inputs)
     state: bool = False
     vr: int = -1  #: value reference: the row's position in its table
+    #: an Integer choice that the modelDescription declares as an Enumeration of this type (its items
+    #: the choices, with ``item_descriptions``); None: a plain Integer whose description lists the codes
+    enumeration: str | None = None
+    item_descriptions: tuple[str, ...] | None = None
 
     @property
     def initial(self) -> str | None:
         """The ``initial`` attribute the modelDescription declares (outputs and locals are calculated)."""
-        return "calculated" if self.causality in ("output", "local") else None
+        return "calculated" if self.causality in ("output", "local", "calculatedParameter") else None
 
     @property
     def codes(self) -> dict[str, int] | None:
@@ -90,13 +94,14 @@ class Variable:
 
 
 def _settable(name, key, vtype, causality, variability, unit, start, description, interval=None, *,
-              choices=None, first_code=1, range_text=None):
+              choices=None, first_code=1, range_text=None, enumeration=None, item_descriptions=None):
     if choices is not None:
         interval = (first_code, first_code + len(choices) - 1, False, False)
     if interval is None:
         interval = (0.0, math.inf, True, True)  # finite and > 0: the usual physical quantity
     return Variable(name, key, vtype, causality, variability, unit, description, start, tuple(interval), range_text,
-                    tuple(choices) if choices is not None else None, first_code, state=True)
+                    tuple(choices) if choices is not None else None, first_code, state=True,
+                    enumeration=enumeration, item_descriptions=tuple(item_descriptions) if item_descriptions else None)
 
 
 def parameter(name, key, unit, start, description, interval=None, *, vtype="Real", variability="tunable", **kw):
@@ -115,6 +120,11 @@ def output(name, key, unit, description, *, vtype="Real", feedthrough=False, sta
     return Variable(name, key, vtype, "output", variability, unit, description, feedthrough=feedthrough, state=state)
 
 
+def calculated_parameter(name, key, unit, description):
+    """A Real calculated parameter: computed from the parameters (tunable, as they are), not settable."""
+    return Variable(name, key, "Real", "calculatedParameter", "tunable", unit, description)
+
+
 def local(name, key, unit, description, *, state=True):
     """A continuous Real local variable (one the model evolves: part of the state)."""
     return Variable(name, key, "Real", "local", "continuous", unit, description, state=state)
@@ -123,9 +133,12 @@ def local(name, key, unit, description, *, state=True):
 class Table:
     """The variables of one model, value reference = position; looked up by FMU name."""
 
-    def __init__(self, model: str, description: str, rows):
+    def __init__(self, model: str, description: str, rows, constants: dict | None = None):
         self.model = model
         self.description = description
+        #: name -> tuple of floats the model's C needs beside the rows (the generated header holds them
+        #: as ``RST_<MODEL>_<NAME>[]``), e.g. the material presets by code
+        self.constants = dict(constants or {})
         self.rows = tuple(replace(row, vr=i) for i, row in enumerate(rows))
         self._by_name = {row.name: row for row in self.rows}
         if len(self._by_name) != len(self.rows):
@@ -154,6 +167,20 @@ class Table:
     @property
     def outputs(self) -> tuple[Variable, ...]:
         return tuple(row for row in self.rows if row.causality == "output")
+
+    @property
+    def calculated(self) -> tuple[Variable, ...]:
+        """The calculated parameters, in value-reference order."""
+        return tuple(row for row in self.rows if row.causality == "calculatedParameter")
+
+    @property
+    def enumerations(self) -> dict[str, Variable]:
+        """Enumeration type name -> the first variable declared with it (its items are the type's)."""
+        out = {}
+        for row in self.rows:
+            if row.enumeration is not None:
+                out.setdefault(row.enumeration, row)
+        return out
 
     @property
     def choices(self) -> dict[str, dict[str, int]]:

@@ -33,7 +33,7 @@ import numpy as np
 
 from ..fmu.models.sphere_plate_impact.variables import TABLE
 from ..model import PARAMETERS
-from .spec import CODES, INPUTS, INTEGER_INPUTS, OUTPUTS
+from .spec import CODES, INPUTS, INTEGER_INPUTS, OUTPUTS, SETTABLE
 
 __all__ = ["Backend", "PackageBackend", "FmuBackend", "get_backend", "code_fingerprint", "release_fmus",
            "check_impact_fmu"]
@@ -41,7 +41,7 @@ __all__ = ["Backend", "PackageBackend", "FmuBackend", "get_backend", "code_finge
 _REAL_OUT = [name for name, _f, t in OUTPUTS if t == "Real"]
 _BOOL_OUT = [name for name, _f, t in OUTPUTS if t == "Boolean"]
 #: impact()'s keyword options (the inputs that are neither v nor a material or geometry parameter)
-_OPTION_NAMES = tuple(v.name for v in TABLE.settable
+_OPTION_NAMES = tuple(v.name for v in SETTABLE
                       if v.key not in {"v", *(key for key, _unit, _check in PARAMETERS)})
 
 
@@ -82,7 +82,7 @@ def inputs_ok(cases: dict) -> np.ndarray:
     others read NaN."""
     ok = np.ones(np.size(cases["v_approach"]), dtype=bool)
     with np.errstate(invalid="ignore"):
-        for var in TABLE.settable:
+        for var in SETTABLE:
             x = np.asarray(cases[var.name], dtype=float)
             low, high, low_open, high_open = var.interval
             ok &= (x > low) if low_open else (x >= low)

@@ -23,7 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..fmu.models.sphere_plate_impact.variables import TABLE, fmu_values
+from ..fmu.models.sphere_plate_impact.variables import MATERIAL_SELECTORS, TABLE, fmu_values
 from ..materials import MATERIALS, TABLE4_CASES, table4_case
 
 __all__ = ["SweepSpec", "INPUTS", "OUTPUTS", "CODES", "RANDOM_BLOCK", "canonical_name", "load_spec",
@@ -34,14 +34,17 @@ class SizeError(ValueError):
     """A sweep refused before any work by the size guard: an axis too long to build, or a table too
     big for the memory budget and for the disk (the message gives the numbers)."""
 
-#: (FMU name, impact() keyword, FMI type, start value): the FMU's inputs and parameters.
-INPUTS = tuple((v.name, v.key, v.type, v.start) for v in TABLE.settable)
+#: The FMU's inputs and parameters a sweep sets: all but the material selectors (a sweep gives the
+#: materials as pairs and sets their properties, the selectors stay custom).
+SETTABLE = tuple(v for v in TABLE.settable if v.name not in MATERIAL_SELECTORS)
+#: (FMU name, impact() keyword, FMI type, start value) of each of them.
+INPUTS = tuple((v.name, v.key, v.type, v.start) for v in SETTABLE)
 INPUT_NAMES = tuple(row[0] for row in INPUTS)
 START = {row[0]: row[3] for row in INPUTS}
 INTEGER_INPUTS = tuple(row[0] for row in INPUTS if row[2] == "Integer")
 
 #: Integer-coded parameters: the words accepted for each code (as in the FMU's descriptions).
-CODES = TABLE.choices
+CODES = {v.name: v.codes for v in SETTABLE if v.choices is not None}
 
 #: (FMU name, ImpactResult field, FMI type): the FMU's outputs, as restitution.model.published gives them.
 OUTPUTS = tuple((v.name, v.key, v.type) for v in TABLE.outputs)

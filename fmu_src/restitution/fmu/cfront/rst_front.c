@@ -165,9 +165,11 @@ static int check_set(rst_instance *inst, const char *function, fmi2ValueReferenc
         return 0;
     }
     if (!settable(inst, var)) {
-        if (var->causality == RST_OUTPUT || var->causality == RST_LOCAL)
+        if (var->causality == RST_OUTPUT || var->causality == RST_LOCAL || var->causality == RST_CALCULATEDPARAMETER)
             rst_log(inst, fmi2Error, "%s: %s is %s and cannot be set", function, var->name,
-                    var->causality == RST_OUTPUT ? "an output" : "a local variable");
+                    var->causality == RST_OUTPUT  ? "an output"
+                    : var->causality == RST_LOCAL ? "a local variable"
+                                                  : "a calculated parameter");
         else
             rst_log(inst, fmi2Error, "%s: %s is a fixed parameter and cannot be set in %s (only before "
                     "fmi2ExitInitializationMode)", function, var->name, mode_name(inst->mode));
@@ -216,8 +218,8 @@ static int check_get(rst_instance *inst, const char *function, fmi2ValueReferenc
     return 1;
 }
 
-/* Reads `n` (at most 64) variables of `type` into `out`: inputs and parameters from the store, outputs
- * and locals (what the model computes) from the backend in one call. */
+/* Reads `n` (at most 64) variables of `type` into `out`: inputs and parameters from the store, outputs,
+ * locals and calculated parameters (what the model computes) from the backend in one call. */
 static fmi2Status get_values(rst_instance *inst, const char *function, rst_type type, const fmi2ValueReference vr[],
                              size_t n, double *out)
 {
@@ -231,7 +233,8 @@ static fmi2Status get_values(rst_instance *inst, const char *function, rst_type 
             return fmi2Error;
         out[i] = inst->store[vr[i]];
         if (inst->model->variables[vr[i]].causality == RST_OUTPUT ||
-            inst->model->variables[vr[i]].causality == RST_LOCAL) {
+            inst->model->variables[vr[i]].causality == RST_LOCAL ||
+            inst->model->variables[vr[i]].causality == RST_CALCULATEDPARAMETER) {
             position[n_outputs] = i;
             outputs[n_outputs++] = vr[i];
         }

@@ -10,7 +10,8 @@
 #define RST_VARIABLE_LAYOUT 2
 
 typedef enum { RST_REAL, RST_INTEGER, RST_BOOLEAN } rst_type;
-typedef enum { RST_PARAMETER, RST_INPUT, RST_OUTPUT, RST_LOCAL } rst_causality;
+/* RST_CALCULATEDPARAMETER: computed from the parameters by the backend, read like an output, never set */
+typedef enum { RST_PARAMETER, RST_INPUT, RST_OUTPUT, RST_LOCAL, RST_CALCULATEDPARAMETER } rst_causality;
 typedef enum { RST_FIXED, RST_TUNABLE, RST_DISCRETE, RST_CONTINUOUS } rst_variability;
 
 typedef struct {

@@ -72,21 +72,44 @@ static void invalidate(double *values)
         values[BOOLEAN_OUTPUTS[i]] = 0.0;
 }
 
+/* The calculated parameters <body>.used.*: the body's preset where <body>.material names one (code > 0,
+ * checked against the declared range by the front), else its numeric parameters (the slave's
+ * resolve_materials). */
+static void resolve_materials(double *values)
+{
+    static const unsigned int SELECTOR[2] = {VR(SPHERE_MATERIAL), VR(PLATE_MATERIAL)};
+    static const unsigned int SET[2][4] = {{VR(SPHERE_E), VR(SPHERE_NU), VR(SPHERE_SY), VR(SPHERE_RHO)},
+                                           {VR(PLATE_E), VR(PLATE_NU), VR(PLATE_SY), VR(PLATE_RHO)}};
+    static const unsigned int USED[2][4] = {
+        {VR(SPHERE_USED_E), VR(SPHERE_USED_NU), VR(SPHERE_USED_SY), VR(SPHERE_USED_RHO)},
+        {VR(PLATE_USED_E), VR(PLATE_USED_NU), VR(PLATE_USED_SY), VR(PLATE_USED_RHO)}};
+    static const double *const PRESET[4] = {RST_SPHEREPLATEIMPACT_MATERIAL_E, RST_SPHEREPLATEIMPACT_MATERIAL_NU,
+                                            RST_SPHEREPLATEIMPACT_MATERIAL_SY, RST_SPHEREPLATEIMPACT_MATERIAL_RHO};
+    const int n_codes = (int)(sizeof RST_SPHEREPLATEIMPACT_MATERIAL_E / sizeof RST_SPHEREPLATEIMPACT_MATERIAL_E[0]);
+    int body, prop;
+    for (body = 0; body < 2; body++) {
+        int code = to_code(values[SELECTOR[body]]);
+        for (prop = 0; prop < 4; prop++)
+            values[USED[body][prop]] = (code > 0 && code < n_codes) ? PRESET[prop][code] : values[SET[body][prop]];
+    }
+}
+
 int rst_impact_evaluate(double *values, char *message, size_t size)
 {
     rst_impact_inputs in;
     rst_impact_result r;
     int status, k;
+    resolve_materials(values);
     in.v = values[VR(V_APPROACH)];
-    in.sphere_E = values[VR(SPHERE_E)];
-    in.sphere_nu = values[VR(SPHERE_NU)];
-    in.sphere_Sy = values[VR(SPHERE_SY)];
-    in.sphere_rho = values[VR(SPHERE_RHO)];
+    in.sphere_E = values[VR(SPHERE_USED_E)];
+    in.sphere_nu = values[VR(SPHERE_USED_NU)];
+    in.sphere_Sy = values[VR(SPHERE_USED_SY)];
+    in.sphere_rho = values[VR(SPHERE_USED_RHO)];
     in.sphere_d = values[VR(SPHERE_D)];
-    in.plate_E = values[VR(PLATE_E)];
-    in.plate_nu = values[VR(PLATE_NU)];
-    in.plate_Sy = values[VR(PLATE_SY)];
-    in.plate_rho = values[VR(PLATE_RHO)];
+    in.plate_E = values[VR(PLATE_USED_E)];
+    in.plate_nu = values[VR(PLATE_USED_NU)];
+    in.plate_Sy = values[VR(PLATE_USED_SY)];
+    in.plate_rho = values[VR(PLATE_USED_RHO)];
     in.plate_t = values[VR(PLATE_T)];
     in.restitution_model = to_code(values[VR(RESTITUTION_MODEL)]);
     in.zener_method = to_code(values[VR(ZENER_METHOD)]);

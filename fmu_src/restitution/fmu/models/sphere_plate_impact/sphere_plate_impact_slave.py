@@ -32,7 +32,8 @@ _HERE = os.path.dirname(os.path.abspath(__file__))
 if os.path.isdir(os.path.join(_HERE, "restitution")) and sys.path[0] != _HERE:
     sys.path.insert(0, _HERE)
 
-from restitution.fmu.models.sphere_plate_impact.variables import TABLE  # noqa: E402
+from restitution.fmu.models.sphere_plate_impact.variables import (  # noqa: E402
+    MATERIAL_SELECTORS, TABLE, resolve_materials)
 from restitution.model import PARAMETERS, impact, published  # noqa: E402
 from restitution.quantities import si_only  # noqa: E402
 from restitution_slave_support import (checked_setter, restore_state, state_check,  # noqa: E402
@@ -44,7 +45,7 @@ _REAL_OUTPUTS = {v.key: v.name for v in TABLE.outputs if v.type == "Real"}
 _impact_si = si_only(impact)
 
 #: impact()'s keyword arguments that are Integer choices, and the words their codes stand for
-_CHOICES = {v.name: v for v in TABLE.settable if v.choices is not None}
+_CHOICES = {v.name: v for v in TABLE.settable if v.choices is not None and v.name not in MATERIAL_SELECTORS}
 #: impact()'s positional arguments after v: the material and geometry parameters, by FMU name
 _PHYSICAL = tuple(TABLE.by_key()[key].name for key, _unit, _check in PARAMETERS)
 _FMI_CAUSALITY = {"input": Fmi2Causality.input, "parameter": Fmi2Causality.parameter, "output": Fmi2Causality.output}
@@ -72,11 +73,18 @@ class SpherePlateImpact(Fmi2Slave):
         self._outputs = {}
         self._stale = True  # an input or parameter changed since the last evaluation
         self._call = None  # impact()'s arguments but v, built when a parameter changed
+        self._used = None  # the parameters with each body's material preset applied, when a parameter changed
         self._failure = None  # message of the last evaluation that raised
         self._output_keys = {}  # (Real|Boolean, value reference) -> ImpactResult key, for get_real/get_boolean
         for var in TABLE:
             kind = {"Real": Real, "Integer": Integer, "Boolean": Boolean}[var.type]
             variability = getattr(Fmi2Variability, var.variability)
+            if var.causality == "calculatedParameter":
+                self.register_variable(kind(
+                    var.name, causality=Fmi2Causality.calculatedParameter, variability=variability,
+                    initial=Fmi2Initial.calculated, description=var.description,
+                    getter=self._used_getter(var.name)), nested=False)
+                continue
             if var.causality == "output":
                 fmi_var = kind(var.name, causality=Fmi2Causality.output, variability=variability,
                                initial=Fmi2Initial.calculated, description=var.description,
@@ -95,10 +103,22 @@ class SpherePlateImpact(Fmi2Slave):
     def _input_getter(self, name):
         return lambda: self._values[name]
 
+    def _used_getter(self, name):
+        """A calculated parameter: the material property the model uses (``sphere.used.E`` is the
+        preset's E, or sphere.E for a custom material)."""
+        parameter = name.replace(".used.", ".")
+        return lambda: self._used_values()[parameter]
+
+    def _used_values(self):
+        if self._used is None:
+            self._used = resolve_materials(self._values)
+        return self._used
+
     def _changed(self, name):
         self._stale = True
         if name != "v_approach":
             self._call = None
+            self._used = None
 
     def _output_getter(self, key, vtype):
         nan = math.nan if vtype == "Real" else False
@@ -138,8 +158,9 @@ class SpherePlateImpact(Fmi2Slave):
         v = self._values
         try:
             if self._call is None:
+                used = self._used_values()
                 self._call = (
-                    tuple(float(v[name]) for name in _PHYSICAL),
+                    tuple(float(used[name]) for name in _PHYSICAL),
                     dict({TABLE.key_of(name): var.word(int(v[name])) for name, var in _CHOICES.items()},
                          effect_tolerance=float(v["effect_tolerance"]), ode_rtol=float(v["zener.ode_tolerance"]),
                          validate=False))
@@ -179,6 +200,7 @@ class SpherePlateImpact(Fmi2Slave):
             self._values[var.name] = var.start
         self._stale = True
         self._call = None
+        self._used = None
         self._failure = None
         self._outputs = {}
 

@@ -9,9 +9,9 @@ from __future__ import annotations
 
 import math
 
-from ....materials import MATERIALS
+from ....materials import ALIASES, MATERIALS
 from ....model import DOMAIN, EFFECT_MODES, RESTITUTION_MODELS, ZENER_METHODS
-from ...table import Table, input_, output, parameter
+from ...table import Table, calculated_parameter, input_, output, parameter
 
 _BALL, _PLATE = MATERIALS["s2_tool_steel"], MATERIALS["al_6061"]
 _D = 6.35e-3  # [m] the paper's default ball diameter and plate thickness (1/4 in)
@@ -25,6 +25,49 @@ def _domain(key):
 
 def _feedthrough(name, key, unit, description, vtype="Real"):
     return output(name, key, unit, description, vtype=vtype, feedthrough=True)
+
+
+#: The materials a body can be given by name: code 0 "custom" (the body's numeric parameters), then
+#: every preset of restitution.MATERIALS (aliases excluded), in its order.
+PRESETS = tuple(key for key in MATERIALS if key not in ALIASES)
+MATERIAL_CHOICES = ("custom", *PRESETS)
+#: The material properties a preset sets: (FMU suffix, unit, what it is)
+MATERIAL_PROPERTIES = (("E", "Pa", "elastic modulus"), ("nu", "1", "Poisson's ratio"),
+                       ("Sy", "Pa", "yield strength"), ("rho", "kg/m3", "density"))
+#: The selectors: FMU name -> the body whose parameters they replace
+MATERIAL_SELECTORS = {"sphere.material": "sphere", "plate.material": "plate"}
+
+
+def _material(body, default_text):
+    codes = ", ".join(f"{code} = {word}" for code, word in enumerate(MATERIAL_CHOICES))
+    return parameter(
+        f"{body}.material", f"{body}_material", None, 0,
+        f"{body.capitalize()} material by name: custom (default) uses {body}.E, {body}.nu, {body}.Sy and {body}.rho "
+        f"as set ({default_text}); a preset uses its own values (docs/materials.md) and those four are ignored; "
+        f"{body}.used.* show the values used. Codes: {codes}",
+        vtype="Integer", choices=MATERIAL_CHOICES, first_code=0, enumeration="Material",
+        item_descriptions=("the body's own numeric parameters",
+                           *(f"{MATERIALS[k].name} ({MATERIALS[k].source})" for k in PRESETS)))
+
+
+def _used(body):
+    return [calculated_parameter(f"{body}.used.{prop}", f"{body}_{prop}", unit,
+                                 f"{body.capitalize()} {what} used: the preset's when {body}.material names one, "
+                                 f"else {body}.{prop}")
+            for prop, unit, what in MATERIAL_PROPERTIES]
+
+
+def resolve_materials(values: dict) -> dict:
+    """``values`` (FMU name -> value of the inputs and parameters) with each body's material properties
+    taken from its preset where ``<body>.material`` names one (code > 0): the values the model uses."""
+    out = dict(values)
+    for selector, body in MATERIAL_SELECTORS.items():
+        code = int(values[selector])
+        if code:
+            preset = MATERIALS[MATERIAL_CHOICES[code]]
+            for prop, _unit, _what in MATERIAL_PROPERTIES:
+                out[f"{body}.{prop}"] = float(getattr(preset, prop))
+    return out
 
 
 TABLE = Table("SpherePlateImpact", "Apparent coefficient of restitution of a sphere hitting a plate of finite "
@@ -97,7 +140,13 @@ TABLE = Table("SpherePlateImpact", "Apparent coefficient of restitution of a sph
     _feedthrough("zener.contact_ends", "contact_ends", None, "The sphere leaves the plate after a finite contact "
                  "time (false only for the linear method at lambda >= 2: e_ze = 0, tau0 and t_contact read 0)",
                  "Boolean"),
-))
+    # appended after the outputs so that the value references above stay as they were
+    _material("sphere", "default: S2 tool steel"),
+    _material("plate", "default: Al 6061"),
+    *_used("sphere"),
+    *_used("plate"),
+), constants={f"MATERIAL_{prop.upper()}": (math.nan, *(float(getattr(MATERIALS[k], prop)) for k in PRESETS))
+              for prop, _unit, _what in MATERIAL_PROPERTIES})
 
 
 def fmu_values(**package_values) -> dict:
