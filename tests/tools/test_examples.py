@@ -7,6 +7,7 @@ Nonlinear Dyn 2022, Sec. 6-7).
 """
 import importlib.util
 import math
+import re
 import sys
 from pathlib import Path
 from xml.etree import ElementTree as ET
@@ -238,25 +239,40 @@ def test_fig7_velocity_dependence(figures):
     assert all(p.stat().st_size > 10_000 for p in figures["png"].values())
 
 
-def _readme_block(after: str) -> str:
+
+def _readme_blocks() -> list[tuple[str, str]]:
+    """README's fenced blocks, in order: (language, text)."""
     text = (ROOT / "README.md").read_text(encoding="utf-8")
-    start = text.index("```python", text.index(after)) + len("```python")
-    return text[start:text.index("```", start)]
+    return [(m.group(1), m.group(2)) for m in re.finditer(r"(?ms)^```(\w*)\n(.*?)^```", text)]
 
 
 @pytest.mark.parametrize("implementation", ["python", "native"])
-def test_readme_fmpy_example_runs_and_chooses_materials_by_name(built_fmus, implementation):
-    """README's fmpy example, run as printed against a built FMU: the plate is brass by name, so the
-    modulus used is brass's 103 GPa (Table 3) and e is the package's for chrome steel on brass (the
-    native C physics agrees with the package to far better than 1e-9 on so well-conditioned a case)."""
+def test_readme_python_blocks_run_as_printed(built_fmus, implementation, capsys):
+    """Every Python block of README runs against a built FMU (its dist/ path replaced), and where a
+    text block follows it, prints exactly that. The fmpy example chooses the materials by name: the
+    plate is brass, so the modulus used is brass's 103 GPa (Table 3) and e is the package's for
+    chrome steel on brass (the native C physics agrees with the package to far better than 1e-9 on
+    so well-conditioned a case)."""
     fmu = built_fmus / ("SpherePlateImpact.fmu" if implementation == "python" else "native/SpherePlateImpact.fmu")
     if not fmu.is_file():
         pytest.skip(f"{fmu} not built here")
-    code = _readme_block("The FMU with fmpy:").replace('"dist/SpherePlateImpact.fmu"', repr(str(fmu)))
-    scope = {}
-    exec(compile(code, "README.md", "exec"), scope)
-    assert scope["plate_E"] == 103e9
-    expected = r.impact_between(r.Sphere(r.MATERIALS["chrome_steel"], 4.76e-3),
-                                r.Plate(r.MATERIALS["brass_260"], 3.18e-3), 2.3)
-    assert scope["e"] == pytest.approx(expected.e, rel=1e-9)
-    assert scope["v_rebound"] == pytest.approx(expected.v_rebound, rel=1e-9)
+    blocks = _readme_blocks()
+    ran = 0
+    for k, (language, code) in enumerate(blocks):
+        if language != "python":
+            continue
+        scope = {}
+        capsys.readouterr()
+        exec(compile(code.replace('"dist/SpherePlateImpact.fmu"', repr(str(fmu))), f"README.md block {k}", "exec"),
+             scope)
+        printed = capsys.readouterr().out
+        if k + 1 < len(blocks) and blocks[k + 1][0] == "text":
+            assert printed == blocks[k + 1][1], f"README block {k} prints:\n{printed}"
+        if "plate_E" in scope:  # the fmpy example
+            assert scope["plate_E"] == 103e9
+            expected = r.impact_between(r.Sphere(r.MATERIALS["chrome_steel"], 4.76e-3),
+                                        r.Plate(r.MATERIALS["brass_260"], 3.18e-3), 2.3)
+            assert scope["e"] == pytest.approx(expected.e, rel=1e-9)
+            assert scope["v_rebound"] == pytest.approx(expected.v_rebound, rel=1e-9)
+        ran += 1
+    assert ran >= 2
