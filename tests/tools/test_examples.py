@@ -276,3 +276,26 @@ def test_readme_python_blocks_run_as_printed(built_fmus, implementation, capsys)
             assert scope["v_rebound"] == pytest.approx(expected.v_rebound, rel=1e-9)
         ran += 1
     assert ran >= 2
+
+
+def test_the_demo_reuses_up_to_date_fmus_and_rebuilds_stale_ones(built_fmus, tmp_path, monkeypatch, capsys):
+    """The Quickstart demo runs the example without --fmu: FMUs built from the current sources are
+    used as they are (no build), a stale one (another recorded source hash) is rebuilt."""
+    import shutil
+
+    from restitution.fmu import build as fmu_build
+
+    script = (ROOT / "build_scripts" / "quickstart.sh").read_text()
+    demo = script[script.index("demo)"):script.index(";;", script.index("demo)"))]
+    assert "restitution.fmu build" not in demo and "examples/quickstart_bounce.py" in demo
+    dist = tmp_path / "dist"
+    shutil.copytree(built_fmus, dist)
+    builds = []
+    monkeypatch.setattr(fmu_build, "default_fmu_dir", lambda: dist)
+    monkeypatch.setattr(fmu_build, "build_all", lambda out, **kw: builds.append(out) or [])
+    bounces = _load("quickstart_bounce").run()
+    assert builds == [] and bounces.n_impacts > 3
+    assert f"FMU: {dist / 'SpherePlateImpact.fmu'}" in capsys.readouterr().out
+    monkeypatch.setattr(fmu_build, "source_hash", lambda model: "another")
+    _load("quickstart_bounce").run()
+    assert builds == [dist]
