@@ -12,6 +12,9 @@ Builds SpherePlateImpact.fmu from the working tree into a temporary directory, t
   37 columns (all inputs and outputs) and gathers them to this process, as ``run_sweep`` does by
   default. Worker start-up and the first FMU load are done before timing (reported apart).
 
+Then the goals (build_scripts/benchmarks/sweep_goals.py): sweep / model per case, serially and per
+Dask worker, and Parquet write / gather of the table.
+
 Scaling efficiency = rate(2 workers) / (2 x rate(1 worker)). Cost per case: wall time per case
 per worker (workers / rate), and CPU time per case, both inside the tasks (building the cases and
 evaluating them) and in all processes of the run (this client with the LocalCluster's scheduler,
@@ -128,6 +131,8 @@ def main(argv=None) -> int:
     parser.add_argument("--package-cases", type=int, default=480_000,
                         help="cases of the package sweeps (default 480000)")
     parser.add_argument("--repeats", type=int, default=3, help="runs of each measurement; the fastest counts")
+    parser.add_argument("--goal-cases", type=int, default=1_000_000,
+                        help="cases of the sweep / model and write / gather measurements (default 1000000)")
     args = parser.parse_args(argv)
 
     import dask
@@ -181,6 +186,13 @@ def main(argv=None) -> int:
             client.run(release_fmus)
     tmp.cleanup()
 
+    from sweep_goals import goal_lines, sweep_over_model, write_over_gather
+
+    goal_spec = sweep_spec(max(1, args.goal_cases // (2 * 500)), 500)
+    model = sweep_over_model(goal_spec, reps)
+    write = write_over_gather(model.pop("result"), model["cases"] // 100_000 or 1, reps)
+    print(f"sweep / model: {model['ratio']:.2f}x; Parquet write / gather: {write['parquet_s'] / write['gather_s']:.2f}x")
+
     load_after = os.getloadavg()[0]
     rate = {(r["path"], r["where"], r["workers"]): r["rate"] for r in rows}
     eff = {p: rate[(p, "Dask LocalCluster", 2)] / (2 * rate[(p, "Dask LocalCluster", 1)]) for p in ("package", "fmu")}
@@ -221,6 +233,10 @@ def main(argv=None) -> int:
         + "; loading the FMU into the workers (shipping it, extracting, instantiating) "
         + " / ".join(f"{r['startup']:.2f} s" for r in rows if r["path"] == "fmu" and r["startup"] is not None) + ".",
     ]
+    task_cpu = next(r["cpu"] for r in rows if r["path"] == "package" and r["workers"] == 1
+                    and r["where"] == "Dask LocalCluster")
+    lines += ["", "**Goals** (each ratio's two sides measured in this run):", "",
+              *goal_lines(model, write, cpu_eff, task_cpu)]
     table = "\n".join(lines)
     print()
     print(table)
