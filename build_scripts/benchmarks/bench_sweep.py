@@ -128,8 +128,8 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--no-write", action="store_true", help="print the table, leave docs/sweeps.md alone")
     parser.add_argument("--fmu-cases", type=int, default=24_000, help="cases of the FMU sweeps (default 24000)")
-    parser.add_argument("--package-cases", type=int, default=480_000,
-                        help="cases of the package sweeps (default 480000)")
+    parser.add_argument("--package-cases", type=int, default=4_800_000,
+                        help="cases of the package sweeps (default 4800000)")
     parser.add_argument("--repeats", type=int, default=3, help="runs of each measurement; the fastest counts")
     parser.add_argument("--goal-cases", type=int, default=1_000_000,
                         help="cases of the sweep / model and write / gather measurements (default 1000000)")

@@ -264,3 +264,15 @@ def test_a_few_values_of_one_input_are_drawn_as_curves(tmp_path, monkeypatch, fe
         sel = res.columns[few] == value
         assert np.array_equal(np.sort(line.get_xdata()), np.sort(res.columns[many][sel]))
         assert np.array_equal(np.sort(line.get_ydata()), np.sort(res.columns["e"][sel]))  # the data as computed
+
+
+def test_local_workers_keep_glibc_allocation_thresholds(cluster):
+    """The sweep's LocalCluster starts its workers without Dask's MALLOC_TRIM_THRESHOLD_ (which makes
+    glibc map and page-fault every large array afresh: twice the CPU time of a package chunk), and
+    leaves this process's environment and Dask's configuration as they were."""
+    import dask
+
+    got = cluster.run(lambda: os.environ.get("MALLOC_TRIM_THRESHOLD_"))
+    assert len(got) == 2 and set(got.values()) == {None}
+    assert os.environ.get("MALLOC_TRIM_THRESHOLD_") is None
+    assert "MALLOC_TRIM_THRESHOLD_" in dask.config.get("distributed.nanny.pre-spawn-environ")
