@@ -133,6 +133,9 @@ def main(argv=None) -> int:
     parser.add_argument("--repeats", type=int, default=3, help="runs of each measurement; the fastest counts")
     parser.add_argument("--goal-cases", type=int, default=1_000_000,
                         help="cases of the sweep / model and write / gather measurements (default 1000000)")
+    parser.add_argument("--streamed-cases", type=float, default=1e8,
+                        help="cases of the streamed run on a LocalCluster of 2 workers, run after one of a tenth "
+                             "of the size (default 1e8: about 2 minutes and 30 GB of temporary disk; 0 skips them)")
     args = parser.parse_args(argv)
 
     import dask
@@ -192,6 +195,25 @@ def main(argv=None) -> int:
     model = sweep_over_model(goal_spec, reps)
     write = write_over_gather(model.pop("result"), model["cases"] // 100_000 or 1, reps)
     print(f"sweep / model: {model['ratio']:.2f}x; Parquet write / gather: {write['parquet_s'] / write['gather_s']:.2f}x")
+    streamed = None
+    n_streamed = int(args.streamed_cases)
+    if n_streamed > 0:
+        import shutil
+
+        from sweep_goals import streamed_run
+
+        need = n_streamed * 300  # bytes on disk per case of the streamed parts, measured: 264
+        free = shutil.disk_usage(tempfile.gettempdir()).free
+        if free < 1.2 * need:
+            print(f"streamed run skipped: it needs about {need / 1e9:.0f} GB in {tempfile.gettempdir()}, "
+                  f"{free / 1e9:.0f} GB are free")
+        else:
+            streamed = []
+            for n in (n_streamed // 10, n_streamed):  # a tenth, then the whole: memory must not grow with n
+                with open_client("local", n_workers=2) as client, tempfile.TemporaryDirectory() as parts:
+                    streamed.append(streamed_run(sweep_spec(max(1, n // (2 * 1000)), 1000), client, Path(parts)))
+                print(f"streamed: {streamed[-1]['cases']:,} cases in {streamed[-1]['wall_s']:.0f} s, "
+                      f"peak memory {streamed[-1]['peak_gb']:.1f} GB")
 
     load_after = os.getloadavg()[0]
     rate = {(r["path"], r["where"], r["workers"]): r["rate"] for r in rows}
@@ -236,7 +258,7 @@ def main(argv=None) -> int:
     task_cpu = next(r["cpu"] for r in rows if r["path"] == "package" and r["workers"] == 1
                     and r["where"] == "Dask LocalCluster")
     lines += ["", "**Goals** (each ratio's two sides measured in this run):", "",
-              *goal_lines(model, write, cpu_eff, task_cpu)]
+              *goal_lines(model, write, cpu_eff, task_cpu, streamed)]
     table = "\n".join(lines)
     print()
     print(table)

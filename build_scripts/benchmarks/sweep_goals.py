@@ -4,7 +4,9 @@
   gathered) against :func:`restitution.impact` alone on the same cases' arrays, CPU time of this
   thread, best of ``repeats``;
 * write / gather: writing the table as Parquet (and as CSV) against gathering it, i.e. joining the
-  chunks' columns into one table (``restitution.sweep.table.assemble``), CPU time, best of ``repeats``.
+  chunks' columns into one table (``restitution.sweep.table.assemble``), CPU time, best of ``repeats``;
+* a streamed run: a big sweep on a LocalCluster, every chunk written to disk as it finishes: its rate
+  and the peak memory of all its processes.
 
 Ratios are the headline: both sides of each are measured in the same run on the same machine.
 """
@@ -73,7 +75,7 @@ def write_over_gather(result, n_chunks: int, repeats: int = 3) -> dict:
             "csv_s": csv_s, "csv_mb": csv_mb}
 
 
-def goal_lines(model: dict, write: dict, cpu_eff: dict, task_cpu_us: float) -> list[str]:
+def goal_lines(model: dict, write: dict, cpu_eff: dict, task_cpu_us: float, streamed: list | None = None) -> list[str]:
     """The Markdown table of the goals (issue: sweeps at the speed of the model)."""
     model_us = model["model_s"] / model["cases"] * 1e6
     rows = [
@@ -98,6 +100,71 @@ def goal_lines(model: dict, write: dict, cpu_eff: dict, task_cpu_us: float) -> l
         f"as Parquet {write['parquet_s']:.3f} s ({write['parquet_mb']:.0f} MB), as CSV {write['csv_s']:.2f} s "
         f"({write['csv_mb']:.0f} MB, {write['csv_s'] / write['gather_s']:.0f}x the gather): CSV stays available "
         f"for small tables and tools without Parquet.",
-        "- Not measured here yet: a 10^8-case streamed run on a LocalCluster (rate and peak memory).",
     ]
+    if not streamed:
+        lines.append("- The streamed runs were not part of this run (`--streamed-cases 0`, or too little free disk).")
+    else:
+        small, big = streamed[0], streamed[-1]
+        lines.append(
+            f"- Streamed run on a LocalCluster of 2 workers: {big['cases']:,} cases (the whole 37-column "
+            f"table) in {big['wall_s']:.0f} s, **{big['rate']:,.0f} cases/s**, each of its {big['chunks']:,} "
+            f"chunks written as Parquet when it finished and nothing gathered ({big['disk_gb']:.0f} GB on disk); "
+            f"peak memory of this process and the workers together **{big['peak_gb']:.1f} GB**, against "
+            f"{small['peak_gb']:.1f} GB for {small['cases']:,} cases in the same run. Interrupted, such a run "
+            f"resumes from the chunks on disk (`--resume`).")
     return lines
+
+
+class PeakMemory:
+    """Peak resident memory of this process and its children (the Dask workers), sampled every
+    ``interval`` seconds in a background thread while the block runs."""
+
+    def __init__(self, interval: float = 0.1):
+        self.interval = interval
+        self.peak = 0
+
+    def _sample(self) -> int:
+        import psutil
+
+        me = psutil.Process()
+        total = me.memory_info().rss
+        for child in me.children(recursive=True):
+            try:
+                total += child.memory_info().rss
+            except psutil.Error:
+                pass
+        return total
+
+    def __enter__(self):
+        import threading
+
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._run, daemon=True)
+        self._thread.start()
+        return self
+
+    def _run(self):
+        while not self._stop.is_set():
+            self.peak = max(self.peak, self._sample())
+            self._stop.wait(self.interval)
+
+    def __exit__(self, *exc):
+        self._stop.set()
+        self._thread.join()
+        self.peak = max(self.peak, self._sample())
+
+
+def streamed_run(spec, client, directory: Path) -> dict:
+    """A sweep of ``spec`` on ``client``'s cluster streamed to ``directory`` (every finished chunk
+    written as Parquet as it completes, nothing gathered): wall time, rate, peak memory of this
+    process and the workers, and the size on disk."""
+    from restitution.sweep import run_sweep
+
+    parts = Path(directory) / "parts"
+    with PeakMemory() as memory:
+        t0 = time.perf_counter()
+        result = run_sweep(spec, "package", scheduler=client, parts=parts, in_memory=False)
+        wall = time.perf_counter() - t0
+    disk = sum(p.stat().st_size for p in parts.rglob("*") if p.is_file())
+    return {"cases": spec.n_cases, "wall_s": wall, "rate": spec.n_cases / wall, "peak_gb": memory.peak / 1e9,
+            "disk_gb": disk / 1e9, "chunks": result.n_chunks}

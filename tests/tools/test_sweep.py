@@ -2,6 +2,7 @@
 against a serial run, the CLI on an existing scheduler, the table and the COR map."""
 import math
 import os
+import time
 import zipfile
 from xml.etree import ElementTree as ET
 
@@ -276,3 +277,27 @@ def test_local_workers_keep_glibc_allocation_thresholds(cluster):
     assert len(got) == 2 and set(got.values()) == {None}
     assert os.environ.get("MALLOC_TRIM_THRESHOLD_") is None
     assert "MALLOC_TRIM_THRESHOLD_" in dask.config.get("distributed.nanny.pre-spawn-environ")
+
+
+def test_a_dask_sweep_keeps_few_chunks_in_flight(cluster, monkeypatch):
+    """Chunks are submitted a few per worker at a time, the next when one is taken, so a sweep that
+    this process takes more slowly than the workers compute never holds more than that many chunks in
+    the cluster: memory does not grow with the sweep. Observed from the scheduler while this process
+    is made slow at taking each chunk; the table is the serial one."""
+    from restitution.sweep import run as sweep_run
+
+    seen = []
+    original = sweep_run._Run.finished
+
+    def slow_finished(self, a, b, part):
+        seen.append(cluster.run_on_scheduler(lambda dask_scheduler: sum(
+            1 for key in dask_scheduler.tasks if "_run_chunk" in str(key))))
+        time.sleep(0.02)
+        original(self, a, b, part)
+
+    monkeypatch.setattr(sweep_run._Run, "finished", slow_finished)
+    spec = SweepSpec(grid={"v_approach": {"geomspace": [0.1, 10.0, 400]}})
+    result = run_sweep(spec, "package", scheduler=cluster, chunk_size=10)
+    assert len(seen) == 40 and max(seen) <= sweep_run.IN_FLIGHT_PER_WORKER * 2
+    expected = run_sweep(spec, "package", scheduler="serial")
+    assert np.array_equal(result.columns["e"], expected.columns["e"])

@@ -50,6 +50,11 @@ class SweepInterrupted(KeyboardInterrupt):
         self.missing = missing
 
 
+#: Chunks submitted per worker at a time in a Dask run: one computing, one waiting, so a worker never
+#: idles while this process takes a result, and memory does not grow with the sweep.
+IN_FLIGHT_PER_WORKER = 2
+
+
 def _run_chunk(start: int, stop: int, spec: SweepSpec, backend: Backend, payload=None, keep=None):
     cpu = time.thread_time()
     cases = spec.cases(start, stop)
@@ -141,7 +146,7 @@ def run_sweep(spec: SweepSpec | dict, backend: str | Backend = "package", *, fmu
         todo = [(a, b) for a, b in chunks if a not in run.done]
         bar = _Progress(len(chunks), progress, "dask")
         bar.update(len(run.done))
-        futures = []
+        futures = {}  # in flight: key -> future
         payload = None
         try:
             payload = backend.payload()
@@ -149,22 +154,39 @@ def run_sweep(spec: SweepSpec | dict, backend: str | Backend = "package", *, fmu
                 payload = client.scatter([payload], broadcast=True, hash=False)[0]
             from distributed import as_completed
 
-            futures = client.map(_run_chunk, [a for a, _ in todo], [b for _, b in todo],
-                                 spec=spec, backend=backend, payload=payload, keep=keep, pure=False)
-            bounds = {f.key: ab for f, ab in zip(futures, todo)}
-            for future in as_completed(futures):
-                a, b = bounds[future.key]
+            # At most IN_FLIGHT_PER_WORKER chunks per worker are submitted at a time, the next one when
+            # one is taken: finished chunks wait in the workers' memory until this process takes them,
+            # so with every chunk submitted at once a sweep that this process writes more slowly than
+            # the workers compute held its whole table in the workers (10^8 cases: 16 GB).
+            pending = iter(todo)
+            bounds = {}
+            finished = as_completed()
+
+            def submit_next():
+                ab = next(pending, None)
+                if ab is not None:
+                    future = client.submit(_run_chunk, *ab, spec=spec, backend=backend, payload=payload,
+                                           keep=keep, pure=False)
+                    futures[future.key], bounds[future.key] = future, ab
+                    finished.add(future)
+
+            for _ in range(IN_FLIGHT_PER_WORKER * workers):
+                submit_next()
+            for future in finished:
+                a, b = bounds.pop(future.key)
                 run.finished(a, b, future.result())
+                futures.pop(future.key)
                 future.release()
+                submit_next()
                 bar.update(len(run.done))
         except KeyboardInterrupt:
             bar.close(len(run.done))
             with contextlib.suppress(Exception):
-                client.cancel(futures)
+                client.cancel(list(futures.values()))
             raise run.interrupted() from None
         finally:
             with contextlib.suppress(Exception):
-                client.cancel(futures)
+                client.cancel(list(futures.values()))
             if isinstance(backend, FmuBackend) and release:
                 with contextlib.suppress(Exception):
                     client.run(release_fmus)  # an instance still busy with a cancelled chunk is freed after it
