@@ -255,10 +255,10 @@ def main(argv=None) -> int:
         + "; loading the FMU into the workers (shipping it, extracting, instantiating) "
         + " / ".join(f"{r['startup']:.2f} s" for r in rows if r["path"] == "fmu" and r["startup"] is not None) + ".",
     ]
-    task_cpu = next(r["cpu"] for r in rows if r["path"] == "package" and r["workers"] == 1
-                    and r["where"] == "Dask LocalCluster")
+    one_worker = next(r for r in rows if r["path"] == "package" and r["workers"] == 1 and r["where"] == "Dask LocalCluster")
+    task_cpu, dask_gather = one_worker["cpu"], one_worker["total_cpu"] - one_worker["cpu"]
     lines += ["", "**Goals** (each ratio's two sides measured in this run):", "",
-              *goal_lines(model, write, cpu_eff, task_cpu, streamed)]
+              *goal_lines(model, write, cpu_eff, task_cpu, streamed, dask_gather)]
     table = "\n".join(lines)
     print()
     print(table)

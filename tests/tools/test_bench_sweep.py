@@ -25,7 +25,7 @@ def test_goal_measurements_run_and_report_every_goal():
     model = sweep_over_model(SPEC, repeats=1)
     write = write_over_gather(model.pop("result"), 3, repeats=1)
     assert model["cases"] == 1200 and all(math.isfinite(x) and x > 0 for x in (model["ratio"], write["parquet_s"]))
-    text = "\n".join(goal_lines(model, write, {"package": 0.97}, task_cpu_us=1.0))
+    text = "\n".join(goal_lines(model, write, {"package": 0.97}, task_cpu_us=1.0, dask_gather_us=0.5))
     assert "streamed runs were not part" in text
     for goal in ("sweep / model per case, serial", "per Dask worker", "Parquet write / gather", "1 worker / 2 workers"):
         assert goal in text
