@@ -218,3 +218,25 @@ def test_the_slaves_own_states_are_validated(tmp_path):
         assert len(slave.log_queue) == n + 1 and slave.log_queue[-1].status == 3, bad
     slave._set_fmu_state(SpherePlateImpact._fmu_state_from_bytes(good))
     assert slave._values["plate.t"] == 6.35e-3
+
+
+def test_one_pass_reads_equal_the_getters_whatever_the_request(impact_fmu):
+    """get_real/get_boolean keep the reader of the last request: any sequence of requests (repeated,
+    changed, one variable, none, mixed with an input) gives what pythonfmu's getter per variable gives."""
+    from pythonfmu import Boolean, Real
+    from sphere_plate_impact_slave import SpherePlateImpact
+
+    slave = SpherePlateImpact(instance_name="direct")
+    by_name = {v.name: vr for vr, v in slave.vars.items()}
+    outputs = {vr: v for vr, v in slave.vars.items() if v.causality.name == "output"}
+    reals = [vr for vr, v in outputs.items() if isinstance(v, Real)]
+    bools = [vr for vr, v in outputs.items() if isinstance(v, Boolean)]
+    assert len(reals) == 12 and len(bools) == 7
+    requests = {"get_real": [reals, reals, reals[:1], [], reals[::-1], [by_name["v_approach"], reals[0]], reals],
+                "get_boolean": [bools, bools, bools[2:3], [], bools[::-1], bools]}
+    for v in (0.4, 2.3, 0.4):
+        slave.vars[by_name["v_approach"]].setter(v)
+        for method, lists in requests.items():
+            for vrs in lists:
+                got = getattr(slave, method)(list(vrs))
+                assert got == [slave.vars[vr].getter() for vr in vrs], (method, vrs)

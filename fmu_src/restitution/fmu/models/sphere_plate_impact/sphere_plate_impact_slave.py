@@ -20,6 +20,7 @@ a module name clash in one process.
 from __future__ import annotations
 
 import math
+import operator
 import os
 import sys
 
@@ -41,6 +42,8 @@ from restitution_slave_support import (checked_setter, restore_state, state_chec
 
 #: FMU name of each Real output, by ImpactResult key
 _REAL_OUTPUTS = {v.key: v.name for v in TABLE.outputs if v.type == "Real"}
+# one C call for the step's finiteness check instead of a Python loop over the outputs
+_real_output_values = operator.itemgetter(*_REAL_OUTPUTS)
 #: impact() without its unit layer: the FMU's values are SI floats
 _impact_si = si_only(impact)
 
@@ -55,8 +58,7 @@ def nonfinite_outputs(outputs: dict) -> list[str]:
     """The Real outputs that are NaN or infinite (``name = value`` texts). Every output is finite
     (``outputs`` as :func:`restitution.model.published` gives them): anything else is an evaluation
     failure."""
-    values = [outputs[key] for key in _REAL_OUTPUTS]
-    if math.isfinite(sum(values)):  # the usual case, one C loop (a NaN or inf, or an overflow, falls through)
+    if math.isfinite(sum(_real_output_values(outputs))):  # the usual case, one C loop (a NaN or inf, or an overflow, falls through)
         return []
     return [f"{name} = {outputs[key]!r}" for key, name in _REAL_OUTPUTS.items() if not math.isfinite(outputs[key])]
 
@@ -76,6 +78,7 @@ class SpherePlateImpact(Fmi2Slave):
         self._used = None  # the parameters with each body's material preset applied, when a parameter changed
         self._failure = None  # message of the last evaluation that raised
         self._output_keys = {}  # (Real|Boolean, value reference) -> ImpactResult key, for get_real/get_boolean
+        self._last_read = {"Real": (None, None), "Boolean": (None, None)}  # type -> (vrs, reader) of the last get
         for var in TABLE:
             kind = {"Real": Real, "Integer": Integer, "Boolean": Boolean}[var.type]
             variability = getattr(Fmi2Variability, var.variability)
@@ -134,20 +137,46 @@ class SpherePlateImpact(Fmi2Slave):
     # getter checks the cache); for outputs only, evaluate once and read them in one pass. The
     # values are those of the getters: NaN (Real) or False (Boolean) while the outputs are invalid.
     # Requests that include inputs or parameters take pythonfmu's path, with its checks.
+    # A host asks for the same list step after step: the reader of the last list is kept, so a
+    # repeated request costs one list comparison instead of a lookup per value reference.
     def get_real(self, vrs):
-        return self._get_outputs("Real", vrs, math.nan, super().get_real)
+        last_vrs, read = self._last_read["Real"]
+        if vrs != last_vrs:
+            read = self._remember_reader("Real", vrs)
+        if read is None:
+            return super().get_real(vrs)
+        outputs = self._evaluate()
+        return read(outputs) if outputs is not None else [math.nan] * len(vrs)
 
     def get_boolean(self, vrs):
-        return self._get_outputs("Boolean", vrs, False, super().get_boolean)
+        last_vrs, read = self._last_read["Boolean"]
+        if vrs != last_vrs:
+            read = self._remember_reader("Boolean", vrs)
+        if read is None:
+            return super().get_boolean(vrs)
+        outputs = self._evaluate()
+        return read(outputs) if outputs is not None else [False] * len(vrs)
 
-    def _get_outputs(self, vtype, vrs, invalid_value, general_get):
+    def _remember_reader(self, vtype, vrs):
+        """outputs -> the list of values of ``vrs``, or None when ``vrs`` names anything but outputs
+        of type ``vtype``; kept as the reader of ``vtype``'s last request."""
         keys = self._output_keys[vtype]
         try:
             names = [keys[vr] for vr in vrs]
         except KeyError:
-            return general_get(vrs)
-        outputs = self._evaluate()
-        return [outputs[k] for k in names] if outputs is not None else [invalid_value] * len(names)
+            names = None
+        if names is None:
+            read = None
+        elif len(names) < 2:  # itemgetter of one key gives the value itself, of none is an error
+            def read(outputs):
+                return [outputs[name] for name in names]
+        else:
+            values = operator.itemgetter(*names)
+
+            def read(outputs):
+                return list(values(outputs))
+        self._last_read[vtype] = (list(vrs), read)
+        return read
 
     # --- evaluation --------------------------------------------------------------------
     def _evaluate(self):
