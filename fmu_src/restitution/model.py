@@ -18,16 +18,16 @@ from .fusion import apparent_restitution, mass_ratio
 from .jgm import restitution_e44, restitution_e45, vstar_in_fit_range
 from .quantities import si_only, with_units
 from .validation import check_choice, check_nonnegative, check_poisson, check_positive
-from .zener import (TAU0_HERTZ, ZENER_METHODS, lambda_in_studied_range, zener_linear, zener_paper_fit,
-                    zener_solution)
+from .zener import (TAU0_HERTZ, ZENER_METHODS, lambda_from_terms, lambda_in_studied_range, lambda_material_terms,
+                    zener_linear, zener_paper_fit, zener_solution)
 
 # The pipeline passes SI numbers it has checked: it calls the equations without their unit layer
 # (restitution.quantities), which would cost more than the equations on the scalar path.
 (critical_interference, critical_load, critical_pressure, critical_velocity, effective_modulus, sphere_mass,
  yield_strain) = map(si_only, (jgm.critical_interference, jgm.critical_load, jgm.critical_pressure,
                                jgm.critical_velocity, jgm.effective_modulus, jgm.sphere_mass, jgm.yield_strain))
-(contact_duration, hertz_stiffness, inelasticity_parameter, time_scale) = map(
-    si_only, (zener.contact_duration, zener.hertz_stiffness, zener.inelasticity_parameter, zener.time_scale))
+(contact_duration, hertz_stiffness, time_scale) = map(
+    si_only, (zener.contact_duration, zener.hertz_stiffness, zener.time_scale))
 equivalent_plate_mass, velocities_after_impact = map(si_only, (fusion.equivalent_plate_mass,
                                                               fusion.velocities_after_impact))
 
@@ -162,6 +162,8 @@ def published(values: dict) -> dict:
 
 
 def _mode(name, value):
+    if value.__class__ is str and value in EFFECT_MODES:  # a word, the usual case: nothing to convert
+        return value
     if isinstance(value, (int, np.integer)) and not isinstance(value, bool):
         if not 0 <= value < len(EFFECT_MODES):
             raise ValueError(f"{name} = {value!r} is not one of 0 = off, 1 = on, 2 = auto")
@@ -238,8 +240,8 @@ def _pipeline(v, params, scalar, restitution_model, zener_method, plasticity, pl
 
     # --- JGM, Eqs. (1)-(8)
     material_terms = _material_terms_cached if scalar else _material_terms
-    E_prime, eps_y, m_a, V_c, k = material_terms(sphere_E, sphere_nu, sphere_Sy, sphere_rho, sphere_d,
-                                                 plate_E, plate_nu, plate_Sy)
+    E_prime, eps_y, m_a, V_c, k, wave_speed, density_factor, modulus_factor = material_terms(
+        sphere_E, sphere_nu, sphere_Sy, sphere_rho, sphere_d, plate_E, plate_nu, plate_Sy, plate_rho)
     V_star = v / V_c
     if plasticity == "off":
         e_ep = 1.0
@@ -250,8 +252,7 @@ def _pipeline(v, params, scalar, restitution_model, zener_method, plasticity, pl
             e_ep = where(1.0 - e_ep < effect_tolerance, 1.0, e_ep)
 
     # --- Zener, Eqs. (9)-(13a)
-    lam = inelasticity_parameter(v, sphere_E, sphere_nu, sphere_rho, sphere_d, plate_E, plate_nu, plate_rho,
-                                 plate_t)
+    lam = lambda_from_terms(v, sphere_d, plate_t, wave_speed, density_factor, modulus_factor)  # Eq. (12)
     if plate_waves == "auto":
         needed = ZENER_SLOPE_BOUND * lam >= effect_tolerance
         skipped_tau0 = _TAU0_AT_LAMBDA0[zener_method]
@@ -308,16 +309,19 @@ def _own_array(x, shape, dtype):
     return np.broadcast_to(x, shape).astype(dtype)
 
 
-def _material_terms(sphere_E, sphere_nu, sphere_Sy, sphere_rho, sphere_d, plate_E, plate_nu, plate_Sy):
-    """What depends on the materials only: (E' [Pa], eps_y [1], m_a [kg], V_c [m/s], k [N/m^1.5]),
-    Eqs. (1)-(6) and the Hertz stiffness of Eq. (9)."""
+def _material_terms(sphere_E, sphere_nu, sphere_Sy, sphere_rho, sphere_d, plate_E, plate_nu, plate_Sy,
+                    plate_rho):
+    """What depends on the materials only: (E' [Pa], eps_y [1], m_a [kg], V_c [m/s], k [N/m^1.5],
+    then the material factors of lambda, :func:`restitution.zener.lambda_material_terms`),
+    Eqs. (1)-(6), the Hertz stiffness of Eq. (9) and part of Eq. (12)."""
     E_prime = effective_modulus(sphere_E, sphere_nu, plate_E, plate_nu)
     CSy = critical_pressure(sphere_nu, sphere_Sy, plate_nu, plate_Sy)
     eps_y = yield_strain(E_prime, sphere_nu, sphere_Sy, plate_nu, plate_Sy)
     R = 0.5 * sphere_d
     m_a = sphere_mass(sphere_rho, sphere_d)
     V_c = critical_velocity(critical_interference(CSy, E_prime, R), critical_load(CSy, E_prime, R), m_a)
-    return E_prime, eps_y, m_a, V_c, hertz_stiffness(E_prime, sphere_d)
+    return (E_prime, eps_y, m_a, V_c, hertz_stiffness(E_prime, sphere_d),
+            *lambda_material_terms(sphere_E, sphere_nu, sphere_rho, plate_E, plate_nu, plate_rho))
 
 
 #: :func:`_material_terms` memoised for Python floats (a pure function): a co-simulation or a

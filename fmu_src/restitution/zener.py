@@ -49,11 +49,25 @@ def inelasticity_parameter(v0, E_a, nu_a, rho_a, d, E_b, nu_b, rho_b, t):
     with v0 the impact speed [m/s], d the sphere diameter [m], t = 2h the plate thickness [m].
     It depends on t/d only, not on t and d separately.
     """
+    return lambda_from_terms(v0, d, t, *lambda_material_terms(E_a, nu_a, rho_a, E_b, nu_b, rho_b))
+
+
+def lambda_material_terms(E_a, nu_a, rho_a, E_b, nu_b, rho_b):
+    """The factors of Eq. (12) that depend on the materials only, in SI: (v' [m/s],
+    (rho_a/rho_b)^(3/5), (E_a'/(E_a' + E_b'))^(2/5)). Split from the speed and geometry so that the
+    model computes them once per pair of materials (:func:`restitution.model._material_terms`)."""
     Ea = _reduced_modulus(E_a, nu_a)
     Eb = _reduced_modulus(E_b, nu_b)
+    return _plate_wave_speed(E_b, nu_b, rho_b), (rho_a / rho_b) ** 0.6, (Ea / (Ea + Eb)) ** 0.4
+
+
+def lambda_from_terms(v0, d, t, wave_speed, density_factor, modulus_factor):
+    """lambda [1], Eq. (12), from :func:`lambda_material_terms`'s factors, in SI. The product is taken
+    in the order of the printed equation, so it is the same number to the last bit whichever way the
+    factors were obtained."""
     r_over_t = 0.5 * d / t
-    return (_LAMBDA_PREFACTOR * r_over_t * r_over_t * (v0 / _plate_wave_speed(E_b, nu_b, rho_b)) ** 0.2
-            * (rho_a / rho_b) ** 0.6 * (Ea / (Ea + Eb)) ** 0.4)
+    return (_LAMBDA_PREFACTOR * r_over_t * r_over_t * (v0 / wave_speed) ** 0.2
+            * density_factor * modulus_factor)
 
 
 _LAMBDA_PREFACTOR = math.pi ** 0.6 / math.sqrt(3.0)
