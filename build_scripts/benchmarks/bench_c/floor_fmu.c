@@ -5,45 +5,45 @@
 #include "rst_SpherePlateImpact_interface.h" /* generated: restitution.fmu.interface.c_header */
 #include "rst_model_info.h"                  /* generated: identifier and GUID of modelDescription.xml */
 
-static fmi2Status instantiate(rst_instance *inst, const char *resource_dir, fmi2Boolean visible)
+static rst_status instantiate(rst_instance *inst, const char *resource_dir, int visible)
 {
     (void)inst, (void)resource_dir, (void)visible;
-    return fmi2OK;
+    return RST_OK;
 }
 
-static fmi2Status accept(rst_instance *inst, const rst_variable *var, double value)
+static rst_status accept(rst_instance *inst, const rst_variable *var, double value)
 {
     (void)inst, (void)var, (void)value;
-    return fmi2OK;
+    return RST_OK;
 }
 
-static fmi2Status set(rst_instance *inst, rst_type type, const fmi2ValueReference vr[], size_t n,
+static rst_status set(rst_instance *inst, rst_type type, const rst_vr vr[], size_t n,
                       const double values[])
 {
     (void)inst, (void)type, (void)vr, (void)n, (void)values;
-    return fmi2OK;
+    return RST_OK;
 }
 
-static fmi2Status nothing(rst_instance *inst)
+static rst_status nothing(rst_instance *inst)
 {
     (void)inst;
-    return fmi2OK;
+    return RST_OK;
 }
 
-static fmi2Status get_outputs(rst_instance *inst, rst_type type, const fmi2ValueReference vr[], size_t n,
+static rst_status get_outputs(rst_instance *inst, rst_type type, const rst_vr vr[], size_t n,
                               double values[])
 {
     size_t i;
     (void)inst, (void)vr;
     for (i = 0; i < n; i++)
         values[i] = type == RST_BOOLEAN ? 1.0 : 0.5;
-    return fmi2OK;
+    return RST_OK;
 }
 
-static fmi2Status do_step(rst_instance *inst, double t, double h)
+static rst_status do_step(rst_instance *inst, double t, double h)
 {
     (void)inst, (void)t, (void)h;
-    return fmi2OK;
+    return RST_OK;
 }
 
 const rst_model RST_MODEL = {

@@ -36,6 +36,7 @@ from ..about import AUTHOR, COPYRIGHT, LICENSE, VERSION
 from .documentation import license_files
 from .models import FOLDERS, SLAVE_SUPPORT, slave_script, table
 from .sources import BUILD_INFO, PACKAGE, bundle_filter, recorded_source_hash, source_hash
+from .table import UNITS
 
 #: FMU model identifier -> pythonfmu slave script (shipped with the package, in the model's folder).
 FMUS = {model: slave_script(model) for model in FOLDERS}
@@ -44,18 +45,6 @@ FMUS = {model: slave_script(model) for model in FOLDERS}
 class BuildError(RuntimeError):
     """The FMU cannot be built here (a one-line reason for the user: no pythonfmu, unwritable --out, ...)."""
 
-
-#: SI base-unit exponents of every unit the FMUs use.
-UNITS = {
-    "1": {},
-    "m": {"m": 1},
-    "s": {"s": 1},
-    "kg": {"kg": 1},
-    "m/s": {"m": 1, "s": -1},
-    "m/s2": {"m": 1, "s": -2},
-    "Pa": {"kg": 1, "m": -1, "s": -2},
-    "kg/m3": {"kg": 1, "m": -3},
-}
 
 PARAMETER_CAUSALITIES = ("parameter", "input")
 

@@ -42,10 +42,11 @@ from pathlib import Path
 from typing import Iterable, Optional, Sequence
 from xml.etree import ElementTree
 
-FRONT = Path(__file__).resolve().parent / "cfront"
-GUARD = Path(__file__).resolve().parent / "pythonfmu_guard"
+from restitution.fmu.sources import FRONT, GUARD, front_files
+
 #: The guard's C sources: the front, then the guard's backend (forwarding to pythonfmu) and Python loader.
-GUARD_SOURCES = (*sorted(FRONT.glob("*.c")), GUARD / "pythonfmu_backend.c", GUARD / "python_loader.c")
+GUARD_SOURCES = (*(p for p in front_files("2.0") if p.suffix == ".c"), GUARD / "pythonfmu_backend.c",
+                 GUARD / "python_loader.c")
 CONFIG_NAME = "python_env.txt"  # must match PYLOADER_CONFIG_NAME in python_loader.c
 REAL_SUFFIX = "_pythonfmu"
 

@@ -28,16 +28,21 @@ from xml.etree import ElementTree as ET
 
 from .compile import CFLAGS, PHYSICS_SOURCES, prepare_sources
 from .documentation import license_files
-from .interface import c_header, model_info_header
+from . import model_description3
+from .interface import c_header, model_info, model_info_header
 from .models import FOLDERS, native_sources
+from . import sources
 from .sources import BUILD_INFO, FRONT, PHYSICS_C, native_source_hash
 
 #: The models with a native backend (every one).
 BACKENDS = tuple(FOLDERS)
 #: Models whose backend calls the impact physics (rst_physics.c and the generated Zener table).
 PHYSICS_MODELS = {"SpherePlateImpact"}
-#: The FMI 2.0 headers fmpy ships (used at build time only; not copied into the FMU: FMI 2.0 hosts bring them).
-FMI2_HEADERS = ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h")
+#: The FMI headers fmpy ships, by FMI version (used at build time only; not copied into the FMU: hosts
+#: bring them).
+FMI_HEADERS = {"2.0": ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h"),
+               "3.0": ("fmi3Functions.h", "fmi3FunctionTypes.h", "fmi3PlatformTypes.h")}
+FMI2_HEADERS = FMI_HEADERS["2.0"]
 INTERFACE_HEADER = "rst_{model}_interface.h"
 MODEL_INFO_HEADER = "rst_model_info.h"
 COMPILERS = {  # platform folder -> (compiler, extra flags, binary suffix)
@@ -45,6 +50,11 @@ COMPILERS = {  # platform folder -> (compiler, extra flags, binary suffix)
     "linux64": ("gcc", ("-fPIC", "-fvisibility=hidden", "-pthread"), ".so"),
     "win64": ("x86_64-w64-mingw32-gcc", ("-static", "-static-libgcc"), ".dll"),
 }
+#: The binaries/ folder of each platform, by FMI version (FMI 3.0 names platforms by architecture-OS).
+PLATFORM_FOLDERS = {"2.0": {"linux64": "linux64", "win64": "win64"},
+                    "3.0": {"linux64": "x86_64-linux", "win64": "x86_64-windows"}}
+#: Where the FMUs of each FMI version go, below the build's output directory.
+VERSION_DIRS = {"2.0": "native", "3.0": "fmi3"}
 GENERATION_TOOL = "restitution native build (C99 front + native physics)"
 
 
@@ -52,29 +62,35 @@ class NativeBuildSkipped(RuntimeError):
     """The native FMU cannot be built here; the message says why."""
 
 
-def fmi2_include_dir() -> Path:
-    """fmpy's copy of the FMI 2.0 C headers."""
+def fmi_include_dir(fmi_version: str = "2.0") -> Path:
+    """fmpy's copy of the FMI C headers of ``fmi_version``."""
     try:
         import fmpy
     except ImportError:
-        raise NativeBuildSkipped("fmpy is not installed (its FMI 2.0 headers are needed)") from None
+        raise NativeBuildSkipped(f"fmpy is not installed (its FMI {fmi_version} headers are needed)") from None
     path = Path(fmpy.__file__).resolve().parent / "c-code"
-    if not all((path / h).is_file() for h in FMI2_HEADERS):
-        raise NativeBuildSkipped(f"FMI 2.0 headers not found in {path}")
+    if not all((path / h).is_file() for h in FMI_HEADERS[fmi_version]):
+        raise NativeBuildSkipped(f"FMI {fmi_version} headers not found in {path}")
     return path
 
 
-def front_files() -> list[Path]:
-    """The C FMI front's sources (cfront/); NativeBuildSkipped where they are missing (an installed
-    package without its package data)."""
+def fmi2_include_dir() -> Path:
+    """fmpy's copy of the FMI 2.0 C headers."""
+    return fmi_include_dir("2.0")
+
+
+def front_files(fmi_version: str = "2.0") -> list[Path]:
+    """The C FMI front's sources for one FMI version (cfront/: the core and that version's layer);
+    NativeBuildSkipped where they are missing (an installed package without its package data)."""
     if not (FRONT / "rst_front.h").is_file():
         raise NativeBuildSkipped(f"the C FMI front is missing ({FRONT / 'rst_front.h'})")
-    return sorted(p for p in FRONT.iterdir() if p.suffix in (".c", ".h"))
+    return sources.front_files(fmi_version)
 
 
-def write_sources(model: str, directory: Path) -> list[str]:
-    """Every C file of ``model``'s native FMU into ``directory``; returns the .c files to compile."""
-    front = front_files()
+def write_sources(model: str, directory: Path, fmi_version: str = "2.0") -> list[str]:
+    """Every C file of ``model``'s native FMU of ``fmi_version`` into ``directory``; returns the .c files
+    to compile."""
+    front = front_files(fmi_version)
     needed = [PHYSICS_C / name for name in PHYSICS_SOURCES] if model in PHYSICS_MODELS else []
     missing = [str(path) for path in needed if not path.is_file()]
     if missing or not native_sources(model):  # an installed package without its C files (package-data)
@@ -118,15 +134,17 @@ def native_model_description(xml_text: str, c_files: list[str]) -> str:
 
 
 def compile_binary(model: str, sources: Path, c_files: list[str], platform: str, out: Path,
-                   extra_flags=()) -> Path:
-    """Compile ``out/binaries/<platform>/<model>.<so|dll>``; NativeBuildSkipped when the compiler is missing."""
+                   extra_flags=(), fmi_version: str = "2.0") -> Path:
+    """Compile ``out/binaries/<platform folder>/<model>.<so|dll>``; NativeBuildSkipped when the compiler
+    is missing."""
     cc, flags, suffix = COMPILERS[platform]
+    folder = PLATFORM_FOLDERS[fmi_version][platform]
     if shutil.which(cc) is None:
-        raise NativeBuildSkipped(f"{cc} not found: no binaries/{platform}"
+        raise NativeBuildSkipped(f"{cc} not found: no binaries/{folder}"
                                  + (" (Debian: apt-get install gcc-mingw-w64-x86-64)" if platform == "win64" else ""))
-    target = out / "binaries" / platform / f"{model}{suffix}"
+    target = out / "binaries" / folder / f"{model}{suffix}"
     target.parent.mkdir(parents=True, exist_ok=True)
-    cmd = [cc, *CFLAGS, *flags, *extra_flags, "-shared", f"-I{sources}", f"-I{fmi2_include_dir()}",
+    cmd = [cc, *CFLAGS, *flags, *extra_flags, "-shared", f"-I{sources}", f"-I{fmi_include_dir(fmi_version)}",
            "-o", str(target), *(str(sources / f) for f in c_files), "-lm"]
     done = subprocess.run(cmd, capture_output=True, text=True)
     if done.returncode != 0:
@@ -141,33 +159,41 @@ def _zip_dir(directory: Path, fmu: Path) -> None:
                 z.write(path, path.relative_to(directory).as_posix())
 
 
-def build_native_one(model: str, out_dir: Path, python_fmu: Path, log=None) -> Path:
-    """Build and validate ``out_dir/native/<model>.fmu`` beside the pythonfmu ``python_fmu``."""
+def build_native_one(model: str, out_dir: Path, python_fmu: Path, log=None, fmi_version: str = "2.0") -> Path:
+    """Build and validate ``out_dir/native/<model>.fmu`` (FMI 2.0) or ``out_dir/fmi3/<model>.fmu``
+    (FMI 3.0) beside the pythonfmu ``python_fmu``, whose GUID both carry (FMI 3.0: as the instantiation
+    token) and whose modelDescription the FMI 2.0 one reuses."""
     from fmpy.validation import validate_fmu
 
     log = log or (lambda message: print(message, file=sys.stderr))
-    front_files()  # before anything is written: no empty native/ where the front is missing
-    target_dir = Path(out_dir) / "native"
+    front_files(fmi_version)  # before anything is written: no empty folder where the front is missing
+    target_dir = Path(out_dir) / VERSION_DIRS[fmi_version]
     target_dir.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(prefix=f".{model}-native-", dir=target_dir) as tmp:
         stage = Path(tmp) / "fmu"
         sources = stage / "sources"
-        c_files = write_sources(model, sources)
+        c_files = write_sources(model, sources, fmi_version)
         if not Path(python_fmu).is_file():
-            raise NativeBuildSkipped(f"{python_fmu} missing: the native FMU takes its modelDescription from it")
+            raise NativeBuildSkipped(f"{python_fmu} missing: the native FMU takes its GUID from it")
         with zipfile.ZipFile(python_fmu) as z:
             xml = z.read("modelDescription.xml").decode("utf-8")
-        (stage / "modelDescription.xml").write_text(native_model_description(xml, c_files), encoding="utf-8")
+        if fmi_version == "2.0":
+            description = native_model_description(xml, c_files)
+        else:
+            description = model_description3.model_description(model, model_info(xml)[1])
+            (sources / "buildDescription.xml").write_text(model_description3.build_description(model, c_files),
+                                                          encoding="utf-8")
+        (stage / "modelDescription.xml").write_text(description, encoding="utf-8")
         (sources / MODEL_INFO_HEADER).write_text(model_info_header(xml), encoding="ascii")
         built = []
         for platform in COMPILERS:
             try:
-                built.append(compile_binary(model, sources, c_files, platform, stage))
+                built.append(compile_binary(model, sources, c_files, platform, stage, fmi_version=fmi_version))
             except NativeBuildSkipped as exc:
-                log(f"warning: native {model}.fmu: {exc}")
+                log(f"warning: native FMI {fmi_version} {model}.fmu: {exc}")
         if not built:
-            raise NativeBuildSkipped(f"no C compiler for any platform: native {model}.fmu not built")
-        info = {"model": model, "native": True, "source_hash": native_source_hash(model),
+            raise NativeBuildSkipped(f"no C compiler for any platform: native FMI {fmi_version} {model}.fmu not built")
+        info = {"model": model, "native": True, "fmi_version": fmi_version, "source_hash": native_source_hash(model),
                 "platforms": sorted(p.parent.name for p in built)}
         (stage / BUILD_INFO).parent.mkdir(parents=True, exist_ok=True)
         (stage / BUILD_INFO).write_text(json.dumps(info, indent=1), encoding="utf-8")
@@ -178,7 +204,7 @@ def build_native_one(model: str, out_dir: Path, python_fmu: Path, log=None) -> P
         _zip_dir(stage, fmu)
         problems = validate_fmu(str(fmu))
         if problems:
-            raise RuntimeError(f"native {model}.fmu failed fmpy validation: " + "; ".join(problems))
+            raise RuntimeError(f"native FMI {fmi_version} {model}.fmu failed fmpy validation: " + "; ".join(problems))
         mask = os.umask(0o022)
         os.umask(mask)
         os.chmod(fmu, 0o666 & ~mask)
@@ -188,13 +214,16 @@ def build_native_one(model: str, out_dir: Path, python_fmu: Path, log=None) -> P
 
 
 def build_native(out_dir: Path, log=None) -> list[Path]:
-    """Every native FMU there is a backend for, beside the pythonfmu ones already in ``out_dir``;
-    a model that cannot be built here is skipped with a message (the Python FMUs stay usable)."""
+    """Every native FMU there is a backend for, FMI 2.0 (``native/``) and FMI 3.0 (``fmi3/``), beside the
+    pythonfmu ones already in ``out_dir``; a model that cannot be built here is skipped with a message
+    (the Python FMUs stay usable)."""
     log = log or (lambda message: print(message, file=sys.stderr))
     built = []
-    for model in BACKENDS:
-        try:
-            built.append(build_native_one(model, out_dir, Path(out_dir) / f"{model}.fmu", log=log))
-        except NativeBuildSkipped as exc:
-            log(f"warning: native {model}.fmu not built: {exc}")
+    for fmi_version in VERSION_DIRS:
+        for model in BACKENDS:
+            try:
+                built.append(build_native_one(model, out_dir, Path(out_dir) / f"{model}.fmu", log=log,
+                                              fmi_version=fmi_version))
+            except NativeBuildSkipped as exc:
+                log(f"warning: native FMI {fmi_version} {model}.fmu not built: {exc}")
     return built

@@ -18,7 +18,7 @@ FRONT = Path(__file__).resolve().parent / "cfront"
 #: The hand-written C sources of the physics (the table header is generated, see :func:`prepare_sources`).
 PHYSICS_SOURCES = ("rst_physics.h", "rst_physics.c")
 TABLE_HEADER = "rst_zener_table.h"
-#: The front's header that prefixes every external name when FMI2_FUNCTION_PREFIX is defined.
+#: The front's header that prefixes every external name when FMI2_FUNCTION_PREFIX or FMI3_FUNCTION_PREFIX is defined.
 PREFIX_HEADER = "rst_prefix.h"
 #: C99, every warning an error; no contraction of a*b+c into an FMA, so the C rounds as the Python does.
 CFLAGS = ("-std=c99", "-O2", "-Wall", "-Wextra", "-Werror", "-pedantic", "-ffp-contract=off")

@@ -18,7 +18,7 @@ from .table import Variable
 
 #: The layout of the C row (``cfront/rst_variable.h``'s RST_VARIABLE_LAYOUT): the generated header
 #: refuses to compile against another.
-TABLE_VERSION = 2
+TABLE_VERSION = 3
 
 
 def variables(model: str) -> tuple[Variable, ...]:
@@ -153,7 +153,7 @@ def c_header(model: str, rows: list[Variable] | None = None) -> str:
     for v in rows:
         low, high, low_open, high_open = v.interval if v.interval else (0.0, 0.0, 0, 0)
         lines.append(
-            f"    {{{v.vr}, {_c_string(v.name)}, RST_{v.type.upper()}, RST_{v.causality.upper()}, "
+            f"    {{{v.vr}, {_c_string(v.name)}, RST_{v.type.upper()}, {int(v.is_enumeration)}, RST_{v.causality.upper()}, "
             f"RST_{v.variability.upper()}, {int(v.state)}, {_c_double(v.start)}, {_c_double(low)}, "
             f"{_c_double(high)}, {int(bool(low_open))}, {int(bool(high_open))}, {_c_string(v.allowed_text())}, "
             f"{_c_string(v.unit)}, {_c_string(v.description)}}},")

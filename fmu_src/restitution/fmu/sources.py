@@ -19,6 +19,10 @@ FRONT = FMU_DIR / "cfront"
 GUARD = FMU_DIR / "pythonfmu_guard"
 PHYSICS_C = FMU_DIR / "physics_c"
 
+#: The front's version layers (one per FMI version; a binary is built with one of them and the core,
+#: every other file of cfront/).
+FRONT_LAYERS = {"2.0": "rst_fmi2.c", "3.0": "rst_fmi3.c"}
+
 #: Where the build records what it was built from, inside the FMU.
 BUILD_INFO = "resources/build_info.json"
 
@@ -28,6 +32,12 @@ BUILD_INFO = "resources/build_info.json"
 BUNDLED_SUBDIRS = {"data"}
 #: Of fmu/, the slaves need only the interface tables (pure data): these files, and models/*/variables.py.
 BUNDLED_FMU_FILES = {"__init__.py", "table.py"}
+
+
+def front_files(fmi_version: str = "2.0") -> list[Path]:
+    """The C files of the front for one FMI version: the core and that version's layer."""
+    others = {name for version, name in FRONT_LAYERS.items() if version != fmi_version}
+    return sorted(p for p in FRONT.glob("*.[ch]") if p.name not in others)
 
 
 def bundle_filter(directory, names):
@@ -80,7 +90,7 @@ def native_source_hash(model: str) -> str:
     every C file and generator the native ``<model>.fmu`` is built from."""
     digest = hashlib.sha256(source_hash(model).encode())
     paths = (sorted(FRONT.glob("*.[ch]")) + sorted(PHYSICS_C.glob("*.[ch]")) + sorted(PHYSICS_C.glob("*.py"))
-             + native_sources(model) + [FMU_DIR / "build_native.py", FMU_DIR / "compile.py"])
+             + native_sources(model) + [FMU_DIR / name for name in ("build_native.py", "compile.py", "model_description3.py")])
     for path in paths:
         digest.update(path.name.encode() + b"\0" + path.read_bytes() + b"\0")
     return digest.hexdigest()

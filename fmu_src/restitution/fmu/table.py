@@ -15,6 +15,19 @@ __all__ = ["Variable", "Table", "parameter", "input_", "output", "local", "calcu
 
 CAUSALITIES = ("parameter", "input", "output", "local", "calculatedParameter")
 TYPES = ("Real", "Integer", "Boolean")
+#: SI base-unit exponents of every unit the tables use (unit string -> {base unit: exponent}; "1":
+#: dimensionless), which both modelDescriptions' <UnitDefinitions> declare. A new unit in a table needs
+#: its row here (the build fails with a KeyError otherwise).
+UNITS = {
+    "1": {},
+    "m": {"m": 1},
+    "s": {"s": 1},
+    "kg": {"kg": 1},
+    "m/s": {"m": 1, "s": -1},
+    "m/s2": {"m": 1, "s": -2},
+    "Pa": {"kg": 1, "m": -1, "s": -2},
+    "kg/m3": {"kg": 1, "m": -3},
+}
 
 
 @dataclass(frozen=True)
@@ -52,6 +65,12 @@ class Variable:
     def initial(self) -> str | None:
         """The ``initial`` attribute the modelDescription declares (outputs and locals are calculated)."""
         return "calculated" if self.causality in ("output", "local", "calculatedParameter") else None
+
+    @property
+    def is_enumeration(self) -> bool:
+        """An Integer whose values are named codes: FMI 3.0 declares it an Enumeration (FMI 2.0 an
+        Integer, or an Enumeration where ``enumeration`` names its type)."""
+        return self.choices is not None or self.enumeration is not None
 
     @property
     def codes(self) -> dict[str, int] | None:

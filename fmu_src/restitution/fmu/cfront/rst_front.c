@@ -1,12 +1,14 @@
-/* The FMI 2.0 co-simulation front: see rst_front.h. This file: the instance's life cycle, values
- * and steps (messages: rst_log.c; FMU states: rst_state.c).
+/* The front's core: see rst_front.h. This file: the instance's life cycle, values and steps, for every
+ * FMI version (messages: rst_log.c; FMU states: rst_state.c; each version's entry points: rst_fmi2.c,
+ * rst_fmi3.c).
  *
- * Which call is allowed in which mode follows the FMI 2.0 standard's co-simulation state table
- * (section 4.2.4). A call that is not allowed, or whose arguments are wrong, returns fmi2Error with a
- * log message and changes nothing: the instance stays in its mode and keeps its values (more
- * forgiving than the standard, which lets a master give up on an instance after any fmi2Error).
- * A backend that reports fmi2Error puts the instance into the error mode (fmi2Reset, fmi2SetFMUstate
- * or fmi2FreeInstance leave it); fmi2Fatal latches it for good.
+ * Which call is allowed in which mode follows the co-simulation state machine of FMI 2.0 (section
+ * 4.2.4), which FMI 3.0's restricts to the same transitions for an FMU without event mode,
+ * intermediate updates or configuration mode. A call that is not allowed, or whose arguments are
+ * wrong, returns an error with a log message and changes nothing: the instance stays in its mode and
+ * keeps its values (more forgiving than the standards, which let an importer give up on an instance
+ * after any error). A backend that reports RST_ERROR puts the instance into the error mode (reset,
+ * restoring an FMU state or freeing the instance leave it); RST_FATAL latches it for good.
  */
 #include "rst_front_internal.h"
 
@@ -15,9 +17,12 @@
 #include <stdio.h>
 #include <string.h>
 
-/* Relative tolerance of the doStep time check: a master's t differs from the previous t + h by a
+/* Relative tolerance of the step time check: an importer's t differs from the previous t + h by a
  * rounding or two; a skipped or repeated step differs by about h. */
 #define TIME_RTOL 1e-9
+/* Values converted per chunk on the stack; a longer set is converted in one allocated piece (all or
+ * nothing needs every value checked before any is stored). */
+#define CHUNK 64
 
 /* ------------------------------------------------------------------------------------------------ */
 /* Accessors for backends                                                                           */
@@ -27,16 +32,21 @@ void *rst_backend(rst_instance *inst) { return inst->backend; }
 const char *rst_instance_name(const rst_instance *inst) { return inst->name; }
 rst_mode rst_mode_of(const rst_instance *inst) { return inst->mode; }
 double rst_start_time(const rst_instance *inst) { return inst->has_start ? inst->start_time : 0.0; }
+const char *rst_fmi_prefix(const rst_instance *inst) { return inst->api->prefix; }
 
-static const char *mode_name(rst_mode mode)
+/* The mode as messages name it; `buffer` holds the text of the modes that name a function. */
+static const char *mode_name(const rst_instance *inst, rst_mode mode, char *buffer, size_t size)
 {
     switch (mode) {
-    case RST_INSTANTIATED: return "instantiated";
-    case RST_INITIALIZATION: return "initialization mode";
-    case RST_STEP_COMPLETE: return "step mode";
-    case RST_STEP_FAILED: return "step failed (after fmi2DoStep returned fmi2Discard)";
-    case RST_TERMINATED: return "terminated";
-    case RST_ERROR: return "error";
+    case RST_MODE_INSTANTIATED: return "instantiated";
+    case RST_MODE_INITIALIZATION: return "initialization mode";
+    case RST_MODE_STEP_COMPLETE: return "step mode";
+    case RST_MODE_STEP_FAILED:
+        snprintf(buffer, size, "step failed (after %sDoStep returned %sDiscard)", inst->api->prefix,
+                 inst->api->prefix);
+        return buffer;
+    case RST_MODE_TERMINATED: return "terminated";
+    case RST_MODE_ERROR: return "error";
     default: return "fatal error";
     }
 }
@@ -49,7 +59,7 @@ const char *front_type_name(rst_type type)
 /* ------------------------------------------------------------------------------------------------ */
 /* Entering and leaving a call                                                                      */
 /* ------------------------------------------------------------------------------------------------ */
-rst_instance *front_instance(fmi2Component c)
+rst_instance *front_instance(void *c)
 {
     rst_instance *inst = (rst_instance *)c;
     return (inst != NULL && inst->magic == RST_INSTANCE_MAGIC) ? inst : NULL;
@@ -80,26 +90,27 @@ void front_unlock(rst_instance *inst)
 /* Is `function` allowed in the instance's mode? Logs why not. */
 int front_allowed(rst_instance *inst, const char *function, unsigned int modes)
 {
-    if (inst->mode == RST_FATAL) {
-        rst_log(inst, fmi2Error, "%s: this instance reported fmi2Fatal earlier and cannot be used any more; "
-                "free it (fmi2FreeInstance)", function);
+    char buffer[80];
+    if (inst->mode == RST_MODE_FATAL) {
+        rst_log(inst, RST_ERROR, "%s: this instance reported %sFatal earlier and cannot be used any more; "
+                "free it (%sFreeInstance)", function, inst->api->prefix, inst->api->prefix);
         return 0;
     }
     if (!(modes & (unsigned int)inst->mode)) {
-        rst_log(inst, fmi2Error, "%s is not allowed in %s (FMI 2.0 co-simulation state machine)", function,
-                mode_name(inst->mode));
+        rst_log(inst, RST_ERROR, "%s is not allowed in %s (%s co-simulation state machine)", function,
+                mode_name(inst, inst->mode, buffer, sizeof buffer), inst->api->standard);
         return 0;
     }
     return 1;
 }
 
-/* A backend's answer: fmi2Error puts the instance into the error mode, fmi2Fatal latches it. */
-fmi2Status front_backend_status(rst_instance *inst, fmi2Status status)
+/* A backend's answer: RST_ERROR puts the instance into the error mode, RST_FATAL latches it. */
+rst_status front_backend_status(rst_instance *inst, rst_status status)
 {
-    if (status == fmi2Fatal)
-        inst->mode = RST_FATAL;
-    else if (status == fmi2Error)
-        inst->mode = RST_ERROR;
+    if (status == RST_FATAL)
+        inst->mode = RST_MODE_FATAL;
+    else if (status == RST_ERROR)
+        inst->mode = RST_MODE_ERROR;
     return status;
 }
 
@@ -137,252 +148,249 @@ int front_in_range(const rst_variable *var, double value)
     return 1;
 }
 
-/* May the host set `var` in the current mode? (FMI 2.0: inputs and parameters in instantiated and
+/* The access kind of a variable: its type, or Enumeration for an Integer with named codes. */
+static rst_access access_of(const rst_variable *var)
+{
+    if (var->type == RST_REAL)
+        return RST_AS_REAL;
+    if (var->type == RST_BOOLEAN)
+        return RST_AS_BOOLEAN;
+    return var->enumeration ? RST_AS_ENUMERATION : RST_AS_INTEGER;
+}
+
+/* The name the version gives an access kind (FMI 2.0: Real, Integer, Boolean; FMI 3.0: Float64, ...);
+ * of a set of kinds, the first. */
+static const char *access_name(const rst_instance *inst, unsigned int kinds)
+{
+    int i;
+    for (i = 0; i < 4; i++)
+        if (kinds & (1u << i))
+            return inst->api->type_names[i];
+    return "?";
+}
+
+/* Is `vr` the independent variable time (FMI 3.0)? */
+static int is_time(const rst_instance *inst, rst_vr vr)
+{
+    return inst->api->time_variable && vr == inst->model->n_variables;
+}
+
+/* The independent variable: the start time until the first step, then the end of the last step. */
+static double current_time(const rst_instance *inst)
+{
+    if (inst->mode == RST_MODE_INSTANTIATED || inst->mode == RST_MODE_INITIALIZATION)
+        return rst_start_time(inst);
+    return inst->last_time;
+}
+
+/* Is `vr` a variable of one of the `kinds` (time included)? Logs why not. */
+static int check_vr(rst_instance *inst, const char *function, rst_vr vr, unsigned int kinds)
+{
+    const rst_variable *var;
+    if (is_time(inst, vr)) {
+        if (kinds & RST_AS_REAL)
+            return 1;
+        rst_log(inst, RST_ERROR, "%s: time (value reference %u) is a %s variable, not %s", function, vr,
+                access_name(inst, RST_AS_REAL), access_name(inst, kinds));
+        return 0;
+    }
+    if (vr >= inst->model->n_variables) {
+        rst_log(inst, RST_ERROR, "%s: unknown value reference %u (this FMU has %u variables)", function, vr,
+                (unsigned int)(inst->model->n_variables + (inst->api->time_variable ? 1 : 0)));
+        return 0;
+    }
+    var = &inst->model->variables[vr];
+    if (!(kinds & (unsigned int)access_of(var))) {
+        rst_log(inst, RST_ERROR, "%s: %s (value reference %u) is a %s variable, not %s", function, var->name, vr,
+                access_name(inst, (unsigned int)access_of(var)), access_name(inst, kinds));
+        return 0;
+    }
+    return 1;
+}
+
+/* May the host set `var` in the current mode? (Inputs and parameters in instantiated and
  * initialization mode; in step mode inputs and tunable parameters only.) */
 static int settable(const rst_instance *inst, const rst_variable *var)
 {
     if (var->causality != RST_INPUT && var->causality != RST_PARAMETER)
         return 0;
-    if (inst->mode == RST_STEP_COMPLETE)
+    if (inst->mode == RST_MODE_STEP_COMPLETE)
         return var->causality == RST_INPUT || var->variability == RST_TUNABLE;
     return 1;
 }
 
 /* Checks one value the host wants to set; logs and returns 0 if it is refused. */
-static int check_set(rst_instance *inst, const char *function, fmi2ValueReference vr, rst_type type, double value)
+static int check_set(rst_instance *inst, const char *function, rst_vr vr, unsigned int kinds, double value)
 {
     const rst_variable *var;
-    char text[40];
-    if (vr >= inst->model->n_variables) {
-        rst_log(inst, fmi2Error, "%s: unknown value reference %u (this FMU has %u variables)", function, vr,
-                (unsigned int)inst->model->n_variables);
+    char text[40], buffer[80];
+    if (!check_vr(inst, function, vr, kinds))
+        return 0;
+    if (is_time(inst, vr)) {
+        rst_log(inst, RST_ERROR, "%s: time is the independent variable and cannot be set", function);
         return 0;
     }
     var = &inst->model->variables[vr];
-    if (var->type != type) {
-        rst_log(inst, fmi2Error, "%s: %s (value reference %u) is a %s variable, not %s", function, var->name, vr,
-                front_type_name(var->type), front_type_name(type));
-        return 0;
-    }
     if (!settable(inst, var)) {
         if (var->causality == RST_OUTPUT || var->causality == RST_LOCAL || var->causality == RST_CALCULATEDPARAMETER)
-            rst_log(inst, fmi2Error, "%s: %s is %s and cannot be set", function, var->name,
+            rst_log(inst, RST_ERROR, "%s: %s is %s and cannot be set", function, var->name,
                     var->causality == RST_OUTPUT  ? "an output"
                     : var->causality == RST_LOCAL ? "a local variable"
                                                   : "a calculated parameter");
         else
-            rst_log(inst, fmi2Error, "%s: %s is a fixed parameter and cannot be set in %s (only before "
-                    "fmi2ExitInitializationMode)", function, var->name, mode_name(inst->mode));
+            rst_log(inst, RST_ERROR, "%s: %s is a fixed parameter and cannot be set in %s (only before "
+                    "%sExitInitializationMode)", function, var->name,
+                    mode_name(inst, inst->mode, buffer, sizeof buffer), inst->api->prefix);
         return 0;
     }
     if (!front_in_range(var, value)) {
-        front_describe_value(type, value, text, sizeof text);
-        rst_log(inst, fmi2Error, "%s = %s is outside the allowed range: %s", var->name, text,
+        front_describe_value(var->type, value, text, sizeof text);
+        rst_log(inst, RST_ERROR, "%s = %s is outside the allowed range: %s", var->name, text,
                 var->range_text ? var->range_text : "finite");
         return 0;
     }
-    if (inst->model->accept != NULL && inst->model->accept(inst, var, value) != fmi2OK)
+    if (inst->model->accept != NULL && inst->model->accept(inst, var, value) != RST_OK)
         return 0;
     return 1;
 }
 
-static fmi2Status set_values(fmi2Component c, const char *function, rst_type type, const fmi2ValueReference vr[],
-                             size_t n, const double *values)
+/* The set of a call: every value checked, then all stored, or none (a rejected value leaves every
+ * variable as it was). The backend hears of the new values once per type. */
+static rst_status set_checked(rst_instance *inst, const char *function, unsigned int kinds, const rst_vr vr[],
+                              size_t n, const double *values)
 {
     size_t i;
-    fmi2Status status = fmi2OK;
-    ENTER(function, SET_MODES)
     for (i = 0; i < n; i++)
-        if (!check_set(inst, function, vr[i], type, values[i]))
-            LEAVE(fmi2Error); /* all or nothing: a rejected value leaves every variable as it was */
+        if (!check_set(inst, function, vr[i], kinds, values[i]))
+            return RST_ERROR;
     for (i = 0; i < n; i++)
         inst->store[vr[i]] = values[i];
-    if (inst->model->set != NULL)
-        status = front_backend_status(inst, inst->model->set(inst, type, vr, n, values));
+    if (inst->model->set == NULL || n == 0)
+        return RST_OK;
+    /* the kinds of one call are of one storage type (Integer and Enumeration are both integers) */
+    return front_backend_status(inst, inst->model->set(inst, inst->model->variables[vr[0]].type, vr, n, values));
+}
+
+static int check_counts(rst_instance *inst, const char *function, const rst_vr vr[], size_t n, const void *values,
+                        size_t n_values)
+{
+    if (n > 0 && (vr == NULL || values == NULL)) {
+        rst_log(inst, RST_ERROR, "%s: NULL value reference or value array for %u variables", function,
+                (unsigned int)n);
+        return 0;
+    }
+    if (n_values != n) {
+        rst_log(inst, RST_ERROR, "%s: %u values for %u value references (every variable here is a scalar: one "
+                "value each)", function, (unsigned int)n_values, (unsigned int)n);
+        return 0;
+    }
+    return 1;
+}
+
+rst_status front_set(void *c, const char *function, unsigned int kinds, const rst_vr vr[], size_t n,
+                     const void *values, size_t n_values, rst_read_fn read)
+{
+    double buffer[CHUNK], *all = buffer;
+    size_t i;
+    rst_status status;
+    ENTER(function, SET_MODES)
+    if (!check_counts(inst, function, vr, n, values, n_values))
+        LEAVE(RST_ERROR);
+    if (n > CHUNK) {
+        all = (double *)inst->allocate(n, sizeof(double));
+        if (all == NULL) {
+            rst_log(inst, RST_ERROR, "%s: out of memory for %u values", function, (unsigned int)n);
+            LEAVE(RST_ERROR);
+        }
+    }
+    for (i = 0; i < n; i++)
+        all[i] = read(values, i);
+    status = set_checked(inst, function, kinds, vr, n, all);
+    if (all != buffer)
+        inst->release(all);
     LEAVE(status);
 }
 
-static int check_get(rst_instance *inst, const char *function, fmi2ValueReference vr, rst_type type)
-{
-    if (vr >= inst->model->n_variables) {
-        rst_log(inst, fmi2Error, "%s: unknown value reference %u (this FMU has %u variables)", function, vr,
-                (unsigned int)inst->model->n_variables);
-        return 0;
-    }
-    if (inst->model->variables[vr].type != type) {
-        rst_log(inst, fmi2Error, "%s: %s (value reference %u) is a %s variable, not %s", function,
-                inst->model->variables[vr].name, vr, front_type_name(inst->model->variables[vr].type),
-                front_type_name(type));
-        return 0;
-    }
-    return 1;
-}
-
-/* Reads `n` (at most 64) variables of `type` into `out`: inputs and parameters from the store, outputs,
+/* Reads `n` (at most CHUNK) variables into `out`: inputs and parameters from the store, outputs,
  * locals and calculated parameters (what the model computes) from the backend in one call. */
-static fmi2Status get_values(rst_instance *inst, const char *function, rst_type type, const fmi2ValueReference vr[],
-                             size_t n, double *out)
+static rst_status get_chunk(rst_instance *inst, const char *function, unsigned int kinds, const rst_vr vr[],
+                            size_t n, double *out)
 {
-    fmi2ValueReference outputs[64];
-    double output_values[64];
-    size_t position[64];
+    rst_vr outputs[CHUNK];
+    double output_values[CHUNK];
+    size_t position[CHUNK];
     size_t i, n_outputs = 0;
-    fmi2Status status;
+    rst_status status;
     for (i = 0; i < n; i++) {
-        if (!check_get(inst, function, vr[i], type))
-            return fmi2Error;
+        rst_causality causality;
+        if (!check_vr(inst, function, vr[i], kinds))
+            return RST_ERROR;
+        if (is_time(inst, vr[i])) {
+            out[i] = current_time(inst);
+            continue;
+        }
         out[i] = inst->store[vr[i]];
-        if (inst->model->variables[vr[i]].causality == RST_OUTPUT ||
-            inst->model->variables[vr[i]].causality == RST_LOCAL ||
-            inst->model->variables[vr[i]].causality == RST_CALCULATEDPARAMETER) {
+        causality = inst->model->variables[vr[i]].causality;
+        if (causality == RST_OUTPUT || causality == RST_LOCAL || causality == RST_CALCULATEDPARAMETER) {
             position[n_outputs] = i;
             outputs[n_outputs++] = vr[i];
         }
     }
     if (n_outputs == 0 || inst->model->get_outputs == NULL)
-        return fmi2OK;
-    status = front_backend_status(inst, inst->model->get_outputs(inst, type, outputs, n_outputs, output_values));
-    if (status < fmi2Error)
+        return RST_OK;
+    status = front_backend_status(inst, inst->model->get_outputs(inst, inst->model->variables[outputs[0]].type,
+                                                                 outputs, n_outputs, output_values));
+    if (status < RST_ERROR)
         for (i = 0; i < n_outputs; i++)
             out[position[i]] = output_values[i];
     return status;
 }
 
-/* `out` may hold a non-double type: read into doubles first, in chunks. */
-#define GET_TYPED(function, rst_type_, c_type, convert)                                               \
-    size_t i0;                                                                                        \
-    double buffer[64];                                                                                \
-    fmi2Status status = fmi2OK;                                                                       \
-    ENTER(function, GET_MODES)                                                                        \
-    if (n > 0 && (vr == NULL || value == NULL)) {                                                     \
-        rst_log(inst, fmi2Error, "%s: NULL value reference or value array for %u variables", function, \
-                (unsigned int)n);                                                                     \
-        LEAVE(fmi2Error);                                                                             \
-    }                                                                                                 \
-    for (i0 = 0; i0 < n; i0 += 64) {                                                                  \
-        size_t m = n - i0 < 64 ? n - i0 : 64, j;                                                      \
-        fmi2Status s = get_values(inst, function, rst_type_, vr + i0, m, buffer);                     \
-        if (s > status)                                                                               \
-            status = s;                                                                               \
-        if (s >= fmi2Error)                                                                           \
-            LEAVE(status);                                                                            \
-        for (j = 0; j < m; j++)                                                                       \
-            value[i0 + j] = (c_type)convert(buffer[j]);                                               \
-    }                                                                                                 \
+rst_status front_get(void *c, const char *function, unsigned int kinds, const rst_vr vr[], size_t n,
+                     void *values, size_t n_values, rst_write_fn write)
+{
+    size_t i0, j;
+    double buffer[CHUNK];
+    rst_status status = RST_OK;
+    ENTER(function, GET_MODES)
+    if (!check_counts(inst, function, vr, n, values, n_values))
+        LEAVE(RST_ERROR);
+    for (i0 = 0; i0 < n; i0 += CHUNK) {
+        size_t m = n - i0 < CHUNK ? n - i0 : CHUNK;
+        rst_status s = get_chunk(inst, function, kinds, vr + i0, m, buffer);
+        if (s > status)
+            status = s;
+        if (s >= RST_ERROR)
+            LEAVE(status);
+        for (j = 0; j < m; j++)
+            write(values, i0 + j, buffer[j]);
+    }
     LEAVE(status);
-
-static double same(double x) { return x; }
-/* an Integer or Boolean held as a double, converted without undefined behaviour for any double */
-static fmi2Integer to_integer(double x)
-{
-    if (!(x >= -2147483648.0 && x <= 2147483647.0))
-        return 0;
-    return (fmi2Integer)x;
-}
-static fmi2Boolean to_boolean(double x) { return x != 0.0 && !isnan(x) ? fmi2True : fmi2False; }
-
-fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2Real value[])
-{
-    GET_TYPED("fmi2GetReal", RST_REAL, fmi2Real, same)
 }
 
-fmi2Status fmi2GetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2Integer value[])
-{
-    GET_TYPED("fmi2GetInteger", RST_INTEGER, fmi2Integer, to_integer)
-}
-
-fmi2Status fmi2GetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2Boolean value[])
-{
-    GET_TYPED("fmi2GetBoolean", RST_BOOLEAN, fmi2Boolean, to_boolean)
-}
-
-fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2String value[])
+rst_status front_refuse_type(void *c, const char *function, const char *type_name, const rst_vr vr[], size_t n,
+                             int set)
 {
     size_t i;
-    ENTER("fmi2GetString", GET_MODES)
-    (void)value;
+    ENTER(function, set ? SET_MODES : GET_MODES)
     for (i = 0; i < n; i++) {
-        if (vr == NULL || vr[i] >= inst->model->n_variables)
-            rst_log(inst, fmi2Error, "fmi2GetString: unknown value reference %u (this FMU has no String variables)",
-                    vr ? vr[i] : 0u);
+        if (vr != NULL && is_time(inst, vr[i]))
+            rst_log(inst, RST_ERROR, "%s: time is a %s variable, not %s", function, access_name(inst, RST_AS_REAL),
+                    type_name);
+        else if (vr == NULL || vr[i] >= inst->model->n_variables)
+            rst_log(inst, RST_ERROR, "%s: unknown value reference %u (this FMU has no %s variables)", function,
+                    vr ? vr[i] : 0u, type_name);
         else
-            rst_log(inst, fmi2Error, "fmi2GetString: %s is a %s variable, not String", inst->model->variables[vr[i]].name,
-                    front_type_name(inst->model->variables[vr[i]].type));
-        LEAVE(fmi2Error);
+            rst_log(inst, RST_ERROR, "%s: %s is a %s variable, not %s", function, inst->model->variables[vr[i]].name,
+                    access_name(inst, (unsigned int)access_of(&inst->model->variables[vr[i]])), type_name);
+        LEAVE(RST_ERROR);
     }
-    LEAVE(fmi2OK);
-}
-
-#define SET_TYPED(function, rst_type_, convert)                                                       \
-    size_t i0;                                                                                        \
-    double buffer[64];                                                                                \
-    rst_instance *checked = front_instance(c);                                                           \
-    if (checked == NULL)                                                                              \
-        return fmi2Error;                                                                             \
-    if (n > 0 && (vr == NULL || value == NULL)) {                                                     \
-        front_lock(checked);                                                                                \
-        rst_log(checked, fmi2Error, "%s: NULL value reference or value array for %u variables", function, \
-                (unsigned int)n);                                                                     \
-        front_unlock(checked);                                                                              \
-        return fmi2Error;                                                                             \
-    }                                                                                                 \
-    if (n <= 64) {                                                                                    \
-        for (i0 = 0; i0 < n; i0++)                                                                    \
-            buffer[i0] = convert(value[i0]);                                                          \
-        return set_values(c, function, rst_type_, vr, n, buffer);                                     \
-    } else { /* more than 64: all-or-nothing needs them in one piece */                              \
-        double *all = (double *)checked->allocate(n, sizeof(double));                                 \
-        fmi2Status status;                                                                            \
-        if (all == NULL) {                                                                            \
-            front_lock(checked);                                                                            \
-            rst_log(checked, fmi2Error, "%s: out of memory for %u values", function, (unsigned int)n); \
-            front_unlock(checked);                                                                          \
-            return fmi2Error;                                                                         \
-        }                                                                                             \
-        for (i0 = 0; i0 < n; i0++)                                                                    \
-            all[i0] = convert(value[i0]);                                                             \
-        status = set_values(c, function, rst_type_, vr, n, all);                                      \
-        checked->release(all);                                                                        \
-        return status;                                                                                \
-    }
-
-static double from_boolean(fmi2Boolean b) { return (double)b; }
-static double from_integer(fmi2Integer i) { return (double)i; }
-
-fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2Real value[])
-{
-    SET_TYPED("fmi2SetReal", RST_REAL, same)
-}
-
-fmi2Status fmi2SetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2Integer value[])
-{
-    SET_TYPED("fmi2SetInteger", RST_INTEGER, from_integer)
-}
-
-fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2Boolean value[])
-{
-    SET_TYPED("fmi2SetBoolean", RST_BOOLEAN, from_boolean)
-}
-
-fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2String value[])
-{
-    size_t i;
-    ENTER("fmi2SetString", SET_MODES)
-    (void)value;
-    for (i = 0; i < n; i++) {
-        rst_log(inst, fmi2Error, "fmi2SetString: value reference %u is not a String variable (this FMU has none)",
-                vr ? vr[i] : 0u);
-        LEAVE(fmi2Error);
-    }
-    LEAVE(fmi2OK);
+    LEAVE(RST_OK);
 }
 
 /* ------------------------------------------------------------------------------------------------ */
 /* Life cycle                                                                                       */
 /* ------------------------------------------------------------------------------------------------ */
-const char *fmi2GetTypesPlatform(void) { return fmi2TypesPlatform; }
-const char *fmi2GetVersion(void) { return fmi2Version; }
-
 static int hex_value(char ch)
 {
     if (ch >= '0' && ch <= '9') return ch - '0';
@@ -391,11 +399,10 @@ static int hex_value(char ch)
     return -1;
 }
 
-/* fmuResourceLocation (file:///p, file:/p, file://localhost/p, percent-encoded) -> the path p in
- * `path` (room for strlen(uri) + 1 bytes). Returns NULL, or why it is not a file URI one can decode.
- * Windows drive paths (file:///C:/x) lose their leading slash. A '%' not followed by two hex digits
- * is taken literally (hosts that do not encode their paths exist); an encoded NUL is refused. */
-static const char *decode_resource_location(const char *uri, char *path)
+/* file:///p, file:/p, file://localhost/p, percent-encoded -> p. Windows drive paths (file:///C:/x) lose
+ * their leading slash. A '%' not followed by two hex digits is taken literally (hosts that do not
+ * encode their paths exist); an encoded NUL is refused. Trailing separators are dropped. */
+const char *front_decode_file_uri(const char *uri, char *path)
 {
     const char *p = uri;
     size_t n = 0;
@@ -426,14 +433,9 @@ static const char *decode_resource_location(const char *uri, char *path)
     return NULL;
 }
 
-static void stderr_message(const char *name, const char *message)
-{
-    fprintf(stderr, "%s [%s]: %s\n", RST_MODEL.identifier, name ? name : "?", message);
-}
-
 static void free_memory(rst_instance *inst)
 {
-    fmi2CallbackFreeMemory release = inst->release;
+    rst_release_fn release = inst->release;
     front_free_states(inst);
     front_deliver_messages(inst, front_take_messages(inst));
 #if defined(RST_LOCK_PTHREAD)
@@ -446,55 +448,41 @@ static void free_memory(rst_instance *inst)
     release(inst);
 }
 
-fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2String fmuGUID,
-                              fmi2String fmuResourceLocation, const fmi2CallbackFunctions *functions,
-                              fmi2Boolean visible, fmi2Boolean loggingOn)
+void front_discard_instance(rst_instance *inst) { free_memory(inst); }
+
+rst_instance *front_new_instance(const rst_api *api, void (*host_logger)(void), void *environment,
+                                 rst_allocate_fn allocate, rst_release_fn release, const char *function,
+                                 const char *name, int logging_on)
 {
     const rst_model *model = &RST_MODEL;
-    rst_instance *inst;
-    char *resource_dir = NULL;
-    const char *why = NULL;
+    rst_instance *inst = (rst_instance *)allocate(1, sizeof *inst);
     size_t i;
-    fmi2Status status;
-    if (functions == NULL || functions->logger == NULL) {
-        stderr_message(instanceName, "fmi2Instantiate: no logger in the callback functions (NULL); not instantiated");
-        return NULL;
-    }
-    if (functions->allocateMemory == NULL || functions->freeMemory == NULL) {
-        functions->logger(functions->componentEnvironment, instanceName ? instanceName : "", fmi2Error,
-                          "logStatusError", "fmi2Instantiate: allocateMemory or freeMemory is NULL; not instantiated");
-        return NULL;
-    }
-    if (instanceName == NULL || instanceName[0] == '\0') {
-        functions->logger(functions->componentEnvironment, "", fmi2Error, "logStatusError",
-                          "fmi2Instantiate: the instance name is NULL or empty; not instantiated");
-        return NULL;
-    }
-    inst = (rst_instance *)functions->allocateMemory(1, sizeof *inst);
     if (inst == NULL)
         return NULL;
     inst->model = model;
-    inst->logger = functions->logger;
-    inst->allocate = functions->allocateMemory;
-    inst->release = functions->freeMemory;
-    inst->environment = functions->componentEnvironment;
-    inst->logging_on = loggingOn != fmi2False;
+    inst->api = api;
+    inst->host_logger = host_logger;
+    inst->environment = environment;
+    inst->allocate = allocate;
+    inst->release = release;
+    inst->logging_on = logging_on != 0;
     inst->categories = RST_ALL_CATEGORIES;
-    inst->mode = RST_INSTANTIATED;
-    inst->last_step_status = fmi2OK;
-    inst->name = (char *)inst->allocate(strlen(instanceName) + 1, 1);
-    inst->store = (double *)inst->allocate(model->n_variables ? model->n_variables : 1, sizeof(double));
-    inst->backend = inst->allocate(model->backend_size ? model->backend_size : 1, 1);
+    inst->mode = RST_MODE_INSTANTIATED;
+    inst->last_step_status = RST_OK;
+    inst->name = (char *)allocate(strlen(name) + 1, 1);
+    inst->store = (double *)allocate(model->n_variables ? model->n_variables : 1, sizeof(double));
+    inst->backend = allocate(model->backend_size ? model->backend_size : 1, 1);
     if (inst->name == NULL || inst->store == NULL || inst->backend == NULL) {
-        functions->logger(functions->componentEnvironment, instanceName, fmi2Error, "logStatusError",
-                          "fmi2Instantiate: out of memory");
-        if (inst->name) inst->release(inst->name);
-        if (inst->store) inst->release(inst->store);
-        if (inst->backend) inst->release(inst->backend);
-        inst->release(inst);
+        char message[80];
+        snprintf(message, sizeof message, "%s: out of memory", function);
+        api->emit(host_logger, environment, name, RST_ERROR, "logStatusError", message);
+        if (inst->name) release(inst->name);
+        if (inst->store) release(inst->store);
+        if (inst->backend) release(inst->backend);
+        release(inst);
         return NULL;
     }
-    strcpy(inst->name, instanceName);
+    strcpy(inst->name, name);
     memset(inst->backend, 0, model->backend_size ? model->backend_size : 1);
     for (i = 0; i < model->n_variables; i++)
         inst->n_state += model->variables[i].state != 0;
@@ -506,42 +494,29 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
 #endif
     inst->magic = RST_INSTANCE_MAGIC;
     reset_store(inst);
+    return inst;
+}
 
-    if (fmuType != fmi2CoSimulation) {
-        rst_log(inst, fmi2Error, "fmi2Instantiate: %s is a co-simulation FMU; model exchange is not provided",
-                model->identifier);
+rst_instance *front_instantiate(rst_instance *inst, const char *function, const char *token,
+                                const char *resource_dir, int visible)
+{
+    rst_status status;
+    if (token == NULL || strcmp(token, inst->model->guid) != 0) {
+        rst_log(inst, RST_ERROR, "%s: %s %s does not match this FMU's %s (modelDescription.xml of another FMU or "
+                "another build?)", function, inst->api->token_name,
+                token ? token : "(NULL)", inst->model->guid);
         free_memory(inst);
         return NULL;
     }
-    if (fmuGUID == NULL || strcmp(fmuGUID, model->guid) != 0) {
-        rst_log(inst, fmi2Error, "fmi2Instantiate: GUID %s does not match this FMU's %s (modelDescription.xml "
-                "of another FMU or another build?)", fmuGUID ? fmuGUID : "(NULL)", model->guid);
-        free_memory(inst);
-        return NULL;
-    }
-    if (fmuResourceLocation != NULL && fmuResourceLocation[0] != '\0') {
-        resource_dir = (char *)inst->allocate(strlen(fmuResourceLocation) + 1, 1);
-        why = resource_dir == NULL ? "out of memory" : decode_resource_location(fmuResourceLocation, resource_dir);
-        if (why != NULL) {
-            rst_log(inst, fmi2Error, "fmi2Instantiate: cannot use the resource location %s: %s", fmuResourceLocation,
-                    why);
-            if (resource_dir != NULL)
-                inst->release(resource_dir);
-            free_memory(inst);
-            return NULL;
-        }
-    }
-    status = model->instantiate ? model->instantiate(inst, resource_dir, visible) : fmi2OK;
-    if (resource_dir != NULL)
-        inst->release(resource_dir);
-    if (status != fmi2OK) {
+    status = inst->model->instantiate ? inst->model->instantiate(inst, resource_dir, visible) : RST_OK;
+    if (status != RST_OK) {
         free_memory(inst);
         return NULL;
     }
     return inst;
 }
 
-void fmi2FreeInstance(fmi2Component c)
+void front_free_instance(void *c)
 {
     rst_instance *inst = front_instance(c);
     if (inst == NULL)
@@ -553,53 +528,65 @@ void fmi2FreeInstance(fmi2Component c)
     free_memory(inst);
 }
 
-fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined, fmi2Real tolerance,
-                               fmi2Real startTime, fmi2Boolean stopTimeDefined, fmi2Real stopTime)
+static rst_status setup_locked(rst_instance *inst, const char *function, const rst_experiment *e)
 {
-    ENTER("fmi2SetupExperiment", RST_INSTANTIATED)
-    if (!isfinite(startTime) || (stopTimeDefined && !(stopTime >= startTime && stopTime <= DBL_MAX)) ||
-        (toleranceDefined && !(tolerance > 0.0 && tolerance <= DBL_MAX))) {
+    rst_status status = RST_OK;
+    if (!isfinite(e->start_time) || (e->stop_time_defined && !(e->stop_time >= e->start_time && e->stop_time <= DBL_MAX)) ||
+        (e->tolerance_defined && !(e->tolerance > 0.0 && e->tolerance <= DBL_MAX))) {
         char t0[40], t1[40], tol[40];
-        rst_format_double(startTime, t0, sizeof t0);
-        rst_format_double(stopTime, t1, sizeof t1);
-        rst_format_double(tolerance, tol, sizeof tol);
-        rst_log(inst, fmi2Error, "fmi2SetupExperiment: startTime = %s%s%s%s%s: the start time must be finite, a "
-                "defined stop time finite and >= the start time, a defined tolerance finite and > 0", t0,
-                stopTimeDefined ? ", stopTime = " : "", stopTimeDefined ? t1 : "",
-                toleranceDefined ? ", tolerance = " : "", toleranceDefined ? tol : "");
-        LEAVE(fmi2Error);
+        rst_format_double(e->start_time, t0, sizeof t0);
+        rst_format_double(e->stop_time, t1, sizeof t1);
+        rst_format_double(e->tolerance, tol, sizeof tol);
+        rst_log(inst, RST_ERROR, "%s: startTime = %s%s%s%s%s: the start time must be finite, a "
+                "defined stop time finite and >= the start time, a defined tolerance finite and > 0", function, t0,
+                e->stop_time_defined ? ", stopTime = " : "", e->stop_time_defined ? t1 : "",
+                e->tolerance_defined ? ", tolerance = " : "", e->tolerance_defined ? tol : "");
+        return RST_ERROR;
     }
     if (inst->model->setup_experiment != NULL) {
-        fmi2Status s = front_backend_status(inst, inst->model->setup_experiment(inst, toleranceDefined, tolerance,
-                                                                            startTime, stopTimeDefined, stopTime));
-        if (s >= fmi2Error)
-            LEAVE(s);
-        status_ = s;
+        status = front_backend_status(inst, inst->model->setup_experiment(inst, e->tolerance_defined, e->tolerance,
+                                                                          e->start_time, e->stop_time_defined,
+                                                                          e->stop_time));
+        if (status >= RST_ERROR)
+            return status;
     }
     inst->has_start = 1;
-    inst->start_time = startTime;
-    LEAVE(status_);
+    inst->start_time = e->start_time;
+    return status;
 }
 
-fmi2Status fmi2EnterInitializationMode(fmi2Component c)
+rst_status front_setup_experiment(void *c, const char *function, const rst_experiment *experiment)
 {
-    fmi2Status status = fmi2OK;
-    ENTER("fmi2EnterInitializationMode", RST_INSTANTIATED)
-    if (inst->model->enter_initialization != NULL)
-        status = front_backend_status(inst, inst->model->enter_initialization(inst));
-    if (status < fmi2Error)
-        inst->mode = RST_INITIALIZATION;
+    ENTER(function, RST_MODE_INSTANTIATED)
+    LEAVE(setup_locked(inst, function, experiment));
+}
+
+rst_status front_enter_initialization(void *c, const char *function, const rst_experiment *experiment)
+{
+    rst_status status = RST_OK;
+    ENTER(function, RST_MODE_INSTANTIATED)
+    if (experiment != NULL) {
+        status = setup_locked(inst, function, experiment);
+        if (status >= RST_ERROR)
+            LEAVE(status);
+    }
+    if (inst->model->enter_initialization != NULL) {
+        rst_status s = front_backend_status(inst, inst->model->enter_initialization(inst));
+        status = s > status ? s : status;
+    }
+    if (status < RST_ERROR)
+        inst->mode = RST_MODE_INITIALIZATION;
     LEAVE(status);
 }
 
-fmi2Status fmi2ExitInitializationMode(fmi2Component c)
+rst_status front_exit_initialization(void *c, const char *function)
 {
-    fmi2Status status = fmi2OK;
-    ENTER("fmi2ExitInitializationMode", RST_INITIALIZATION)
+    rst_status status = RST_OK;
+    ENTER(function, RST_MODE_INITIALIZATION)
     if (inst->model->exit_initialization != NULL)
         status = front_backend_status(inst, inst->model->exit_initialization(inst));
-    if (status < fmi2Error) {
-        inst->mode = RST_STEP_COMPLETE;
+    if (status < RST_ERROR) {
+        inst->mode = RST_MODE_STEP_COMPLETE;
         inst->has_time = inst->has_start;
         inst->next_time = inst->start_time;
         inst->last_time = inst->start_time;
@@ -607,26 +594,26 @@ fmi2Status fmi2ExitInitializationMode(fmi2Component c)
     LEAVE(status);
 }
 
-fmi2Status fmi2Terminate(fmi2Component c)
+rst_status front_terminate(void *c, const char *function)
 {
-    fmi2Status status = fmi2OK;
-    ENTER("fmi2Terminate", RST_STEP_COMPLETE | RST_STEP_FAILED)
+    rst_status status = RST_OK;
+    ENTER(function, RST_MODE_STEP_COMPLETE | RST_MODE_STEP_FAILED)
     if (inst->model->terminate != NULL)
         status = front_backend_status(inst, inst->model->terminate(inst));
-    if (status < fmi2Error)
-        inst->mode = RST_TERMINATED;
+    if (status < RST_ERROR)
+        inst->mode = RST_MODE_TERMINATED;
     LEAVE(status);
 }
 
-fmi2Status fmi2Reset(fmi2Component c)
+rst_status front_reset(void *c, const char *function)
 {
-    fmi2Status status = fmi2OK;
-    ENTER("fmi2Reset", ANY_LIVE_MODE)
+    rst_status status = RST_OK;
+    ENTER(function, ANY_LIVE_MODE)
     reset_store(inst);
-    inst->mode = RST_INSTANTIATED;
+    inst->mode = RST_MODE_INSTANTIATED;
     inst->has_start = inst->has_time = 0;
     inst->start_time = inst->next_time = inst->last_time = 0.0;
-    inst->last_step_status = fmi2OK;
+    inst->last_step_status = RST_OK;
     if (inst->model->reset != NULL)
         status = front_backend_status(inst, inst->model->reset(inst));
     LEAVE(status);
@@ -635,131 +622,48 @@ fmi2Status fmi2Reset(fmi2Component c)
 /* ------------------------------------------------------------------------------------------------ */
 /* Stepping                                                                                         */
 /* ------------------------------------------------------------------------------------------------ */
-fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint, fmi2Real communicationStepSize,
-                      fmi2Boolean noSetFMUStatePriorToCurrentPoint)
+rst_status front_refuse(void *c, const char *function, unsigned int modes, const char *why)
 {
-    double t = currentCommunicationPoint, h = communicationStepSize;
-    fmi2Status status = fmi2OK;
+    ENTER(function, modes)
+    rst_log(inst, RST_ERROR, "%s: %s", function, why);
+    LEAVE(RST_ERROR);
+}
+
+rst_status front_do_step(void *c, const char *function, double t, double h, double *last_successful_time)
+{
+    rst_status status = RST_OK;
     char t_text[40], h_text[40], want[40];
-    ENTER("fmi2DoStep", RST_STEP_COMPLETE)
-    (void)noSetFMUStatePriorToCurrentPoint;
+    ENTER(function, RST_MODE_STEP_COMPLETE)
     if (!isfinite(t) || !isfinite(h) || !(h > 0.0) || !isfinite(t + h)) {
         rst_format_double(t, t_text, sizeof t_text);
         rst_format_double(h, h_text, sizeof h_text);
-        rst_log(inst, fmi2Error, "fmi2DoStep: currentCommunicationPoint = %s, communicationStepSize = %s: the step "
-                "size must be finite and > 0, the time finite", t_text, h_text);
-        LEAVE(fmi2Error);
+        rst_log(inst, RST_ERROR, "%s: currentCommunicationPoint = %s, communicationStepSize = %s: the step "
+                "size must be finite and > 0, the time finite", function, t_text, h_text);
+        LEAVE(RST_ERROR);
     }
     if (inst->has_time) {
         double scale = fabs(inst->next_time) > fabs(h) ? fabs(inst->next_time) : fabs(h);
         if (fabs(t - inst->next_time) > TIME_RTOL * scale) {
             rst_format_double(t, t_text, sizeof t_text);
             rst_format_double(inst->next_time, want, sizeof want);
-            rst_log(inst, fmi2Error, "fmi2DoStep: currentCommunicationPoint = %s does not continue the previous "
-                    "step, which ended at %s (a step cannot be skipped or repeated without fmi2SetFMUstate)",
-                    t_text, want);
-            LEAVE(fmi2Error);
+            rst_log(inst, RST_ERROR, "%s: currentCommunicationPoint = %s does not continue the previous "
+                    "step, which ended at %s (a step cannot be skipped or repeated without %s)",
+                    function, t_text, want, inst->api->set_state);
+            LEAVE(RST_ERROR);
         }
     }
     if (inst->model->do_step != NULL)
         status = front_backend_status(inst, inst->model->do_step(inst, t, h));
     inst->last_step_status = status;
-    if (status <= fmi2Warning) {
+    if (status <= RST_WARNING) {
         inst->has_time = 1;
         inst->next_time = t + h;
         inst->last_time = t + h;
-    } else if (status == fmi2Discard) {
-        inst->mode = RST_STEP_FAILED;
+    } else if (status == RST_DISCARD) {
+        inst->mode = RST_MODE_STEP_FAILED;
         inst->last_time = t;
     }
+    if (last_successful_time != NULL)
+        *last_successful_time = inst->last_time;
     LEAVE(status);
 }
-
-fmi2Status fmi2CancelStep(fmi2Component c)
-{
-    ENTER("fmi2CancelStep", 0)
-    LEAVE(fmi2Error); /* no step is ever in progress: fmi2DoStep is synchronous */
-}
-
-fmi2Status fmi2GetStatus(fmi2Component c, const fmi2StatusKind s, fmi2Status *value)
-{
-    ENTER("fmi2GetStatus", RST_STEP_COMPLETE | RST_STEP_FAILED | RST_TERMINATED)
-    if (value == NULL || s != fmi2DoStepStatus) {
-        rst_log(inst, fmi2Error, "fmi2GetStatus: only fmi2DoStepStatus is provided, with a non-NULL value");
-        LEAVE(fmi2Error);
-    }
-    *value = inst->last_step_status;
-    LEAVE(fmi2OK);
-}
-
-fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind s, fmi2Real *value)
-{
-    ENTER("fmi2GetRealStatus", RST_STEP_COMPLETE | RST_STEP_FAILED | RST_TERMINATED)
-    if (value == NULL || s != fmi2LastSuccessfulTime) {
-        rst_log(inst, fmi2Error, "fmi2GetRealStatus: only fmi2LastSuccessfulTime is provided, with a non-NULL value");
-        LEAVE(fmi2Error);
-    }
-    *value = inst->last_time;
-    LEAVE(fmi2OK);
-}
-
-fmi2Status fmi2GetIntegerStatus(fmi2Component c, const fmi2StatusKind s, fmi2Integer *value)
-{
-    ENTER("fmi2GetIntegerStatus", RST_STEP_COMPLETE | RST_STEP_FAILED | RST_TERMINATED)
-    (void)s;
-    (void)value;
-    rst_log(inst, fmi2Error, "fmi2GetIntegerStatus: no integer status is defined by FMI 2.0");
-    LEAVE(fmi2Error);
-}
-
-fmi2Status fmi2GetBooleanStatus(fmi2Component c, const fmi2StatusKind s, fmi2Boolean *value)
-{
-    ENTER("fmi2GetBooleanStatus", RST_STEP_COMPLETE | RST_STEP_FAILED | RST_TERMINATED)
-    if (value == NULL || s != fmi2Terminated) {
-        rst_log(inst, fmi2Error, "fmi2GetBooleanStatus: only fmi2Terminated is provided, with a non-NULL value");
-        LEAVE(fmi2Error);
-    }
-    *value = fmi2False; /* the slave never asks to end the simulation */
-    LEAVE(fmi2OK);
-}
-
-fmi2Status fmi2GetStringStatus(fmi2Component c, const fmi2StatusKind s, fmi2String *value)
-{
-    ENTER("fmi2GetStringStatus", RST_STEP_COMPLETE | RST_STEP_FAILED | RST_TERMINATED)
-    (void)s;
-    (void)value;
-    rst_log(inst, fmi2Error, "fmi2GetStringStatus: fmi2PendingStatus does not exist here (no asynchronous steps)");
-    LEAVE(fmi2Error);
-}
-
-/* ------------------------------------------------------------------------------------------------ */
-/* Not provided (canGetDirectionalDerivatives, canInterpolateInputs, maxOutputDerivativeOrder = 0)   */
-/* ------------------------------------------------------------------------------------------------ */
-fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference vUnknown_ref[], size_t nUnknown,
-                                        const fmi2ValueReference vKnown_ref[], size_t nKnown,
-                                        const fmi2Real dvKnown[], fmi2Real dvUnknown[])
-{
-    ENTER("fmi2GetDirectionalDerivative", GET_MODES)
-    (void)vUnknown_ref, (void)nUnknown, (void)vKnown_ref, (void)nKnown, (void)dvKnown, (void)dvUnknown;
-    rst_log(inst, fmi2Error, "fmi2GetDirectionalDerivative is not provided (providesDirectionalDerivative = false)");
-    LEAVE(fmi2Error);
-}
-
-fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
-                                       const fmi2Integer order[], const fmi2Real value[])
-{
-    ENTER("fmi2SetRealInputDerivatives", SET_MODES)
-    (void)vr, (void)nvr, (void)order, (void)value;
-    rst_log(inst, fmi2Error, "fmi2SetRealInputDerivatives is not provided (canInterpolateInputs = false)");
-    LEAVE(fmi2Error);
-}
-
-fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
-                                        const fmi2Integer order[], fmi2Real value[])
-{
-    ENTER("fmi2GetRealOutputDerivatives", RST_STEP_COMPLETE | RST_STEP_FAILED | RST_TERMINATED | RST_ERROR)
-    (void)vr, (void)nvr, (void)order, (void)value;
-    rst_log(inst, fmi2Error, "fmi2GetRealOutputDerivatives is not provided (maxOutputDerivativeOrder = 0)");
-    LEAVE(fmi2Error);
-}
-

@@ -1,29 +1,32 @@
-/* The project's FMI 2.0 co-simulation front: one C implementation of everything an FMU owes its host
- * before any model code runs, shared by the guard in front of pythonfmu (pythonfmu_guard/) and by the
- * native FMUs (native/).
+/* The project's FMI front: one C implementation of everything an FMU owes its host before any model
+ * code runs, shared by the guard in front of pythonfmu (pythonfmu_guard/) and by the native FMUs
+ * (models/<model>/rst_native_*_fmu.c), whatever the FMI version.
  *
- * rst_front.c exports every FMI 2.0 co-simulation function. It checks each call against the FMI 2.0
- * co-simulation state machine and its arguments against the interface table (generated from the
- * model's interface table): unknown value references, wrong types, variables that may not be set in the
- * current mode, values outside their declared range or non-finite, NULL pointers, a wrong GUID, a
- * doStep whose time does not continue the previous one. Anything wrong is answered with fmi2Error and
- * a log message naming the variable, its value and what is allowed, and changes nothing. It keeps
- * the value store (every variable as a double, indexed by value reference), the FMU states (versioned,
- * checksummed and validated on restore) and logging. A backend (the glue file compiled with the front
- * defines RST_MODEL) supplies the model: it is only ever called with checked arguments, in a legal
- * mode. There is no global mutable state here; each instance is independent.
+ * The core (rst_front.c: life cycle, values, steps; rst_log.c: messages; rst_state.c: FMU states)
+ * knows no FMI version. It checks each call against the co-simulation state machine and its arguments
+ * against the interface table (generated from the model's interface table): unknown value references,
+ * wrong types, variables that may not be set in the current mode, values outside their declared range
+ * or non-finite, NULL pointers, a wrong GUID or instantiation token, a step whose time does not
+ * continue the previous one. Anything wrong is answered with an error status and a log message naming
+ * the variable, its value and what is allowed, and changes nothing. It keeps the value store (every
+ * variable as a double, indexed by value reference), the FMU states (versioned, checksummed and
+ * validated on restore) and logging. A thin layer per FMI version exports that version's functions
+ * and translates its types (rst_fmi2.c, rst_fmi3.c); one FMU binary is built with one of them.
+ * A backend (the glue file compiled with the front defines RST_MODEL) supplies the model: it is only
+ * ever called with checked arguments, in a legal mode. There is no global mutable state here; each
+ * instance is independent.
  */
 #ifndef RST_FRONT_H
 #define RST_FRONT_H
 
 #include <stddef.h>
 
-#include "fmi2Functions.h"
 #include "rst_variable.h"
 
 #include "rst_prefix.h"
-#if defined(FMI2_FUNCTION_PREFIX)
+#if defined(RST_PREFIXED)
 #define RST_MODEL RST_PREFIXED(RST_MODEL)
+#define rst_fmi_prefix RST_PREFIXED(rst_fmi_prefix)
 #define rst_store RST_PREFIXED(rst_store)
 #define rst_backend RST_PREFIXED(rst_backend)
 #define rst_instance_name RST_PREFIXED(rst_instance_name)
@@ -36,21 +39,29 @@
 
 typedef struct rst_instance rst_instance;
 
-/* The FMI 2.0 co-simulation modes, as bits (sets of modes describe where a call is allowed).
- * stepInProgress and stepCanceled never occur: every step here is synchronous. */
+/* The status of a call, with the numbers FMI 2.0 and FMI 3.0 both give their statuses (the version
+ * layers convert by value). */
+typedef enum { RST_OK = 0, RST_WARNING = 1, RST_DISCARD = 2, RST_ERROR = 3, RST_FATAL = 4 } rst_status;
+/* A value reference (fmi2ValueReference and fmi3ValueReference are both 32-bit unsigned). */
+typedef unsigned int rst_vr;
+
+/* The co-simulation modes, as bits (sets of modes describe where a call is allowed). FMI 2.0's
+ * stepInProgress and stepCanceled never occur (every step here is synchronous), nor FMI 3.0's event
+ * and intermediate-update modes (not offered). RST_MODE_STEP_FAILED: a step returned a discard. */
 typedef enum {
-    RST_INSTANTIATED = 1,
-    RST_INITIALIZATION = 2,
-    RST_STEP_COMPLETE = 4,
-    RST_STEP_FAILED = 8,
-    RST_TERMINATED = 16,
-    RST_ERROR = 32,
-    RST_FATAL = 64 /* latched: every later call returns fmi2Error without reaching the backend */
+    RST_MODE_INSTANTIATED = 1,
+    RST_MODE_INITIALIZATION = 2,
+    RST_MODE_STEP_COMPLETE = 4,
+    RST_MODE_STEP_FAILED = 8,
+    RST_MODE_TERMINATED = 16,
+    RST_MODE_ERROR = 32,
+    RST_MODE_FATAL = 64 /* latched: every later call returns an error without reaching the backend */
 } rst_mode;
 
 /* A model: its identity, its interface table and the backend's hooks. Every hook is optional (NULL:
- * nothing to do, fmi2OK). Hooks return an fmi2Status; fmi2Error puts the instance into the error
- * mode, fmi2Fatal latches it. They log with rst_log. */
+ * nothing to do, RST_OK). Hooks return an rst_status; RST_ERROR puts the instance into the error
+ * mode, RST_FATAL latches it. They log with rst_log. Each hook is named by the FMI 2.0 call that runs
+ * it; the FMI 3.0 layer runs it at the same point of the life cycle. */
 typedef struct {
     const char *identifier;
     const char *guid;
@@ -58,35 +69,36 @@ typedef struct {
     size_t n_variables;
     size_t backend_size;           /* bytes of zeroed backend data allocated with each instance */
 
-    /* fmi2Instantiate, after the front's checks; `resource_dir` is the decoded fmuResourceLocation
-     * (a directory path) or NULL when the host gave none. Not fmi2OK: no instance. */
-    fmi2Status (*instantiate)(rst_instance *inst, const char *resource_dir, fmi2Boolean visible);
-    /* fmi2FreeInstance; rst_mode_of(inst) == RST_FATAL tells that the backend reported fmi2Fatal */
+    /* fmi2Instantiate, after the front's checks; `resource_dir` is the resource directory (FMI 2.0:
+     * the decoded fmuResourceLocation; FMI 3.0: resourcePath) or NULL when the host gave none.
+     * Not RST_OK: no instance. */
+    rst_status (*instantiate)(rst_instance *inst, const char *resource_dir, int visible);
+    /* fmi2FreeInstance; rst_mode_of(inst) == RST_MODE_FATAL tells that the backend reported RST_FATAL */
     void (*free_instance)(rst_instance *inst);
-    fmi2Status (*setup_experiment)(rst_instance *inst, fmi2Boolean tolerance_defined, double tolerance,
-                                   double start_time, fmi2Boolean stop_time_defined, double stop_time);
-    fmi2Status (*enter_initialization)(rst_instance *inst);
-    fmi2Status (*exit_initialization)(rst_instance *inst);
+    rst_status (*setup_experiment)(rst_instance *inst, int tolerance_defined, double tolerance,
+                                   double start_time, int stop_time_defined, double stop_time);
+    rst_status (*enter_initialization)(rst_instance *inst);
+    rst_status (*exit_initialization)(rst_instance *inst);
     /* A check beyond the table, for a value the table allows (e.g. an option this backend does not
-     * implement): not fmi2OK rejects it (log why). */
-    fmi2Status (*accept)(rst_instance *inst, const rst_variable *var, double value);
+     * implement): not RST_OK rejects it (log why). */
+    rst_status (*accept)(rst_instance *inst, const rst_variable *var, double value);
     /* New values for inputs or parameters of one type: already checked and in the store. */
-    fmi2Status (*set)(rst_instance *inst, rst_type type, const fmi2ValueReference vr[], size_t n,
+    rst_status (*set)(rst_instance *inst, rst_type type, const rst_vr vr[], size_t n,
                       const double values[]);
     /* Values of outputs and locals: the backend writes them to `values`. NULL: the front reads the store. */
-    fmi2Status (*get_outputs)(rst_instance *inst, rst_type type, const fmi2ValueReference vr[], size_t n,
+    rst_status (*get_outputs)(rst_instance *inst, rst_type type, const rst_vr vr[], size_t n,
                               double values[]);
     /* fmi2DoStep from `t` [s] over `h` [s] (checked: h > 0, finite, t continues the previous step). */
-    fmi2Status (*do_step)(rst_instance *inst, double t, double h);
-    fmi2Status (*terminate)(rst_instance *inst);
+    rst_status (*do_step)(rst_instance *inst, double t, double h);
+    rst_status (*terminate)(rst_instance *inst);
     /* fmi2Reset: the store already holds the start values again */
-    fmi2Status (*reset)(rst_instance *inst);
+    rst_status (*reset)(rst_instance *inst);
     /* fmi2GetFMUstate: bring the store's state variables that are not inputs or parameters up to
      * date (the backend keeps them elsewhere) */
-    fmi2Status (*save_state)(rst_instance *inst);
+    rst_status (*save_state)(rst_instance *inst);
     /* fmi2SetFMUstate: the store holds a validated snapshot; make the backend take every state
      * variable from it */
-    fmi2Status (*restore_state)(rst_instance *inst);
+    rst_status (*restore_state)(rst_instance *inst);
 } rst_model;
 
 /* Defined by the glue file compiled together with the front (one model per binary). */
@@ -97,16 +109,17 @@ double *rst_store(rst_instance *inst);         /* every variable by value refere
 void *rst_backend(rst_instance *inst);         /* the backend's zeroed backend_size bytes */
 const char *rst_instance_name(const rst_instance *inst);
 rst_mode rst_mode_of(const rst_instance *inst);
-double rst_start_time(const rst_instance *inst); /* from fmi2SetupExperiment (0 before) */
-/* Log through the host's logger: fmi2Warning and worse always (they say why a call failed);
- * fmi2OK messages only when the host enabled debug logging for logAll. */
-void rst_log(rst_instance *inst, fmi2Status status, const char *format, ...)
+double rst_start_time(const rst_instance *inst); /* from fmi2SetupExperiment or fmi3EnterInitializationMode (0 before) */
+const char *rst_fmi_prefix(const rst_instance *inst); /* "fmi2" or "fmi3": FMI function names in messages */
+/* Log through the host's logger: RST_WARNING and worse always (they say why a call failed);
+ * RST_OK messages only when the host enabled debug logging for logAll. */
+void rst_log(rst_instance *inst, rst_status status, const char *format, ...)
 #if defined(__GNUC__)
     __attribute__((format(printf, 3, 4)))
 #endif
     ;
 /* The same for a message that is not a format (text from elsewhere, e.g. Python). */
-void rst_log_text(rst_instance *inst, fmi2Status status, const char *category, const char *text);
+void rst_log_text(rst_instance *inst, rst_status status, const char *category, const char *text);
 /* A double as Python's repr() writes it (1e-07, 0.5, 2.0, nan, -inf): messages read the same
  * whichever implementation of the FMU wrote them. `out` needs 32 bytes. */
 void rst_format_double(double x, char *out, size_t size);

@@ -2,7 +2,7 @@
 #ifndef RST_FRONT_INTERNAL_H
 #define RST_FRONT_INTERNAL_H
 
-/* Every instance has a lock (FMI 2.0 does not ask one instance to be thread-safe; these are), whatever
+/* Every instance has a lock (FMI does not ask one instance to be thread-safe; these are), whatever
  * the build command: POSIX threads, or a slim reader/writer lock on Windows. RST_FRONT_NO_LOCK leaves
  * it out for a platform with neither. */
 #if !defined(RST_FRONT_NO_LOCK)
@@ -18,7 +18,7 @@
 
 #include "rst_front.h"
 
-#if defined(FMI2_FUNCTION_PREFIX)
+#if defined(RST_PREFIXED)
 #define front_instance RST_PREFIXED(front_instance)
 #define front_lock RST_PREFIXED(front_lock)
 #define front_unlock RST_PREFIXED(front_unlock)
@@ -30,6 +30,28 @@
 #define front_take_messages RST_PREFIXED(front_take_messages)
 #define front_deliver_messages RST_PREFIXED(front_deliver_messages)
 #define front_free_states RST_PREFIXED(front_free_states)
+#define front_new_instance RST_PREFIXED(front_new_instance)
+#define front_instantiate RST_PREFIXED(front_instantiate)
+#define front_discard_instance RST_PREFIXED(front_discard_instance)
+#define front_free_instance RST_PREFIXED(front_free_instance)
+#define front_set RST_PREFIXED(front_set)
+#define front_get RST_PREFIXED(front_get)
+#define front_refuse_type RST_PREFIXED(front_refuse_type)
+#define front_setup_experiment RST_PREFIXED(front_setup_experiment)
+#define front_enter_initialization RST_PREFIXED(front_enter_initialization)
+#define front_exit_initialization RST_PREFIXED(front_exit_initialization)
+#define front_terminate RST_PREFIXED(front_terminate)
+#define front_reset RST_PREFIXED(front_reset)
+#define front_do_step RST_PREFIXED(front_do_step)
+#define front_refuse RST_PREFIXED(front_refuse)
+#define front_set_debug_logging RST_PREFIXED(front_set_debug_logging)
+#define front_decode_file_uri RST_PREFIXED(front_decode_file_uri)
+#define front_get_state RST_PREFIXED(front_get_state)
+#define front_set_state RST_PREFIXED(front_set_state)
+#define front_free_state RST_PREFIXED(front_free_state)
+#define front_serialized_size RST_PREFIXED(front_serialized_size)
+#define front_serialize RST_PREFIXED(front_serialize)
+#define front_deserialize RST_PREFIXED(front_deserialize)
 #endif
 
 #if defined(RST_LOCK_PTHREAD)
@@ -42,17 +64,17 @@
 #define RST_STATE_MAGIC 0x52535453u    /* "RSTS" */
 #define RST_ALL_CATEGORIES 31u         /* the five log categories, all on */
 
-#define ANY_LIVE_MODE (RST_INSTANTIATED | RST_INITIALIZATION | RST_STEP_COMPLETE | RST_STEP_FAILED | \
-                       RST_TERMINATED | RST_ERROR)
-#define GET_MODES (RST_INITIALIZATION | RST_STEP_COMPLETE | RST_STEP_FAILED | RST_TERMINATED | RST_ERROR)
-#define SET_MODES (RST_INSTANTIATED | RST_INITIALIZATION | RST_STEP_COMPLETE)
+#define ANY_LIVE_MODE (RST_MODE_INSTANTIATED | RST_MODE_INITIALIZATION | RST_MODE_STEP_COMPLETE | RST_MODE_STEP_FAILED | \
+                       RST_MODE_TERMINATED | RST_MODE_ERROR)
+#define GET_MODES (RST_MODE_INITIALIZATION | RST_MODE_STEP_COMPLETE | RST_MODE_STEP_FAILED | RST_MODE_TERMINATED | RST_MODE_ERROR)
+#define SET_MODES (RST_MODE_INSTANTIATED | RST_MODE_INITIALIZATION | RST_MODE_STEP_COMPLETE)
 
 /* A message waiting to reach the host's logger: messages of a call are delivered after the call has
  * released the instance's lock, so a logger may call back into the same instance (FMI 2.0 does not
  * forbid it) without deadlocking, and finds the instance in a consistent state. */
 typedef struct rst_message {
     struct rst_message *next;
-    fmi2Status status;
+    rst_status status;
     const char *category; /* points into text[], after the message */
     char text[1];         /* the message (its '%' doubled), NUL, the category, NUL */
 } rst_message;
@@ -66,23 +88,44 @@ typedef struct rst_state {
     double values[1]; /* one per state variable of the table (allocated to size) */
 } rst_state;
 
+/* What an FMI version layer tells the core: its names, and how a message reaches the host. */
+typedef struct {
+    const char *prefix;     /* "fmi2" or "fmi3": the front of every FMI function name in messages */
+    const char *standard;   /* "FMI 2.0" or "FMI 3.0" */
+    const char *token_name; /* what the instantiation checks: "GUID" or "instantiation token" */
+    /* the FMU-state functions, whose spelling differs between the versions */
+    const char *get_state, *set_state, *deserialize_state, *serialized_state_size;
+    /* the names of the access kinds (rst_access, by bit: Real, Integer, Boolean, Enumeration) */
+    const char *type_names[4];
+    /* 1: value reference n_variables is the independent variable `time` (FMI 3.0 declares one), Real
+     * and read-only */
+    int time_variable;
+    /* hands one message to the host's logger, of the layer's type (cast back from host_logger) */
+    void (*emit)(void (*host_logger)(void), void *environment, const char *instance_name, rst_status status,
+                 const char *category, const char *message);
+} rst_api;
+
+typedef void *(*rst_allocate_fn)(size_t n, size_t size); /* zeroed, as calloc */
+typedef void (*rst_release_fn)(void *pointer);
+
 struct rst_instance {
     unsigned int magic;
     const rst_model *model;
+    const rst_api *api;
     char *name;
-    fmi2CallbackLogger logger;
-    fmi2CallbackAllocateMemory allocate;
-    fmi2CallbackFreeMemory release;
-    fmi2ComponentEnvironment environment;
+    void (*host_logger)(void); /* the host's logger, of the version layer's type (api->emit casts it back) */
+    void *environment;         /* what the host passes back to its logger */
+    rst_allocate_fn allocate;
+    rst_release_fn release;
     int logging_on;
     unsigned int categories;
     rst_mode mode;
-    int has_start;      /* fmi2SetupExperiment gave the start time */
+    int has_start;      /* the start time is known (fmi2SetupExperiment, fmi3EnterInitializationMode) */
     double start_time;
-    int has_time;       /* next_time is known: the t the next doStep must have */
+    int has_time;       /* next_time is known: the t the next step must have */
     double next_time;
     double last_time;   /* end of the last successful step (fmi2LastSuccessfulTime) */
-    fmi2Status last_step_status;
+    rst_status last_step_status;
     size_t n_state;     /* state variables of the table */
     rst_state *states;  /* FMU states made by this instance, to tell ours from any other pointer */
     double *store;
@@ -97,42 +140,105 @@ struct rst_instance {
 #endif
 };
 
+/* How the version layers name the variable types a get or set call is for (a variable's access kind:
+ * its rst_type, and Enumeration for an Integer with named codes, which FMI 3.0 gets and sets with the
+ * Int64 functions). A call passes the set of kinds it may touch. */
+typedef enum { RST_AS_REAL = 1, RST_AS_INTEGER = 2, RST_AS_BOOLEAN = 4, RST_AS_ENUMERATION = 8 } rst_access;
+
+/* The experiment an FMI 3.0 fmi3EnterInitializationMode (or FMI 2.0 fmi2SetupExperiment) gives. */
+typedef struct {
+    int tolerance_defined;
+    double tolerance;
+    double start_time;
+    int stop_time_defined;
+    double stop_time;
+} rst_experiment;
+
+/* Converters between the version's value arrays and the core's doubles (element i). */
+typedef double (*rst_read_fn)(const void *values, size_t i);
+typedef void (*rst_write_fn)(void *values, size_t i, double x);
+
 /* Entering and leaving an FMI call (rst_front.c). */
-rst_instance *front_instance(fmi2Component c); /* NULL unless c is one of our live instances */
+rst_instance *front_instance(void *c); /* NULL unless c is one of our live instances */
 void front_lock(rst_instance *inst);
 void front_unlock(rst_instance *inst); /* then delivers the messages the call logged */
 int front_allowed(rst_instance *inst, const char *function, unsigned int modes); /* logs why not */
-fmi2Status front_backend_status(rst_instance *inst, fmi2Status status);       /* Error, Fatal: change mode */
+rst_status front_backend_status(rst_instance *inst, rst_status status);       /* Error, Fatal: change mode */
 
 /* Values (rst_front.c). */
 int front_in_range(const rst_variable *var, double value);
 void front_describe_value(rst_type type, double value, char *out, size_t size);
 const char *front_type_name(rst_type type);
 
+/* The version-neutral FMI functions (rst_front.c): each checks its instance, locks it, checks the mode
+ * and its arguments, logs under the name `function` and returns the status the host sees. */
+/* A new instance (not yet one the host may use): NULL when out of memory (logged). */
+rst_instance *front_new_instance(const rst_api *api, void (*host_logger)(void), void *environment,
+                                 rst_allocate_fn allocate, rst_release_fn release, const char *function,
+                                 const char *name, int logging_on);
+/* Checks the GUID (FMI 3.0: instantiation token) and runs the backend's instantiate: the instance, or
+ * NULL (freed, with a message). */
+rst_instance *front_instantiate(rst_instance *inst, const char *function, const char *token,
+                                const char *resource_dir, int visible);
+void front_discard_instance(rst_instance *inst); /* frees an instance that never reached the host */
+void front_free_instance(void *c);
+/* `kinds`: the rst_access kinds this call may touch; `n_values` must equal `n` (one value each). */
+rst_status front_set(void *c, const char *function, unsigned int kinds, const rst_vr vr[], size_t n,
+                     const void *values, size_t n_values, rst_read_fn read);
+rst_status front_get(void *c, const char *function, unsigned int kinds, const rst_vr vr[], size_t n,
+                     void *values, size_t n_values, rst_write_fn write);
+/* A get or set of a type this FMU has no variables of (String, Float32, Binary, ...). */
+rst_status front_refuse_type(void *c, const char *function, const char *type_name, const rst_vr vr[], size_t n,
+                             int set);
+rst_status front_setup_experiment(void *c, const char *function, const rst_experiment *experiment);
+/* `experiment`: NULL for FMI 2.0 (fmi2SetupExperiment gave it), the arguments for FMI 3.0 */
+rst_status front_enter_initialization(void *c, const char *function, const rst_experiment *experiment);
+rst_status front_exit_initialization(void *c, const char *function);
+rst_status front_terminate(void *c, const char *function);
+rst_status front_reset(void *c, const char *function);
+/* `last_successful_time`: NULL, or where the end of the last successful step goes (FMI 3.0) */
+rst_status front_do_step(void *c, const char *function, double t, double h, double *last_successful_time);
+/* A call this FMU does not provide, or whose arguments the version layer found wrong, in one of
+ * `modes`: logs "<function>: <why>" and returns an error. */
+rst_status front_refuse(void *c, const char *function, unsigned int modes, const char *why);
+/* fmuResourceLocation (a file: URI) -> the path it names, in `path` (room for strlen(uri) + 1 bytes);
+ * NULL, or why it cannot be decoded. */
+const char *front_decode_file_uri(const char *uri, char *path);
+
 /* Messages (rst_log.c): the ones logged since front_lock, taken out of the instance (under its lock),
  * then handed to the logger (after it is released). */
 rst_message *front_take_messages(rst_instance *inst);
 void front_deliver_messages(rst_instance *inst, rst_message *messages);
+rst_status front_set_debug_logging(void *c, const char *function, int logging_on, size_t n,
+                                   const char *const categories[]);
 
 /* FMU states (rst_state.c). */
 void front_free_states(rst_instance *inst);
+rst_status front_get_state(void *c, const char *function, void **state);
+rst_status front_set_state(void *c, const char *function, void *state);
+rst_status front_free_state(void *c, const char *function, void **state);
+rst_status front_serialized_size(void *c, const char *function, void *state, size_t *size);
+rst_status front_serialize(void *c, const char *function, void *state, unsigned char bytes[], size_t size);
+rst_status front_deserialize(void *c, const char *function, const unsigned char bytes[], size_t size,
+                             void **state);
 
 /* The start of every FMI function of an instance: `inst` checked, locked, the call allowed in its
- * mode (else fmi2Error); LEAVE(status) unlocks and returns. */
+ * mode (else an error); LEAVE(status) unlocks and returns. (`status_` is an int: the version layers
+ * return it as their own status type.) */
 #define ENTER(function, modes)                     \
     rst_instance *inst = front_instance(c);        \
-    fmi2Status status_ = fmi2OK;                   \
+    int status_ = RST_OK;                          \
     if (inst == NULL)                              \
-        return fmi2Error;                          \
+        return (int)RST_ERROR;                     \
     front_lock(inst);                              \
     if (!front_allowed(inst, function, modes)) {   \
         front_unlock(inst);                        \
-        return fmi2Error;                          \
+        return (int)RST_ERROR;                     \
     }
 
 #define LEAVE(status)          \
     do {                       \
-        status_ = status;      \
+        status_ = (int)(status); \
         front_unlock(inst);    \
         return status_;        \
     } while (0)

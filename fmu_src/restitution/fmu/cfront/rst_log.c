@@ -1,5 +1,5 @@
 /* The front's messages: formatting values as Python's repr() does, log categories, delivery to the
- * host's logger, fmi2SetDebugLogging. */
+ * host's logger (through the version layer's emit), fmi2SetDebugLogging and fmi3SetDebugLogging. */
 #include "rst_front_internal.h"
 
 #include <math.h>
@@ -84,13 +84,13 @@ void rst_format_double(double x, char *out, size_t size)
     }
 }
 
-static unsigned int category_of(fmi2Status status)
+static unsigned int category_of(rst_status status)
 {
     switch (status) {
-    case fmi2Warning: return CAT_WARNING;
-    case fmi2Discard: return CAT_DISCARD;
-    case fmi2Error: return CAT_ERROR;
-    case fmi2Fatal: return CAT_FATAL;
+    case RST_WARNING: return CAT_WARNING;
+    case RST_DISCARD: return CAT_DISCARD;
+    case RST_ERROR: return CAT_ERROR;
+    case RST_FATAL: return CAT_FATAL;
     default: return CAT_ALL;
     }
 }
@@ -104,18 +104,15 @@ static const char *category_name(unsigned int bit)
     return "logAll";
 }
 
-/* The host's logger treats the message as a printf format: every '%' of the text is doubled. During a
- * call (the instance locked) the message waits until the call has released the lock
- * (front_unlock); otherwise, in fmi2Instantiate and fmi2FreeInstance, it goes to the logger at once. */
-static void deliver(rst_instance *inst, fmi2Status status, const char *category, const char *text)
+/* During a call (the instance locked) the message waits until the call has released the lock
+ * (front_unlock); otherwise, in instantiation and freeing, it goes to the logger at once. */
+static void deliver(rst_instance *inst, rst_status status, const char *category, const char *text)
 {
-    char escaped[2 * MESSAGE_SIZE];
-    size_t k = 0, n_category;
-    const char *p;
+    size_t k, n_category;
     rst_message *message;
-    if (inst->logger == NULL)
+    if (inst->host_logger == NULL)
         return;
-    if (status == fmi2OK || status == fmi2Pending) {
+    if (status == RST_OK) {
         unsigned int bit = CAT_ALL;
         int i;
         for (i = 0; category && i < N_CATEGORIES; i++)
@@ -124,21 +121,16 @@ static void deliver(rst_instance *inst, fmi2Status status, const char *category,
         if (!inst->logging_on || !(inst->categories & bit))
             return;
     }
-    for (p = text; *p && k + 2 < sizeof escaped; p++) {
-        if (*p == '%')
-            escaped[k++] = '%';
-        escaped[k++] = *p;
-    }
-    escaped[k] = '\0';
     if (!inst->in_call) {
-        inst->logger(inst->environment, inst->name, status, category, escaped);
+        inst->api->emit(inst->host_logger, inst->environment, inst->name, status, category, text);
         return;
     }
+    k = strlen(text);
     n_category = strlen(category);
     message = (rst_message *)inst->allocate(1, sizeof *message + k + n_category + 1);
     if (message == NULL)
         return; /* out of memory: the call's status still tells the host what happened */
-    memcpy(message->text, escaped, k + 1);
+    memcpy(message->text, text, k + 1);
     memcpy(message->text + k + 1, category, n_category + 1);
     message->category = message->text + k + 1;
     message->status = status;
@@ -158,24 +150,25 @@ rst_message *front_take_messages(rst_instance *inst)
 /* Called without the lock: the logger may call this instance again. */
 void front_deliver_messages(rst_instance *inst, rst_message *messages)
 {
-    fmi2CallbackLogger logger = inst->logger;
-    fmi2ComponentEnvironment environment = inst->environment;
-    fmi2CallbackFreeMemory release = inst->release;
+    const rst_api *api = inst->api;
+    void (*logger)(void) = inst->host_logger;
+    void *environment = inst->environment;
+    rst_release_fn release = inst->release;
     const char *name = inst->name;
     while (messages != NULL) {
         rst_message *next = messages->next;
-        logger(environment, name, messages->status, messages->category, messages->text);
+        api->emit(logger, environment, name, messages->status, messages->category, messages->text);
         release(messages);
         messages = next;
     }
 }
 
-void rst_log_text(rst_instance *inst, fmi2Status status, const char *category, const char *text)
+void rst_log_text(rst_instance *inst, rst_status status, const char *category, const char *text)
 {
     deliver(inst, status, category ? category : category_name(category_of(status)), text ? text : "");
 }
 
-void rst_log(rst_instance *inst, fmi2Status status, const char *format, ...)
+void rst_log(rst_instance *inst, rst_status status, const char *format, ...)
 {
     char message[MESSAGE_SIZE];
     va_list args;
@@ -185,18 +178,18 @@ void rst_log(rst_instance *inst, fmi2Status status, const char *format, ...)
     deliver(inst, status, category_name(category_of(status)), message);
 }
 
-fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn, size_t nCategories,
-                               const fmi2String categories[])
+rst_status front_set_debug_logging(void *c, const char *function, int logging_on, size_t n,
+                                   const char *const categories[])
 {
     size_t i;
     unsigned int bits = 0;
     int k;
-    ENTER("fmi2SetDebugLogging", ANY_LIVE_MODE)
-    if (nCategories > 0 && categories == NULL) {
-        rst_log(inst, fmi2Error, "fmi2SetDebugLogging: %u categories but a NULL array", (unsigned int)nCategories);
-        LEAVE(fmi2Error);
+    ENTER(function, ANY_LIVE_MODE)
+    if (n > 0 && categories == NULL) {
+        rst_log(inst, RST_ERROR, "%s: %u categories but a NULL array", function, (unsigned int)n);
+        LEAVE(RST_ERROR);
     }
-    for (i = 0; i < nCategories; i++) {
+    for (i = 0; i < n; i++) {
         int found = 0;
         for (k = 0; categories[i] != NULL && k < N_CATEGORIES; k++)
             if (strcmp(categories[i], CATEGORY_NAMES[k]) == 0) {
@@ -204,14 +197,13 @@ fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn, size_t nC
                 found = 1;
             }
         if (!found) {
-            rst_log(inst, fmi2Error, "fmi2SetDebugLogging: unknown log category %s (this FMU has logStatusWarning, "
-                    "logStatusDiscard, logStatusError, logStatusFatal and logAll)",
+            rst_log(inst, RST_ERROR, "%s: unknown log category %s (this FMU has logStatusWarning, "
+                    "logStatusDiscard, logStatusError, logStatusFatal and logAll)", function,
                     categories[i] ? categories[i] : "(NULL)");
-            LEAVE(fmi2Error);
+            LEAVE(RST_ERROR);
         }
     }
-    inst->logging_on = loggingOn != fmi2False;
-    inst->categories = nCategories > 0 ? bits : RST_ALL_CATEGORIES;
-    LEAVE(fmi2OK);
+    inst->logging_on = logging_on != 0;
+    inst->categories = n > 0 ? bits : RST_ALL_CATEGORIES;
+    LEAVE(RST_OK);
 }
-

@@ -1,13 +1,14 @@
 /* The front's FMU states: snapshots of the store's state variables, the communication point and the
- * mode; fmi2Get/Set/FreeFMUstate and their serialization (versioned, checksummed, little-endian),
- * every restored value checked as fmi2SetXXX would. */
+ * mode; getting, setting and freeing them and their serialization (versioned, checksummed,
+ * little-endian, the same bytes whatever the FMI version), every restored value checked as a set
+ * call would. */
 #include "rst_front_internal.h"
 
 #include <math.h>
 #include <stdint.h>
 #include <string.h>
 
-#define RST_STATE_FORMAT 1u /* serialized layout version (see fmi2SerializeFMUstate) */
+#define RST_STATE_FORMAT 1u /* serialized layout version (see front_serialize) */
 
 void front_free_states(rst_instance *inst)
 {
@@ -61,39 +62,39 @@ static void unlink_state(rst_instance *inst, rst_state *state)
 }
 
 /* `*pointer`: NULL (a new state) or one of ours (overwritten). Logs and returns NULL otherwise. */
-static rst_state *target_state(rst_instance *inst, const char *function, fmi2FMUstate *pointer)
+static rst_state *target_state(rst_instance *inst, const char *function, void **pointer)
 {
     rst_state *s;
     if (pointer == NULL) {
-        rst_log(inst, fmi2Error, "%s: the FMUstate pointer is NULL", function);
+        rst_log(inst, RST_ERROR, "%s: the FMUstate pointer is NULL", function);
         return NULL;
     }
     if (*pointer == NULL) {
         s = new_state(inst);
         if (s == NULL)
-            rst_log(inst, fmi2Error, "%s: out of memory", function);
+            rst_log(inst, RST_ERROR, "%s: out of memory", function);
         return s;
     }
     s = find_state(inst, *pointer);
     if (s == NULL)
-        rst_log(inst, fmi2Error, "%s: *FMUstate is neither NULL nor a state of this instance", function);
+        rst_log(inst, RST_ERROR, "%s: *FMUstate is neither NULL nor a state of this instance", function);
     return s;
 }
 
-fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *FMUstate)
+rst_status front_get_state(void *c, const char *function, void **FMUstate)
 {
     rst_state *s;
     size_t i, k = 0;
-    fmi2Status status = fmi2OK;
-    ENTER("fmi2GetFMUstate", ANY_LIVE_MODE)
+    rst_status status = RST_OK;
+    ENTER(function, ANY_LIVE_MODE)
     if (inst->model->save_state != NULL) {
         status = front_backend_status(inst, inst->model->save_state(inst));
-        if (status >= fmi2Error)
+        if (status >= RST_ERROR)
             LEAVE(status);
     }
-    s = target_state(inst, "fmi2GetFMUstate", FMUstate);
+    s = target_state(inst, function, FMUstate);
     if (s == NULL)
-        LEAVE(fmi2Error);
+        LEAVE(RST_ERROR);
     s->mode = inst->mode;
     s->has_start = inst->has_start;
     s->has_time = inst->has_time;
@@ -108,14 +109,14 @@ fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *FMUstate)
 }
 
 /* Is every value of a snapshot one this instance could hold? (A deserialized state passes here
- * before it becomes a state; checks as fmi2SetXXX would, plus the types of the other variables.) */
+ * before it becomes a state; checks as a set call would, plus the types of the other variables.) */
 static int check_snapshot(rst_instance *inst, const char *function, const rst_state *s)
 {
     size_t i, k = 0;
     char text[40];
     if (!(s->mode & (ANY_LIVE_MODE)) || !isfinite(s->start_time) || !isfinite(s->next_time) ||
         !isfinite(s->last_time)) {
-        rst_log(inst, fmi2Error, "%s: the state's mode or times are invalid", function);
+        rst_log(inst, RST_ERROR, "%s: the state's mode or times are invalid", function);
         return 0;
     }
     for (i = 0; i < inst->model->n_variables; i++) {
@@ -128,16 +129,16 @@ static int check_snapshot(rst_instance *inst, const char *function, const rst_st
         if (var->causality == RST_INPUT || var->causality == RST_PARAMETER) {
             if (!front_in_range(var, value) ||
                 (var->type == RST_INTEGER && value != floor(value))) {
-                rst_log(inst, fmi2Error, "%s: the state has %s = %s, outside the allowed range: %s", function,
+                rst_log(inst, RST_ERROR, "%s: the state has %s = %s, outside the allowed range: %s", function,
                         var->name, text, var->range_text ? var->range_text : "finite");
                 return 0;
             }
-            if (inst->model->accept != NULL && inst->model->accept(inst, var, value) != fmi2OK)
+            if (inst->model->accept != NULL && inst->model->accept(inst, var, value) != RST_OK)
                 return 0;
         } else if ((var->type == RST_BOOLEAN && value != 0.0 && value != 1.0) ||
                    (var->type == RST_INTEGER &&
                     !(value == floor(value) && value >= -2147483648.0 && value <= 2147483647.0))) {
-            rst_log(inst, fmi2Error, "%s: the state has %s = %s, not a valid %s", function, var->name, text,
+            rst_log(inst, RST_ERROR, "%s: the state has %s = %s, not a valid %s", function, var->name, text,
                     front_type_name(var->type));
             return 0;
         }
@@ -145,17 +146,17 @@ static int check_snapshot(rst_instance *inst, const char *function, const rst_st
     return 1;
 }
 
-fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate FMUstate)
+rst_status front_set_state(void *c, const char *function, void *FMUstate)
 {
     rst_state *s;
     size_t i, k = 0;
-    fmi2Status status = fmi2OK;
-    ENTER("fmi2SetFMUstate", ANY_LIVE_MODE)
+    rst_status status = RST_OK;
+    ENTER(function, ANY_LIVE_MODE)
     s = find_state(inst, FMUstate);
     if (s == NULL) {
-        rst_log(inst, fmi2Error, "fmi2SetFMUstate: the FMUstate is not a state of this instance (states are made by "
-                "fmi2GetFMUstate or fmi2DeSerializeFMUstate of the same instance)");
-        LEAVE(fmi2Error);
+        rst_log(inst, RST_ERROR, "%s: the FMUstate is not a state of this instance (states are made by "
+                "%s or %s of the same instance)", function, inst->api->get_state, inst->api->deserialize_state);
+        LEAVE(RST_ERROR);
     }
     for (i = 0; i < inst->model->n_variables; i++)
         if (inst->model->variables[i].state)
@@ -166,26 +167,26 @@ fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate FMUstate)
     inst->start_time = s->start_time;
     inst->next_time = s->next_time;
     inst->last_time = s->last_time;
-    inst->last_step_status = fmi2OK;
+    inst->last_step_status = RST_OK;
     if (inst->model->restore_state != NULL)
         status = front_backend_status(inst, inst->model->restore_state(inst));
     LEAVE(status);
 }
 
-fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate *FMUstate)
+rst_status front_free_state(void *c, const char *function, void **FMUstate)
 {
     rst_state *s;
-    ENTER("fmi2FreeFMUstate", ANY_LIVE_MODE)
+    ENTER(function, ANY_LIVE_MODE)
     if (FMUstate == NULL || *FMUstate == NULL)
-        LEAVE(fmi2OK); /* nothing to free */
+        LEAVE(RST_OK); /* nothing to free */
     s = find_state(inst, *FMUstate);
     if (s == NULL) {
-        rst_log(inst, fmi2Error, "fmi2FreeFMUstate: the FMUstate is not a state of this instance");
-        LEAVE(fmi2Error);
+        rst_log(inst, RST_ERROR, "%s: the FMUstate is not a state of this instance", function);
+        LEAVE(RST_ERROR);
     }
     unlink_state(inst, s);
     *FMUstate = NULL;
-    LEAVE(fmi2OK);
+    LEAVE(RST_OK);
 }
 
 /* Serialized layout (little-endian whatever the platform):
@@ -240,31 +241,32 @@ static uint64_t fnv1a(const unsigned char *bytes, size_t n)
     return hash;
 }
 
-fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate FMUstate, size_t *size)
+rst_status front_serialized_size(void *c, const char *function, void *FMUstate, size_t *size)
 {
-    ENTER("fmi2SerializedFMUstateSize", ANY_LIVE_MODE)
+    ENTER(function, ANY_LIVE_MODE)
     if (size == NULL || find_state(inst, FMUstate) == NULL) {
-        rst_log(inst, fmi2Error, "fmi2SerializedFMUstateSize: %s", size == NULL ? "size is NULL"
+        rst_log(inst, RST_ERROR, "%s: %s", function, size == NULL ? "size is NULL"
                 : "the FMUstate is not a state of this instance");
-        LEAVE(fmi2Error);
+        LEAVE(RST_ERROR);
     }
     *size = serialized_size(inst);
-    LEAVE(fmi2OK);
+    LEAVE(RST_OK);
 }
 
-fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate FMUstate, fmi2Byte serializedState[], size_t size)
+rst_status front_serialize(void *c, const char *function, void *FMUstate, unsigned char serializedState[], size_t size)
 {
     rst_state *s;
     unsigned char *p;
     size_t i, k = 0;
-    ENTER("fmi2SerializeFMUstate", ANY_LIVE_MODE)
+    ENTER(function, ANY_LIVE_MODE)
     s = find_state(inst, FMUstate);
     if (s == NULL || serializedState == NULL || size < serialized_size(inst)) {
-        rst_log(inst, fmi2Error, "fmi2SerializeFMUstate: %s",
+        rst_log(inst, RST_ERROR, "%s: %s%s%s", function,
                 s == NULL ? "the FMUstate is not a state of this instance"
                 : serializedState == NULL ? "the byte array is NULL"
-                : "the byte array is smaller than fmi2SerializedFMUstateSize says");
-        LEAVE(fmi2Error);
+                : "the byte array is smaller than ", s != NULL && serializedState != NULL ?
+                inst->api->serialized_state_size : "", s != NULL && serializedState != NULL ? " says" : "");
+        LEAVE(RST_ERROR);
     }
     p = (unsigned char *)serializedState;
     memcpy(p, SERIAL_MAGIC, 8);
@@ -286,7 +288,7 @@ fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate FMUstate, fmi2Byt
             put_f64(&p, s->values[k++]);
         }
     put_u64(&p, fnv1a((const unsigned char *)serializedState, (size_t)(p - (unsigned char *)serializedState)));
-    LEAVE(fmi2OK);
+    LEAVE(RST_OK);
 }
 
 /* A reader that never goes past the end of the bytes. */
@@ -331,7 +333,7 @@ static int get_text_equal(reader *r, const char *expected)
 }
 
 /* Reads serialized bytes into the snapshot `s` (room for n_state values); NULL, or what is wrong. */
-static const char *read_snapshot(const rst_instance *inst, const fmi2Byte bytes[], size_t size, rst_state *s)
+static const char *read_snapshot(const rst_instance *inst, const unsigned char bytes[], size_t size, rst_state *s)
 {
     reader r;
     size_t i, k = 0;
@@ -371,38 +373,38 @@ static const char *read_snapshot(const rst_instance *inst, const fmi2Byte bytes[
     return r.p == r.end ? NULL : "the state has trailing bytes";
 }
 
-fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte serializedState[], size_t size,
-                                   fmi2FMUstate *FMUstate)
+rst_status front_deserialize(void *c, const char *function, const unsigned char serializedState[], size_t size,
+                             void **FMUstate)
 {
     rst_state *s, *target;
     const char *problem;
-    ENTER("fmi2DeSerializeFMUstate", ANY_LIVE_MODE)
+    ENTER(function, ANY_LIVE_MODE)
     if (serializedState == NULL || FMUstate == NULL) {
-        rst_log(inst, fmi2Error, "fmi2DeSerializeFMUstate: NULL %s", serializedState == NULL ? "bytes" : "FMUstate pointer");
-        LEAVE(fmi2Error);
+        rst_log(inst, RST_ERROR, "%s: NULL %s", function, serializedState == NULL ? "bytes" : "FMUstate pointer");
+        LEAVE(RST_ERROR);
     }
     if (*FMUstate != NULL && find_state(inst, *FMUstate) == NULL) {
-        rst_log(inst, fmi2Error, "fmi2DeSerializeFMUstate: *FMUstate is neither NULL nor a state of this instance");
-        LEAVE(fmi2Error);
+        rst_log(inst, RST_ERROR, "%s: *FMUstate is neither NULL nor a state of this instance", function);
+        LEAVE(RST_ERROR);
     }
     s = (rst_state *)inst->allocate(1, state_bytes(inst));
     if (s == NULL) {
-        rst_log(inst, fmi2Error, "fmi2DeSerializeFMUstate: out of memory");
-        LEAVE(fmi2Error);
+        rst_log(inst, RST_ERROR, "%s: out of memory", function);
+        LEAVE(RST_ERROR);
     }
     problem = read_snapshot(inst, serializedState, size, s);
     if (problem != NULL)
-        rst_log(inst, fmi2Error, "fmi2DeSerializeFMUstate: %s; nothing was changed", problem);
-    /* checked like fmi2SetXXX before it may become a state */
-    if (problem != NULL || !check_snapshot(inst, "fmi2DeSerializeFMUstate", s) ||
-        (target = target_state(inst, "fmi2DeSerializeFMUstate", FMUstate)) == NULL) {
+        rst_log(inst, RST_ERROR, "%s: %s; nothing was changed", function, problem);
+    /* checked like a set call before it may become a state */
+    if (problem != NULL || !check_snapshot(inst, function, s) ||
+        (target = target_state(inst, function, FMUstate)) == NULL) {
         inst->release(s);
-        LEAVE(fmi2Error);
+        LEAVE(RST_ERROR);
     }
     s->magic = RST_STATE_MAGIC;
     s->next = target->next;
     memcpy(target, s, state_bytes(inst));
     inst->release(s);
     *FMUstate = target;
-    LEAVE(fmi2OK);
+    LEAVE(RST_OK);
 }

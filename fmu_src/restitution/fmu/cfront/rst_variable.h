@@ -7,7 +7,7 @@
 #ifndef RST_VARIABLE_H
 #define RST_VARIABLE_H
 
-#define RST_VARIABLE_LAYOUT 2
+#define RST_VARIABLE_LAYOUT 3
 
 typedef enum { RST_REAL, RST_INTEGER, RST_BOOLEAN } rst_type;
 /* RST_CALCULATEDPARAMETER: computed from the parameters by the backend, read like an output, never set */
@@ -18,6 +18,7 @@ typedef struct {
     unsigned int vr;         /* value reference (= index in the table) */
     const char *name;
     rst_type type;
+    int enumeration;         /* 1: an Integer whose values are named codes (FMI 3.0: an Enumeration, got and set as Int64) */
     rst_causality causality;
     rst_variability variability;
     int state;               /* 1: part of the FMU state (inputs, parameters and the model's own evolving variables) */

@@ -12,7 +12,7 @@
 #define RST_PHYSICS_H
 
 #include "rst_prefix.h"
-#if defined(FMI2_FUNCTION_PREFIX)
+#if defined(RST_PREFIXED)
 #define rst_impact RST_PREFIXED(rst_impact)
 #define rst_zener_solution RST_PREFIXED(rst_zener_solution)
 #endif

@@ -157,7 +157,7 @@ typedef struct {
 /* ------------------------------------------------------------------------ */
 /* Helpers                                                                  */
 /* ------------------------------------------------------------------------ */
-#define LOG_ERROR(...) rst_log(inst, fmi2Error, __VA_ARGS__)
+#define LOG_ERROR(...) rst_log(inst, RST_ERROR, __VA_ARGS__)
 
 static int file_exists(const char *path)
 {
@@ -515,7 +515,7 @@ static int init_with_pyconfig(const guard_config *cfg, rst_instance *inst)
         if (st._type == 0) st = setBytes(&config, &config.executable, cfg->executable);
     } else if (cfg->home[0]) {
         char base_exe[PATH_MAX + 32];
-        rst_log(inst, fmi2Warning, "Python executable %s (recorded in %s) does not exist; starting the interpreter with home=%s",
+        rst_log(inst, RST_WARNING, "Python executable %s (recorded in %s) does not exist; starting the interpreter with home=%s",
                  cfg->executable, cfg->file, cfg->home);
         st = setBytes(&config, &config.home, cfg->home);
         if (st._type == 0 && base_executable(cfg, base_exe, sizeof base_exe)) {
@@ -550,7 +550,7 @@ static int init_legacy(const guard_config *cfg, rst_instance *inst)
     } else if (cfg->home[0] && file_exists(cfg->home) && py.Py_SetPythonHome) {
         static wchar_t *home, *program;
         char base_exe[PATH_MAX + 32];
-        rst_log(inst, fmi2Warning, "Python executable %s (recorded in %s) does not exist; starting the interpreter with home=%s",
+        rst_log(inst, RST_WARNING, "Python executable %s (recorded in %s) does not exist; starting the interpreter with home=%s",
                  cfg->executable, cfg->file, cfg->home);
         home = py.Py_DecodeLocale(cfg->home, NULL);
         if (home) py.Py_SetPythonHome(home);
@@ -612,7 +612,7 @@ static int ensure_ready(rst_instance *inst, const char *resource_dir)
             return 0;
         }
         g_guard_managed = interpreter_is_guard_managed();
-        rst_log(inst, fmi2OK, "pythonfmu guard: using the Python %s already running "
+        rst_log(inst, RST_OK, "pythonfmu guard: using the Python %s already running "
                      "in this process%s", py.Py_GetVersion(), g_guard_managed ? " (started by another FMU)" : "");
     } else {
         if (!have_cfg) {
@@ -641,7 +641,7 @@ static int ensure_ready(rst_instance *inst, const char *resource_dir)
         }
         const char *loaded = py.Py_GetVersion();
         if (cfg.version[0] && !same_major_minor(loaded, cfg.version))
-            rst_log(inst, fmi2Warning,     "%s is Python %.10s but the FMU was built with Python %s", cfg.libpython, loaded, cfg.version);
+            rst_log(inst, RST_WARNING,     "%s is Python %.10s but the FMU was built with Python %s", cfg.libpython, loaded, cfg.version);
         if (py.Py_IsInitialized()) {
             g_guard_managed = interpreter_is_guard_managed();
         } else {
@@ -661,7 +661,7 @@ static int ensure_ready(rst_instance *inst, const char *resource_dir)
             py.PyEval_SaveThread(); /* release the GIL; pythonfmu uses PyGILState_Ensure */
             t_attached = 1;         /* this thread keeps the main thread state */
             g_guard_managed = 1;
-            rst_log(inst, fmi2OK, "pythonfmu guard: started embedded Python %s from %s (config %s)",
+            rst_log(inst, RST_OK, "pythonfmu guard: started embedded Python %s from %s (config %s)",
                          py.Py_GetVersion(), cfg.libpython, cfg.file);
         }
     }
@@ -686,7 +686,7 @@ static int ensure_ready(rst_instance *inst, const char *resource_dir)
             LOG_ERROR("%s", msg + 2);
             return 0;
         }
-        if (msg[0] == 'W') rst_log(inst, fmi2Warning, "%s", msg + 2);
+        if (msg[0] == 'W') rst_log(inst, RST_WARNING, "%s", msg + 2);
     }
 
     if (!g_real) {

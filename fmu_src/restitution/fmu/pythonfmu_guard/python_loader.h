@@ -2,6 +2,7 @@
 #ifndef PYTHON_LOADER_H
 #define PYTHON_LOADER_H
 
+#include "fmi2Functions.h" /* pythonfmu's binary is an FMI 2.0 FMU */
 #include "rst_front.h"
 
 /* pythonfmu's exported FMI functions the guard forwards to (its fmi2Component is pythonfmu's own). */

@@ -192,7 +192,7 @@ static void slot_logger(fmi2ComponentEnvironment environment, fmi2String instanc
     slot *s = (slot *)environment;
     (void)instance_name;
     if (s != NULL && s->owner != NULL)
-        rst_log_text(s->owner, status, category, message); /* pythonfmu passes no format arguments */
+        rst_log_text(s->owner, (rst_status)status, category, message); /* pythonfmu passes no format arguments */
 }
 
 static void *slot_allocate(size_t n, size_t size) { return calloc(n, size); }
@@ -222,7 +222,7 @@ static int pythonfmu_uri(rst_instance *inst, const char *dir, char *uri, size_t 
     {
         int fd = open(dir, O_RDONLY | O_DIRECTORY | O_CLOEXEC); /* kept open: the slot lives as long */
         if (fd < 0) {
-            rst_log(inst, fmi2Error, "fmi2Instantiate: cannot open the resources directory %s", dir);
+            rst_log(inst, RST_ERROR, "fmi2Instantiate: cannot open the resources directory %s", dir);
             return 0;
         }
         snprintf(uri, size, "file:///proc/self/fd/%d", fd);
@@ -230,13 +230,13 @@ static int pythonfmu_uri(rst_instance *inst, const char *dir, char *uri, size_t 
     }
 }
 
-static slot *new_slot(rst_instance *inst, const pythonfmu_api *api, const char *resource_dir, fmi2Boolean visible)
+static slot *new_slot(rst_instance *inst, const pythonfmu_api *api, const char *resource_dir, int visible)
 {
     char uri[4200];
     pyloader_call call;
     slot *s = (slot *)calloc(1, sizeof(slot) + strlen(resource_dir));
     if (s == NULL) {
-        rst_log(inst, fmi2Error, "fmi2Instantiate: out of memory");
+        rst_log(inst, RST_ERROR, "fmi2Instantiate: out of memory");
         return NULL;
     }
     {
@@ -254,7 +254,7 @@ static slot *new_slot(rst_instance *inst, const pythonfmu_api *api, const char *
                                visible, fmi2True);
     end_call(&call);
     if (s->real == NULL) {
-        rst_log(inst, fmi2Error, "fmi2Instantiate: pythonfmu could not instantiate the slave from %s (see the "
+        rst_log(inst, RST_ERROR, "fmi2Instantiate: pythonfmu could not instantiate the slave from %s (see the "
                 "message above)", resource_dir);
         free(s); /* pythonfmu keeps nothing of a failed instance */
         return NULL;
@@ -277,13 +277,13 @@ static int check_resources(rst_instance *inst, const char *dir)
     FILE *f;
     size_t n;
     if (stat(dir, &st) != 0 || !S_ISDIR(st.st_mode)) {
-        rst_log(inst, fmi2Error, "fmi2Instantiate: the resource location %s is not a directory", dir);
+        rst_log(inst, RST_ERROR, "fmi2Instantiate: the resource location %s is not a directory", dir);
         return 0;
     }
     snprintf(path, sizeof path, "%s/slavemodule.txt", dir);
     f = fopen(path, "r");
     if (f == NULL || fgets(module, sizeof module, f) == NULL) {
-        rst_log(inst, fmi2Error, "fmi2Instantiate: cannot read %s (it names the Python slave module)", path);
+        rst_log(inst, RST_ERROR, "fmi2Instantiate: cannot read %s (it names the Python slave module)", path);
         if (f)
             fclose(f);
         return 0;
@@ -293,29 +293,29 @@ static int check_resources(rst_instance *inst, const char *dir)
     module[n] = '\0';
     snprintf(path, sizeof path, "%s/%s.py", dir, module);
     if (n == 0 || stat(path, &st) != 0 || !S_ISREG(st.st_mode)) {
-        rst_log(inst, fmi2Error, "fmi2Instantiate: the Python slave script %s does not exist", path);
+        rst_log(inst, RST_ERROR, "fmi2Instantiate: the Python slave script %s does not exist", path);
         return 0;
     }
     return 1;
 }
 
-static fmi2Status instantiate(rst_instance *inst, const char *resource_dir, fmi2Boolean visible)
+static rst_status instantiate(rst_instance *inst, const char *resource_dir, int visible)
 {
     guard *g = (guard *)rst_backend(inst);
     if (resource_dir == NULL) {
-        rst_log(inst, fmi2Error, "fmi2Instantiate: no fmuResourceLocation: this FMU runs the Python code in its "
+        rst_log(inst, RST_ERROR, "fmi2Instantiate: no fmuResourceLocation: this FMU runs the Python code in its "
                 "resources directory");
-        return fmi2Error;
+        return RST_ERROR;
     }
     if (!check_resources(inst, resource_dir))
-        return fmi2Error;
+        return RST_ERROR;
     g->api = pyloader_ensure_ready(inst, resource_dir);
     if (g->api == NULL)
-        return fmi2Error;
+        return RST_ERROR;
     g->slot = take_slot(inst, resource_dir);
     if (g->slot == NULL)
         g->slot = new_slot(inst, g->api, resource_dir, visible);
-    return g->slot != NULL ? fmi2OK : fmi2Error;
+    return g->slot != NULL ? RST_OK : RST_ERROR;
 }
 
 static void free_instance(rst_instance *inst)
@@ -326,7 +326,7 @@ static void free_instance(rst_instance *inst)
     pyloader_call call;
     if (s == NULL)
         return;
-    if (rst_mode_of(inst) != RST_FATAL && !s->poisoned) {
+    if (rst_mode_of(inst) != RST_MODE_FATAL && !s->poisoned) {
         begin_call(&call);
         status = g->api->Reset(s->real); /* a fresh slave object for the next owner */
         end_call(&call);
@@ -338,8 +338,8 @@ static void free_instance(rst_instance *inst)
     pthread_mutex_unlock(&pool_lock);
 }
 
-static fmi2Status setup_experiment(rst_instance *inst, fmi2Boolean tolerance_defined, double tolerance,
-                                   double start_time, fmi2Boolean stop_time_defined, double stop_time)
+static rst_status setup_experiment(rst_instance *inst, int tolerance_defined, double tolerance,
+                                   double start_time, int stop_time_defined, double stop_time)
 {
     fmi2Status status;
     pyloader_call call;
@@ -347,25 +347,25 @@ static fmi2Status setup_experiment(rst_instance *inst, fmi2Boolean tolerance_def
     status = API(inst)->SetupExperiment(REAL(inst), tolerance_defined, tolerance, start_time, stop_time_defined,
                                         stop_time);
     end_call(&call);
-    return status;
+    return (rst_status)status;
 }
 
 #define FORWARD(name)                                         \
-    static fmi2Status forward_##name(rst_instance *inst)      \
+    static rst_status forward_##name(rst_instance *inst)      \
     {                                                         \
         fmi2Status status;                                    \
         pyloader_call call;                                     \
         begin_call(&call);                                    \
         status = API(inst)->name(REAL(inst));                 \
         end_call(&call);                                      \
-        return status;                                        \
+        return (rst_status)status;                            \
     }
 FORWARD(EnterInitializationMode)
 FORWARD(ExitInitializationMode)
 FORWARD(Terminate)
 FORWARD(Reset)
 
-static fmi2Status set_values(rst_instance *inst, rst_type type, const fmi2ValueReference vr[], size_t n,
+static rst_status set_values(rst_instance *inst, rst_type type, const rst_vr vr[], size_t n,
                              const double values[])
 {
     fmi2Integer integers[64];
@@ -389,10 +389,10 @@ static fmi2Status set_values(rst_instance *inst, rst_type type, const fmi2ValueR
         }
     }
     end_call(&call);
-    return status;
+    return (rst_status)status;
 }
 
-static fmi2Status get_values(rst_instance *inst, rst_type type, const fmi2ValueReference vr[], size_t n,
+static rst_status get_values(rst_instance *inst, rst_type type, const rst_vr vr[], size_t n,
                              double values[])
 {
     fmi2Integer integers[64];
@@ -416,17 +416,17 @@ static fmi2Status get_values(rst_instance *inst, rst_type type, const fmi2ValueR
         }
     }
     end_call(&call);
-    return status;
+    return (rst_status)status;
 }
 
-static fmi2Status do_step(rst_instance *inst, double t, double h)
+static rst_status do_step(rst_instance *inst, double t, double h)
 {
     fmi2Status status;
     pyloader_call call;
     begin_call(&call);
     status = API(inst)->DoStep(REAL(inst), t, h, fmi2True);
     end_call(&call);
-    return status;
+    return (rst_status)status;
 }
 
 /* The state variables that are not inputs or parameters, by type (those the slave evolves). */
@@ -441,31 +441,31 @@ static size_t evolving(rst_type type, fmi2ValueReference vr[], size_t size)
     return n;
 }
 
-static fmi2Status save_state(rst_instance *inst)
+static rst_status save_state(rst_instance *inst)
 {
     fmi2ValueReference vr[RST_MODEL_N_VARIABLES];
     double values[RST_MODEL_N_VARIABLES];
-    fmi2Status status = fmi2OK;
+    rst_status status = RST_OK;
     int t;
-    for (t = RST_REAL; t <= RST_BOOLEAN && status <= fmi2Warning; t++) {
+    for (t = RST_REAL; t <= RST_BOOLEAN && status <= RST_WARNING; t++) {
         size_t n = evolving((rst_type)t, vr, RST_MODEL_N_VARIABLES), i;
         if (n == 0)
             continue;
         status = get_values(inst, (rst_type)t, vr, n, values);
-        for (i = 0; i < n && status <= fmi2Warning; i++)
+        for (i = 0; i < n && status <= RST_WARNING; i++)
             rst_store(inst)[vr[i]] = values[i];
     }
     return status;
 }
 
-static fmi2Status restore_state(rst_instance *inst)
+static rst_status restore_state(rst_instance *inst)
 {
     fmi2ValueReference vr[RST_MODEL_N_VARIABLES];
     double values[RST_MODEL_N_VARIABLES];
-    fmi2Status status = fmi2OK;
+    rst_status status = RST_OK;
     int t;
     size_t i;
-    for (t = RST_REAL; t <= RST_BOOLEAN && status <= fmi2Warning; t++) {
+    for (t = RST_REAL; t <= RST_BOOLEAN && status <= RST_WARNING; t++) {
         size_t n = 0;
         for (i = 0; i < RST_MODEL_N_VARIABLES; i++)
             if (RST_MODEL_VARIABLES[i].state && RST_MODEL_VARIABLES[i].type == (rst_type)t) {

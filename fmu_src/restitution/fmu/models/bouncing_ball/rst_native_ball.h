@@ -9,7 +9,7 @@
 #define RST_NATIVE_BALL_H
 
 #include "rst_prefix.h"
-#if defined(FMI2_FUNCTION_PREFIX)
+#if defined(RST_PREFIXED)
 #define rst_ball_clear RST_PREFIXED(rst_ball_clear)
 #define rst_ball_initialize RST_PREFIXED(rst_ball_initialize)
 #define rst_ball_do_step RST_PREFIXED(rst_ball_do_step)

@@ -7,29 +7,29 @@
 #include "rst_model_info.h"             /* generated: identifier and GUID of modelDescription.xml */
 #include "rst_native_ball.h"
 
-static fmi2Status instantiate(rst_instance *inst, const char *resource_dir, fmi2Boolean visible)
+static rst_status instantiate(rst_instance *inst, const char *resource_dir, int visible)
 {
     (void)resource_dir, (void)visible;
     rst_ball_clear(rst_store(inst));
-    return fmi2OK;
+    return RST_OK;
 }
 
-static fmi2Status reset(rst_instance *inst)
+static rst_status reset(rst_instance *inst)
 {
     rst_ball_clear(rst_store(inst));
-    return fmi2OK;
+    return RST_OK;
 }
 
-static fmi2Status exit_initialization(rst_instance *inst)
+static rst_status exit_initialization(rst_instance *inst)
 {
     rst_ball_initialize(rst_store(inst), rst_start_time(inst));
-    return fmi2OK;
+    return RST_OK;
 }
 
-static fmi2Status do_step(rst_instance *inst, double t, double h)
+static rst_status do_step(rst_instance *inst, double t, double h)
 {
     rst_ball_do_step(rst_store(inst), t, h);
-    return fmi2OK;
+    return RST_OK;
 }
 
 const rst_model RST_MODEL = {

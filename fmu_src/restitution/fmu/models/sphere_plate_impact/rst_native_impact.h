@@ -9,7 +9,7 @@
 #define RST_NATIVE_IMPACT_H
 
 #include "rst_prefix.h"
-#if defined(FMI2_FUNCTION_PREFIX)
+#if defined(RST_PREFIXED)
 #define rst_impact_accept RST_PREFIXED(rst_impact_accept)
 #define rst_impact_evaluate RST_PREFIXED(rst_impact_evaluate)
 #endif

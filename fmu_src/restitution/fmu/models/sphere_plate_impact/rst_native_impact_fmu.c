@@ -14,11 +14,11 @@ typedef struct {
     int failed; /* the last evaluation failed: outputs are NaN/false */
 } impact_backend;
 
-static fmi2Status instantiate(rst_instance *inst, const char *resource_dir, fmi2Boolean visible)
+static rst_status instantiate(rst_instance *inst, const char *resource_dir, int visible)
 {
     (void)resource_dir, (void)visible; /* no resources, no user interface */
     ((impact_backend *)rst_backend(inst))->stale = 1;
-    return fmi2OK;
+    return RST_OK;
 }
 
 /* The inputs as the failure message shows them (the Python slave's _describe_inputs). */
@@ -53,40 +53,40 @@ static void evaluate(rst_instance *inst)
     b->failed = rst_impact_evaluate(rst_store(inst), message, sizeof message) != 0;
     if (b->failed) {
         describe_inputs(inst, inputs, sizeof inputs);
-        rst_log(inst, fmi2Error, "evaluation failed for %s: %s", inputs, message);
+        rst_log(inst, RST_ERROR, "evaluation failed for %s: %s", inputs, message);
     }
 }
 
-static fmi2Status accept(rst_instance *inst, const rst_variable *var, double value)
+static rst_status accept(rst_instance *inst, const rst_variable *var, double value)
 {
     char message[256];
     if (rst_impact_accept(var->vr, value, message, sizeof message) != 0) {
-        rst_log(inst, fmi2Error, "%s", message);
-        return fmi2Error;
+        rst_log(inst, RST_ERROR, "%s", message);
+        return RST_ERROR;
     }
-    return fmi2OK;
+    return RST_OK;
 }
 
-static fmi2Status changed(rst_instance *inst)
+static rst_status changed(rst_instance *inst)
 {
     ((impact_backend *)rst_backend(inst))->stale = 1;
-    return fmi2OK;
+    return RST_OK;
 }
 
-static fmi2Status set(rst_instance *inst, rst_type type, const fmi2ValueReference vr[], size_t n,
+static rst_status set(rst_instance *inst, rst_type type, const rst_vr vr[], size_t n,
                       const double values[])
 {
     (void)type, (void)vr, (void)n, (void)values;
     return changed(inst);
 }
 
-static fmi2Status exit_initialization(rst_instance *inst)
+static rst_status exit_initialization(rst_instance *inst)
 {
     evaluate(inst);
-    return fmi2OK;
+    return RST_OK;
 }
 
-static fmi2Status get_outputs(rst_instance *inst, rst_type type, const fmi2ValueReference vr[], size_t n,
+static rst_status get_outputs(rst_instance *inst, rst_type type, const rst_vr vr[], size_t n,
                               double values[])
 {
     size_t i;
@@ -94,19 +94,19 @@ static fmi2Status get_outputs(rst_instance *inst, rst_type type, const fmi2Value
     evaluate(inst);
     for (i = 0; i < n; i++)
         values[i] = rst_store(inst)[vr[i]];
-    return fmi2OK;
+    return RST_OK;
 }
 
-static fmi2Status do_step(rst_instance *inst, double t, double h)
+static rst_status do_step(rst_instance *inst, double t, double h)
 {
     (void)t, (void)h;
     evaluate(inst);
     if (((impact_backend *)rst_backend(inst))->failed) {
-        rst_log(inst, fmi2Discard, "fmi2DoStep discarded: the model could not be evaluated for the current inputs "
-                "(see the error above)");
-        return fmi2Discard;
+        rst_log(inst, RST_DISCARD, "%sDoStep discarded: the model could not be evaluated for the current inputs "
+                "(see the error above)", rst_fmi_prefix(inst));
+        return RST_DISCARD;
     }
-    return fmi2OK;
+    return RST_OK;
 }
 
 const rst_model RST_MODEL = {

@@ -1,0 +1,542 @@
+/* The FMI 3.0 co-simulation layer of the front: every fmi3 function, each a translation of FMI 3.0's
+ * types into the core's (rst_front.c, rst_log.c, rst_state.c) and back. What FMI 3.0 alone has lives
+ * here: the independent variable `time` (value reference n_variables, after the table), Enumerations
+ * got and set with the Int64 functions, the instantiation token and resource path, the experiment given
+ * to fmi3EnterInitializationMode and fmi3DoStep's out-arguments. The FMU has no event mode, clocks,
+ * intermediate updates or configuration mode, and is not yet offered for model exchange or scheduled
+ * execution: those functions exist (a host may look them up) and refuse with a message. */
+#include "rst_front_internal.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "fmi3Functions.h"
+
+/* FMI 3.0's logger takes the message as it is (no format) and may be absent. */
+static void emit(void (*host_logger)(void), void *environment, const char *instance_name, rst_status status,
+                 const char *category, const char *message)
+{
+    (void)instance_name; /* the host knows which instance its environment stands for */
+    if (host_logger != NULL)
+        ((fmi3LogMessageCallback)host_logger)(environment, (fmi3Status)status, category, message);
+}
+
+static const rst_api FMI3 = {
+    "fmi3", "FMI 3.0", "instantiation token", "fmi3GetFMUState", "fmi3SetFMUState", "fmi3DeserializeFMUState",
+    "fmi3SerializedFMUStateSize", {"Float64", "Int32", "Boolean", "Enumeration"}, 1, emit};
+
+/* Converters between FMI 3.0's arrays and the core's doubles. */
+static double read_float64(const void *v, size_t i) { return ((const fmi3Float64 *)v)[i]; }
+static double read_int32(const void *v, size_t i) { return (double)((const fmi3Int32 *)v)[i]; }
+static double read_int64(const void *v, size_t i) { return (double)((const fmi3Int64 *)v)[i]; }
+static double read_boolean(const void *v, size_t i) { return ((const fmi3Boolean *)v)[i] ? 1.0 : 0.0; }
+static void write_float64(void *v, size_t i, double x) { ((fmi3Float64 *)v)[i] = x; }
+/* integers held as doubles, converted without undefined behaviour for any double */
+static void write_int32(void *v, size_t i, double x)
+{
+    ((fmi3Int32 *)v)[i] = (x >= -2147483648.0 && x <= 2147483647.0) ? (fmi3Int32)x : 0;
+}
+static void write_int64(void *v, size_t i, double x)
+{
+    ((fmi3Int64 *)v)[i] = (x >= -9223372036854775808.0 && x < 9223372036854775808.0) ? (fmi3Int64)x : 0;
+}
+static void write_boolean(void *v, size_t i, double x) { ((fmi3Boolean *)v)[i] = x != 0.0 && !isnan(x); }
+
+#define ANY_MODE (RST_MODE_INSTANTIATED | RST_MODE_INITIALIZATION | RST_MODE_STEP_COMPLETE | RST_MODE_STEP_FAILED | \
+                  RST_MODE_TERMINATED | RST_MODE_ERROR)
+#define AFTER_INSTANTIATION (ANY_MODE & ~(unsigned int)RST_MODE_INSTANTIATED)
+
+/* ------------------------------------------------------------------------------------------------ */
+/* Life cycle                                                                                       */
+/* ------------------------------------------------------------------------------------------------ */
+const char *fmi3GetVersion(void) { return fmi3Version; }
+
+static void stderr_message(const char *name, const char *message)
+{
+    fprintf(stderr, "%s [%s]: %s\n", RST_MODEL.identifier, name ? name : "?", message);
+}
+
+/* A message from an instantiation function before there is an instance. */
+static void instantiation_message(fmi3LogMessageCallback logger, fmi3InstanceEnvironment environment,
+                                  const char *name, const char *message)
+{
+    if (logger != NULL)
+        logger(environment, fmi3Error, "logStatusError", message);
+    else
+        stderr_message(name, message);
+}
+
+fmi3Instance fmi3InstantiateCoSimulation(fmi3String instanceName, fmi3String instantiationToken,
+                                         fmi3String resourcePath, fmi3Boolean visible, fmi3Boolean loggingOn,
+                                         fmi3Boolean eventModeUsed, fmi3Boolean earlyReturnAllowed,
+                                         const fmi3ValueReference requiredIntermediateVariables[],
+                                         size_t nRequiredIntermediateVariables,
+                                         fmi3InstanceEnvironment instanceEnvironment,
+                                         fmi3LogMessageCallback logMessage,
+                                         fmi3IntermediateUpdateCallback intermediateUpdate)
+{
+    rst_instance *inst;
+    char *resource_dir = NULL;
+    (void)earlyReturnAllowed, (void)requiredIntermediateVariables, (void)intermediateUpdate; /* never returns early */
+    if (instanceName == NULL || instanceName[0] == '\0') {
+        instantiation_message(logMessage, instanceEnvironment, "",
+                              "fmi3InstantiateCoSimulation: the instance name is NULL or empty; not instantiated");
+        return NULL;
+    }
+    inst = front_new_instance(&FMI3, (void (*)(void))logMessage, instanceEnvironment, calloc, free,
+                              "fmi3InstantiateCoSimulation", instanceName, loggingOn);
+    if (inst == NULL)
+        return NULL;
+    if (eventModeUsed || nRequiredIntermediateVariables > 0) {
+        rst_log(inst, RST_ERROR, "fmi3InstantiateCoSimulation: %s is not provided by %s (hasEventMode = false, "
+                "providesIntermediateUpdate = false); not instantiated",
+                eventModeUsed ? "event mode" : "intermediate update", inst->model->identifier);
+        front_discard_instance(inst);
+        return NULL;
+    }
+    if (resourcePath != NULL && resourcePath[0] != '\0') {
+        size_t n = strlen(resourcePath);
+        resource_dir = (char *)inst->allocate(n + 1, 1);
+        if (resource_dir == NULL) {
+            rst_log(inst, RST_ERROR, "fmi3InstantiateCoSimulation: out of memory");
+            front_discard_instance(inst);
+            return NULL;
+        }
+        memcpy(resource_dir, resourcePath, n + 1);
+        while (n > 1 && (resource_dir[n - 1] == '/' || resource_dir[n - 1] == '\\'))
+            resource_dir[--n] = '\0'; /* resourcePath ends with a separator; backends want the directory */
+    }
+    {
+        rst_release_fn release = inst->release;
+        inst = front_instantiate(inst, "fmi3InstantiateCoSimulation", instantiationToken, resource_dir, visible);
+        if (resource_dir != NULL)
+            release(resource_dir);
+    }
+    return inst;
+}
+
+fmi3Instance fmi3InstantiateModelExchange(fmi3String instanceName, fmi3String instantiationToken,
+                                          fmi3String resourcePath, fmi3Boolean visible, fmi3Boolean loggingOn,
+                                          fmi3InstanceEnvironment instanceEnvironment,
+                                          fmi3LogMessageCallback logMessage)
+{
+    (void)instantiationToken, (void)resourcePath, (void)visible, (void)loggingOn;
+    instantiation_message(logMessage, instanceEnvironment, instanceName,
+                          "fmi3InstantiateModelExchange: this FMU is a co-simulation FMU; model exchange is not "
+                          "provided");
+    return NULL;
+}
+
+fmi3Instance fmi3InstantiateScheduledExecution(fmi3String instanceName, fmi3String instantiationToken,
+                                               fmi3String resourcePath, fmi3Boolean visible, fmi3Boolean loggingOn,
+                                               fmi3InstanceEnvironment instanceEnvironment,
+                                               fmi3LogMessageCallback logMessage, fmi3ClockUpdateCallback clockUpdate,
+                                               fmi3LockPreemptionCallback lockPreemption,
+                                               fmi3UnlockPreemptionCallback unlockPreemption)
+{
+    (void)instantiationToken, (void)resourcePath, (void)visible, (void)loggingOn, (void)clockUpdate;
+    (void)lockPreemption, (void)unlockPreemption;
+    instantiation_message(logMessage, instanceEnvironment, instanceName,
+                          "fmi3InstantiateScheduledExecution: this FMU is a co-simulation FMU; scheduled execution "
+                          "is not provided");
+    return NULL;
+}
+
+void fmi3FreeInstance(fmi3Instance instance) { front_free_instance(instance); }
+
+fmi3Status fmi3SetDebugLogging(fmi3Instance instance, fmi3Boolean loggingOn, size_t nCategories,
+                               const fmi3String categories[])
+{
+    return (fmi3Status)front_set_debug_logging(instance, "fmi3SetDebugLogging", loggingOn, nCategories, categories);
+}
+
+fmi3Status fmi3EnterInitializationMode(fmi3Instance instance, fmi3Boolean toleranceDefined, fmi3Float64 tolerance,
+                                       fmi3Float64 startTime, fmi3Boolean stopTimeDefined, fmi3Float64 stopTime)
+{
+    rst_experiment e;
+    e.tolerance_defined = toleranceDefined;
+    e.tolerance = tolerance;
+    e.start_time = startTime;
+    e.stop_time_defined = stopTimeDefined;
+    e.stop_time = stopTime;
+    return (fmi3Status)front_enter_initialization(instance, "fmi3EnterInitializationMode", &e);
+}
+
+fmi3Status fmi3ExitInitializationMode(fmi3Instance instance)
+{
+    return (fmi3Status)front_exit_initialization(instance, "fmi3ExitInitializationMode");
+}
+
+fmi3Status fmi3EnterEventMode(fmi3Instance instance)
+{
+    return (fmi3Status)front_refuse(instance, "fmi3EnterEventMode", ANY_MODE, "not provided (hasEventMode = false)");
+}
+
+fmi3Status fmi3Terminate(fmi3Instance instance) { return (fmi3Status)front_terminate(instance, "fmi3Terminate"); }
+fmi3Status fmi3Reset(fmi3Instance instance) { return (fmi3Status)front_reset(instance, "fmi3Reset"); }
+
+/* ------------------------------------------------------------------------------------------------ */
+/* Values                                                                                           */
+/* ------------------------------------------------------------------------------------------------ */
+#define GET(name, kinds, c_type, write)                                                                          \
+    fmi3Status fmi3Get##name(fmi3Instance instance, const fmi3ValueReference valueReferences[],                 \
+                             size_t nValueReferences, c_type values[], size_t nValues)                         \
+    {                                                                                                          \
+        return (fmi3Status)front_get(instance, "fmi3Get" #name, kinds, valueReferences, nValueReferences,      \
+                                     values, nValues, write);                                                  \
+    }
+#define SET(name, kinds, c_type, read)                                                                           \
+    fmi3Status fmi3Set##name(fmi3Instance instance, const fmi3ValueReference valueReferences[],                 \
+                             size_t nValueReferences, const c_type values[], size_t nValues)                   \
+    {                                                                                                          \
+        return (fmi3Status)front_set(instance, "fmi3Set" #name, kinds, valueReferences, nValueReferences,      \
+                                     values, nValues, read);                                                   \
+    }
+/* The types this FMU has no variables of: every value reference is refused. */
+#define NO_GET(name, c_type)                                                                                     \
+    fmi3Status fmi3Get##name(fmi3Instance instance, const fmi3ValueReference valueReferences[],                 \
+                             size_t nValueReferences, c_type values[], size_t nValues)                         \
+    {                                                                                                          \
+        (void)values, (void)nValues;                                                                           \
+        return (fmi3Status)front_refuse_type(instance, "fmi3Get" #name, #name, valueReferences,                \
+                                             nValueReferences, 0);                                             \
+    }
+#define NO_SET(name, c_type)                                                                                     \
+    fmi3Status fmi3Set##name(fmi3Instance instance, const fmi3ValueReference valueReferences[],                 \
+                             size_t nValueReferences, const c_type values[], size_t nValues)                   \
+    {                                                                                                          \
+        (void)values, (void)nValues;                                                                           \
+        return (fmi3Status)front_refuse_type(instance, "fmi3Set" #name, #name, valueReferences,                \
+                                             nValueReferences, 1);                                             \
+    }
+
+GET(Float64, RST_AS_REAL, fmi3Float64, write_float64)
+GET(Int32, RST_AS_INTEGER, fmi3Int32, write_int32)
+GET(Int64, RST_AS_ENUMERATION, fmi3Int64, write_int64) /* Enumerations are got and set as Int64 */
+GET(Boolean, RST_AS_BOOLEAN, fmi3Boolean, write_boolean)
+SET(Float64, RST_AS_REAL, fmi3Float64, read_float64)
+SET(Int32, RST_AS_INTEGER, fmi3Int32, read_int32)
+SET(Int64, RST_AS_ENUMERATION, fmi3Int64, read_int64)
+SET(Boolean, RST_AS_BOOLEAN, fmi3Boolean, read_boolean)
+NO_GET(Float32, fmi3Float32)
+NO_GET(Int8, fmi3Int8)
+NO_GET(UInt8, fmi3UInt8)
+NO_GET(Int16, fmi3Int16)
+NO_GET(UInt16, fmi3UInt16)
+NO_GET(UInt32, fmi3UInt32)
+NO_GET(UInt64, fmi3UInt64)
+NO_GET(String, fmi3String)
+NO_SET(Float32, fmi3Float32)
+NO_SET(Int8, fmi3Int8)
+NO_SET(UInt8, fmi3UInt8)
+NO_SET(Int16, fmi3Int16)
+NO_SET(UInt16, fmi3UInt16)
+NO_SET(UInt32, fmi3UInt32)
+NO_SET(UInt64, fmi3UInt64)
+NO_SET(String, fmi3String)
+
+fmi3Status fmi3GetBinary(fmi3Instance instance, const fmi3ValueReference valueReferences[], size_t nValueReferences,
+                         size_t valueSizes[], fmi3Binary values[], size_t nValues)
+{
+    (void)valueSizes, (void)values, (void)nValues;
+    return (fmi3Status)front_refuse_type(instance, "fmi3GetBinary", "Binary", valueReferences, nValueReferences, 0);
+}
+
+fmi3Status fmi3SetBinary(fmi3Instance instance, const fmi3ValueReference valueReferences[], size_t nValueReferences,
+                         const size_t valueSizes[], const fmi3Binary values[], size_t nValues)
+{
+    (void)valueSizes, (void)values, (void)nValues;
+    return (fmi3Status)front_refuse_type(instance, "fmi3SetBinary", "Binary", valueReferences, nValueReferences, 1);
+}
+
+fmi3Status fmi3GetClock(fmi3Instance instance, const fmi3ValueReference valueReferences[], size_t nValueReferences,
+                        fmi3Clock values[])
+{
+    (void)values;
+    return (fmi3Status)front_refuse_type(instance, "fmi3GetClock", "Clock", valueReferences, nValueReferences, 0);
+}
+
+fmi3Status fmi3SetClock(fmi3Instance instance, const fmi3ValueReference valueReferences[], size_t nValueReferences,
+                        const fmi3Clock values[])
+{
+    (void)values;
+    return (fmi3Status)front_refuse_type(instance, "fmi3SetClock", "Clock", valueReferences, nValueReferences, 1);
+}
+
+/* ------------------------------------------------------------------------------------------------ */
+/* FMU states                                                                                       */
+/* ------------------------------------------------------------------------------------------------ */
+fmi3Status fmi3GetFMUState(fmi3Instance instance, fmi3FMUState *FMUState)
+{
+    return (fmi3Status)front_get_state(instance, "fmi3GetFMUState", FMUState);
+}
+
+fmi3Status fmi3SetFMUState(fmi3Instance instance, fmi3FMUState FMUState)
+{
+    return (fmi3Status)front_set_state(instance, "fmi3SetFMUState", FMUState);
+}
+
+fmi3Status fmi3FreeFMUState(fmi3Instance instance, fmi3FMUState *FMUState)
+{
+    return (fmi3Status)front_free_state(instance, "fmi3FreeFMUState", FMUState);
+}
+
+fmi3Status fmi3SerializedFMUStateSize(fmi3Instance instance, fmi3FMUState FMUState, size_t *size)
+{
+    return (fmi3Status)front_serialized_size(instance, "fmi3SerializedFMUStateSize", FMUState, size);
+}
+
+fmi3Status fmi3SerializeFMUState(fmi3Instance instance, fmi3FMUState FMUState, fmi3Byte serializedState[],
+                                 size_t size)
+{
+    return (fmi3Status)front_serialize(instance, "fmi3SerializeFMUState", FMUState, serializedState, size);
+}
+
+fmi3Status fmi3DeserializeFMUState(fmi3Instance instance, const fmi3Byte serializedState[], size_t size,
+                                   fmi3FMUState *FMUState)
+{
+    return (fmi3Status)front_deserialize(instance, "fmi3DeserializeFMUState", serializedState, size, FMUState);
+}
+
+/* ------------------------------------------------------------------------------------------------ */
+/* Stepping                                                                                         */
+/* ------------------------------------------------------------------------------------------------ */
+fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 currentCommunicationPoint, fmi3Float64 communicationStepSize,
+                      fmi3Boolean noSetFMUStatePriorToCurrentPoint, fmi3Boolean *eventHandlingNeeded,
+                      fmi3Boolean *terminateSimulation, fmi3Boolean *earlyReturn, fmi3Float64 *lastSuccessfulTime)
+{
+    double last = 0.0;
+    rst_status status;
+    (void)noSetFMUStatePriorToCurrentPoint;
+    if (eventHandlingNeeded == NULL || terminateSimulation == NULL || earlyReturn == NULL ||
+        lastSuccessfulTime == NULL)
+        return (fmi3Status)front_refuse(instance, "fmi3DoStep", ANY_MODE, "eventHandlingNeeded, terminateSimulation, "
+                                        "earlyReturn and lastSuccessfulTime must not be NULL");
+    status = front_do_step(instance, "fmi3DoStep", currentCommunicationPoint, communicationStepSize, &last);
+    if (status < RST_ERROR) {
+        *eventHandlingNeeded = fmi3False;
+        *earlyReturn = fmi3False; /* every step runs to its end */
+        /* a discarded step leaves the instance unable to step on (fmi3Terminate, fmi3Reset or fmi3SetFMUState) */
+        *terminateSimulation = status == RST_DISCARD;
+        *lastSuccessfulTime = last;
+    }
+    return (fmi3Status)status;
+}
+
+fmi3Status fmi3EnterStepMode(fmi3Instance instance)
+{
+    return (fmi3Status)front_refuse(instance, "fmi3EnterStepMode", ANY_MODE,
+                                    "not provided (hasEventMode = false: the FMU enters step mode on "
+                                    "fmi3ExitInitializationMode)");
+}
+
+fmi3Status fmi3GetOutputDerivatives(fmi3Instance instance, const fmi3ValueReference valueReferences[],
+                                    size_t nValueReferences, const fmi3Int32 orders[], fmi3Float64 values[],
+                                    size_t nValues)
+{
+    (void)valueReferences, (void)nValueReferences, (void)orders, (void)values, (void)nValues;
+    return (fmi3Status)front_refuse(instance, "fmi3GetOutputDerivatives", ANY_MODE,
+                                    "not provided (maxOutputDerivativeOrder = 0)");
+}
+
+/* ------------------------------------------------------------------------------------------------ */
+/* Not provided: dependencies at run time, derivatives, configuration, clocks, discrete states, model  */
+/* exchange and scheduled execution                                                                  */
+/* ------------------------------------------------------------------------------------------------ */
+fmi3Status fmi3GetNumberOfVariableDependencies(fmi3Instance instance, fmi3ValueReference valueReference,
+                                               size_t *nDependencies)
+{
+    (void)valueReference, (void)nDependencies;
+    return (fmi3Status)front_refuse(instance, "fmi3GetNumberOfVariableDependencies", AFTER_INSTANTIATION,
+                                    "not provided (the dependencies are declared in modelDescription.xml's "
+                                    "ModelStructure)");
+}
+
+fmi3Status fmi3GetVariableDependencies(fmi3Instance instance, fmi3ValueReference dependent,
+                                       size_t elementIndicesOfDependent[], fmi3ValueReference independents[],
+                                       size_t elementIndicesOfIndependents[], fmi3DependencyKind dependencyKinds[],
+                                       size_t nDependencies)
+{
+    (void)dependent, (void)elementIndicesOfDependent, (void)independents, (void)elementIndicesOfIndependents;
+    (void)dependencyKinds, (void)nDependencies;
+    return (fmi3Status)front_refuse(instance, "fmi3GetVariableDependencies", AFTER_INSTANTIATION,
+                                    "not provided (the dependencies are declared in modelDescription.xml's "
+                                    "ModelStructure)");
+}
+
+#define DERIVATIVE(name, flag)                                                                                   \
+    fmi3Status fmi3Get##name(fmi3Instance instance, const fmi3ValueReference unknowns[], size_t nUnknowns,      \
+                             const fmi3ValueReference knowns[], size_t nKnowns, const fmi3Float64 seed[],       \
+                             size_t nSeed, fmi3Float64 sensitivity[], size_t nSensitivity)                     \
+    {                                                                                                          \
+        (void)unknowns, (void)nUnknowns, (void)knowns, (void)nKnowns, (void)seed, (void)nSeed;                 \
+        (void)sensitivity, (void)nSensitivity;                                                                 \
+        return (fmi3Status)front_refuse(instance, "fmi3Get" #name, ANY_MODE, "not provided (" flag " = false)"); \
+    }
+DERIVATIVE(DirectionalDerivative, "providesDirectionalDerivatives")
+DERIVATIVE(AdjointDerivative, "providesAdjointDerivatives")
+
+#define NO_CLOCKS "this FMU has no clocks"
+#define NO_ME "this FMU is not offered for model exchange"
+
+fmi3Status fmi3EnterConfigurationMode(fmi3Instance instance)
+{
+    return (fmi3Status)front_refuse(instance, "fmi3EnterConfigurationMode", ANY_MODE,
+                                    "not provided (this FMU has no structural parameters)");
+}
+
+fmi3Status fmi3ExitConfigurationMode(fmi3Instance instance)
+{
+    return (fmi3Status)front_refuse(instance, "fmi3ExitConfigurationMode", ANY_MODE,
+                                    "not provided (this FMU has no structural parameters)");
+}
+
+fmi3Status fmi3GetIntervalDecimal(fmi3Instance instance, const fmi3ValueReference valueReferences[],
+                                  size_t nValueReferences, fmi3Float64 intervals[], fmi3IntervalQualifier qualifiers[])
+{
+    (void)valueReferences, (void)nValueReferences, (void)intervals, (void)qualifiers;
+    return (fmi3Status)front_refuse(instance, "fmi3GetIntervalDecimal", ANY_MODE, "not provided (" NO_CLOCKS ")");
+}
+
+fmi3Status fmi3GetIntervalFraction(fmi3Instance instance, const fmi3ValueReference valueReferences[],
+                                   size_t nValueReferences, fmi3UInt64 counters[], fmi3UInt64 resolutions[],
+                                   fmi3IntervalQualifier qualifiers[])
+{
+    (void)valueReferences, (void)nValueReferences, (void)counters, (void)resolutions, (void)qualifiers;
+    return (fmi3Status)front_refuse(instance, "fmi3GetIntervalFraction", ANY_MODE, "not provided (" NO_CLOCKS ")");
+}
+
+fmi3Status fmi3GetShiftDecimal(fmi3Instance instance, const fmi3ValueReference valueReferences[],
+                               size_t nValueReferences, fmi3Float64 shifts[])
+{
+    (void)valueReferences, (void)nValueReferences, (void)shifts;
+    return (fmi3Status)front_refuse(instance, "fmi3GetShiftDecimal", ANY_MODE, "not provided (" NO_CLOCKS ")");
+}
+
+fmi3Status fmi3GetShiftFraction(fmi3Instance instance, const fmi3ValueReference valueReferences[],
+                                size_t nValueReferences, fmi3UInt64 counters[], fmi3UInt64 resolutions[])
+{
+    (void)valueReferences, (void)nValueReferences, (void)counters, (void)resolutions;
+    return (fmi3Status)front_refuse(instance, "fmi3GetShiftFraction", ANY_MODE, "not provided (" NO_CLOCKS ")");
+}
+
+fmi3Status fmi3SetIntervalDecimal(fmi3Instance instance, const fmi3ValueReference valueReferences[],
+                                  size_t nValueReferences, const fmi3Float64 intervals[])
+{
+    (void)valueReferences, (void)nValueReferences, (void)intervals;
+    return (fmi3Status)front_refuse(instance, "fmi3SetIntervalDecimal", ANY_MODE, "not provided (" NO_CLOCKS ")");
+}
+
+fmi3Status fmi3SetIntervalFraction(fmi3Instance instance, const fmi3ValueReference valueReferences[],
+                                   size_t nValueReferences, const fmi3UInt64 counters[],
+                                   const fmi3UInt64 resolutions[])
+{
+    (void)valueReferences, (void)nValueReferences, (void)counters, (void)resolutions;
+    return (fmi3Status)front_refuse(instance, "fmi3SetIntervalFraction", ANY_MODE, "not provided (" NO_CLOCKS ")");
+}
+
+fmi3Status fmi3SetShiftDecimal(fmi3Instance instance, const fmi3ValueReference valueReferences[],
+                               size_t nValueReferences, const fmi3Float64 shifts[])
+{
+    (void)valueReferences, (void)nValueReferences, (void)shifts;
+    return (fmi3Status)front_refuse(instance, "fmi3SetShiftDecimal", ANY_MODE, "not provided (" NO_CLOCKS ")");
+}
+
+fmi3Status fmi3SetShiftFraction(fmi3Instance instance, const fmi3ValueReference valueReferences[],
+                                size_t nValueReferences, const fmi3UInt64 counters[], const fmi3UInt64 resolutions[])
+{
+    (void)valueReferences, (void)nValueReferences, (void)counters, (void)resolutions;
+    return (fmi3Status)front_refuse(instance, "fmi3SetShiftFraction", ANY_MODE, "not provided (" NO_CLOCKS ")");
+}
+
+fmi3Status fmi3EvaluateDiscreteStates(fmi3Instance instance)
+{
+    return (fmi3Status)front_refuse(instance, "fmi3EvaluateDiscreteStates", ANY_MODE,
+                                    "not provided (hasEventMode = false)");
+}
+
+fmi3Status fmi3UpdateDiscreteStates(fmi3Instance instance, fmi3Boolean *discreteStatesNeedUpdate,
+                                    fmi3Boolean *terminateSimulation, fmi3Boolean *nominalsOfContinuousStatesChanged,
+                                    fmi3Boolean *valuesOfContinuousStatesChanged, fmi3Boolean *nextEventTimeDefined,
+                                    fmi3Float64 *nextEventTime)
+{
+    (void)discreteStatesNeedUpdate, (void)terminateSimulation, (void)nominalsOfContinuousStatesChanged;
+    (void)valuesOfContinuousStatesChanged, (void)nextEventTimeDefined, (void)nextEventTime;
+    return (fmi3Status)front_refuse(instance, "fmi3UpdateDiscreteStates", ANY_MODE,
+                                    "not provided (hasEventMode = false)");
+}
+
+fmi3Status fmi3EnterContinuousTimeMode(fmi3Instance instance)
+{
+    return (fmi3Status)front_refuse(instance, "fmi3EnterContinuousTimeMode", ANY_MODE, "not provided (" NO_ME ")");
+}
+
+fmi3Status fmi3CompletedIntegratorStep(fmi3Instance instance, fmi3Boolean noSetFMUStatePriorToCurrentPoint,
+                                       fmi3Boolean *enterEventMode, fmi3Boolean *terminateSimulation)
+{
+    (void)noSetFMUStatePriorToCurrentPoint, (void)enterEventMode, (void)terminateSimulation;
+    return (fmi3Status)front_refuse(instance, "fmi3CompletedIntegratorStep", ANY_MODE, "not provided (" NO_ME ")");
+}
+
+fmi3Status fmi3SetTime(fmi3Instance instance, fmi3Float64 time)
+{
+    (void)time;
+    return (fmi3Status)front_refuse(instance, "fmi3SetTime", ANY_MODE, "not provided (" NO_ME ")");
+}
+
+fmi3Status fmi3SetContinuousStates(fmi3Instance instance, const fmi3Float64 continuousStates[],
+                                   size_t nContinuousStates)
+{
+    (void)continuousStates, (void)nContinuousStates;
+    return (fmi3Status)front_refuse(instance, "fmi3SetContinuousStates", ANY_MODE, "not provided (" NO_ME ")");
+}
+
+fmi3Status fmi3GetContinuousStateDerivatives(fmi3Instance instance, fmi3Float64 derivatives[],
+                                             size_t nContinuousStates)
+{
+    (void)derivatives, (void)nContinuousStates;
+    return (fmi3Status)front_refuse(instance, "fmi3GetContinuousStateDerivatives", ANY_MODE,
+                                    "not provided (" NO_ME ")");
+}
+
+fmi3Status fmi3GetEventIndicators(fmi3Instance instance, fmi3Float64 eventIndicators[], size_t nEventIndicators)
+{
+    (void)eventIndicators, (void)nEventIndicators;
+    return (fmi3Status)front_refuse(instance, "fmi3GetEventIndicators", ANY_MODE, "not provided (" NO_ME ")");
+}
+
+fmi3Status fmi3GetContinuousStates(fmi3Instance instance, fmi3Float64 continuousStates[], size_t nContinuousStates)
+{
+    (void)continuousStates, (void)nContinuousStates;
+    return (fmi3Status)front_refuse(instance, "fmi3GetContinuousStates", ANY_MODE, "not provided (" NO_ME ")");
+}
+
+fmi3Status fmi3GetNominalsOfContinuousStates(fmi3Instance instance, fmi3Float64 nominals[], size_t nContinuousStates)
+{
+    (void)nominals, (void)nContinuousStates;
+    return (fmi3Status)front_refuse(instance, "fmi3GetNominalsOfContinuousStates", ANY_MODE,
+                                    "not provided (" NO_ME ")");
+}
+
+fmi3Status fmi3GetNumberOfEventIndicators(fmi3Instance instance, size_t *nEventIndicators)
+{
+    (void)nEventIndicators;
+    return (fmi3Status)front_refuse(instance, "fmi3GetNumberOfEventIndicators", ANY_MODE, "not provided (" NO_ME ")");
+}
+
+fmi3Status fmi3GetNumberOfContinuousStates(fmi3Instance instance, size_t *nContinuousStates)
+{
+    (void)nContinuousStates;
+    return (fmi3Status)front_refuse(instance, "fmi3GetNumberOfContinuousStates", ANY_MODE,
+                                    "not provided (" NO_ME ")");
+}
+
+fmi3Status fmi3ActivateModelPartition(fmi3Instance instance, fmi3ValueReference clockReference,
+                                      fmi3Float64 activationTime)
+{
+    (void)clockReference, (void)activationTime;
+    return (fmi3Status)front_refuse(instance, "fmi3ActivateModelPartition", ANY_MODE,
+                                    "not provided (scheduled execution is not offered)");
+}

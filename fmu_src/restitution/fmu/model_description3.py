@@ -1,0 +1,247 @@
+"""The FMI 3.0 description files of the native co-simulation FMUs, written from the interface table alone.
+
+:func:`model_description` writes ``modelDescription.xml`` and :func:`build_description` writes
+``sources/buildDescription.xml``. Nothing comes from pythonfmu (it writes FMI 2.0 only): names,
+value references, types, causalities, variabilities, units, starts, limits, enumeration items and the
+ModelStructure are all read from ``models/<model>/variables.py`` (:class:`restitution.fmu.table.Table`),
+so the FMI 2.0 and FMI 3.0 files of one model cannot drift apart. Value references are the FMI 2.0
+ones (the row's position), so a host or a C table indexed by them serves both versions.
+
+What FMI 3.0 changes, and how the table's rows map onto it:
+
+* Real -> ``<Float64>`` (with its ``unit``), Integer -> ``<Int32>``, Boolean -> ``<Boolean>``; an Integer
+  with ``choices`` -> ``<Enumeration>`` of a type declared in ``<TypeDefinitions>`` (FMI 3.0 requires a
+  ``declaredType`` on every Enumeration). A host gets and sets an Enumeration with fmi3Get/SetInt64,
+  not Int32.
+* Every FMI 3.0 FMU has exactly one variable of causality ``independent`` (the standard, "causality",
+  and fmpy's validation); here it is ``time`` [s], value reference ``len(table)``, after every row.
+* ModelStructure lists ``<Output>`` and ``<InitialUnknown>`` elements named by value reference (FMI
+  2.0: ``<Unknown index>`` inside ``<Outputs>`` and ``<InitialUnknowns>``, by 1-based position).
+
+Pure data in, text out: no compiler, no fmpy (tests validate the result against fmpy's FMI 3.0 schemas).
+"""
+from __future__ import annotations
+
+import math
+import re
+from datetime import datetime, timezone
+from xml.etree import ElementTree as ET
+
+from ..about import AUTHOR, COPYRIGHT, LICENSE, VERSION
+from .models import table as _table
+from .table import UNITS, Table, Variable
+
+__all__ = ["model_description", "build_description", "enumeration_type", "TIME_NAME", "GENERATION_TOOL"]
+
+GENERATION_TOOL = "restitution native build (C99 front + native physics)"
+#: The independent variable every FMI 3.0 FMU must have (its value reference: ``len(table)``).
+TIME_NAME = "time"
+TIME_UNIT = "s"
+#: The log categories the C front answers to (the FMI 2.0 files' names), in their order.
+LOG_CATEGORIES = (
+    ("logStatusWarning", "Log messages with fmi3Warning status."),
+    ("logStatusDiscard", "Log messages with fmi3Discard status."),
+    ("logStatusError", "Log messages with fmi3Error status."),
+    ("logStatusFatal", "Log messages with fmi3Fatal status."),
+    ("logAll", "Log all messages."),
+)
+#: The co-simulation capabilities of the native front. Each flag is spelled out, false ones too, so a
+#: reader sees what the FMU does not offer without knowing the schema's defaults: no event mode, no
+#: intermediate update, no early return (fmi3DoStep always completes the step or fails).
+CO_SIMULATION = {
+    "canHandleVariableCommunicationStepSize": "true",
+    "canGetAndSetFMUState": "true",
+    "canSerializeFMUState": "true",
+    "needsExecutionTool": "false",
+    "canBeInstantiatedOnlyOncePerProcess": "false",
+    "hasEventMode": "false",
+    "providesIntermediateUpdate": "false",
+    "canReturnEarlyAfterIntermediateUpdate": "false",
+}
+#: Table type -> FMI 3.0 element (an Integer with choices becomes an Enumeration instead).
+ELEMENTS = {"Real": "Float64", "Integer": "Int32", "Boolean": "Boolean"}
+PARAMETER_CAUSALITIES = ("parameter", "input")
+
+
+def enumeration_type(row: Variable) -> str:
+    """The name of the ``<EnumerationType>`` an Integer-coded choice is declared with: the row's
+    ``enumeration`` where the table gives one (shared by several rows: "Material"), else its FMU name in
+    CamelCase ("zener_method" -> "ZenerMethod", "flight.mode" -> "FlightMode")."""
+    if row.enumeration is not None:
+        return row.enumeration
+    return "".join(part[:1].upper() + part[1:] for part in re.split(r"[._]", row.name) if part)
+
+
+def _enumeration_types(table: Table) -> dict[str, Variable]:
+    """Type name -> the first row declared with it, in value-reference order. Two rows may share a
+    type only with the same items (a host shows one list of words for both)."""
+    types: dict[str, Variable] = {}
+    for row in table:
+        if not row.is_enumeration:
+            continue
+        name = enumeration_type(row)
+        first = types.setdefault(name, row)
+        if (first.codes, first.item_descriptions) != (row.codes, row.item_descriptions):
+            raise ValueError(f"{table.model}: {first.name} and {row.name} share the enumeration type {name} "
+                             "but not its items")
+    return types
+
+
+def _float(value) -> str:
+    """A Float64 attribute: the shortest text that reads back as the same double (Python's repr, the
+    'minimal printer' the standard recommends), so a start value survives the XML exactly."""
+    value = float(value)
+    if not math.isfinite(value):
+        raise ValueError(f"{value!r} is not a finite start value")
+    return repr(value)
+
+
+def _start(row: Variable) -> str:
+    if row.type == "Boolean":
+        return "true" if row.start else "false"
+    if row.type == "Integer":
+        return str(int(row.start))
+    return _float(row.start)
+
+
+def _limit(row: Variable, text: str) -> str:
+    # xml_limits formats with %g, which writes 1e+06 for a large integer: not an xs:long
+    return str(int(float(text))) if row.type == "Integer" else text
+
+
+def _variable(parent: ET.Element, row: Variable) -> None:
+    element = "Enumeration" if row.is_enumeration else ELEMENTS[row.type]
+    attrs = {"name": row.name, "valueReference": str(row.vr), "description": row.description,
+             "causality": row.causality, "variability": row.variability}
+    if row.initial is not None:  # the default for these, written out as the FMI 2.0 files do
+        attrs["initial"] = row.initial
+    if element == "Enumeration":
+        attrs["declaredType"] = enumeration_type(row)
+    if element == "Float64" and row.unit is not None:
+        attrs["unit"] = row.unit
+    if row.causality in PARAMETER_CAUSALITIES:
+        low, high = row.xml_limits()
+        if low is not None:
+            attrs["min"] = _limit(row, low)
+        if high is not None:
+            attrs["max"] = _limit(row, high)
+        attrs["start"] = _start(row)
+    ET.SubElement(parent, element, attrs)
+
+
+def _unit_definitions(table: Table) -> ET.Element:
+    used = {row.unit for row in table if row.type == "Real" and row.unit is not None} | {TIME_UNIT}
+    node = ET.Element("UnitDefinitions")
+    for unit in sorted(used):
+        unit_node = ET.SubElement(node, "Unit", name=unit)
+        if UNITS[unit]:  # "1" has no BaseUnit: all exponents 0 is the schema's default anyway
+            ET.SubElement(unit_node, "BaseUnit", {k: str(v) for k, v in UNITS[unit].items()})
+    return node
+
+
+def _type_definitions(table: Table) -> ET.Element | None:
+    types = _enumeration_types(table)
+    if not types:
+        return None  # an empty <TypeDefinitions> is not allowed
+    node = ET.Element("TypeDefinitions")
+    for name, row in types.items():
+        enum = ET.SubElement(node, "EnumerationType", name=name)
+        descriptions = row.item_descriptions or (None,) * len(row.choices)
+        for (word, code), text in zip(row.codes.items(), descriptions):
+            item = {"name": word, "value": str(code)}
+            if text:
+                item["description"] = text
+            ET.SubElement(enum, "Item", item)
+    return node
+
+
+def _model_structure(table: Table) -> ET.Element:
+    """Outputs with their direct dependence on the inputs (``feedthrough``: every input, else none);
+    InitialUnknowns as in the FMI 2.0 files: the outputs and the calculated parameters, without
+    dependencies (an absent attribute: may depend on every known)."""
+    node = ET.Element("ModelStructure")
+    inputs = [str(row.vr) for row in table if row.causality == "input"]
+    for row in table.outputs:
+        attrs = {"valueReference": str(row.vr), "dependencies": " ".join(inputs) if row.feedthrough else ""}
+        if row.feedthrough and inputs:
+            attrs["dependenciesKind"] = " ".join("dependent" for _ in inputs)
+        ET.SubElement(node, "Output", attrs)
+    for row in sorted(table.outputs + table.calculated, key=lambda r: r.vr):
+        ET.SubElement(node, "InitialUnknown", valueReference=str(row.vr))
+    return node
+
+
+def _text(root: ET.Element) -> str:
+    ET.indent(root, "  ")
+    return '<?xml version="1.0" encoding="UTF-8"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
+
+
+def model_description(model: str, instantiation_token: str) -> str:
+    """The FMI 3.0 ``modelDescription.xml`` of ``model``'s native co-simulation FMU, from its interface
+    table (:func:`restitution.fmu.models.table`).
+
+    ``instantiation_token`` is the string a host passes to fmi3InstantiateCoSimulation and the binary
+    compares with its own (the FMI 2.0 guid's role). Element order is the schema's:
+    CoSimulation, UnitDefinitions, TypeDefinitions, LogCategories, ModelVariables, ModelStructure (no
+    DefaultExperiment: the FMI 2.0 files have none; the host chooses start, stop and step).
+    """
+    table = _table(model)
+    root = ET.Element("fmiModelDescription", {
+        "fmiVersion": "3.0",
+        "modelName": model,
+        "instantiationToken": instantiation_token,
+        "description": table.description,
+        "author": AUTHOR,
+        "version": VERSION,
+        "copyright": COPYRIGHT,
+        "license": LICENSE,
+        "generationTool": GENERATION_TOOL,
+        # the form the standard recommends: UTC, whole seconds, "Z"
+        "generationDateAndTime": datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ"),
+        "variableNamingConvention": "structured",
+    })
+    ET.SubElement(root, "CoSimulation", {"modelIdentifier": model, **CO_SIMULATION})
+    root.append(_unit_definitions(table))
+    types = _type_definitions(table)
+    if types is not None:
+        root.append(types)
+    categories = ET.SubElement(root, "LogCategories")
+    for name, description in LOG_CATEGORIES:
+        ET.SubElement(categories, "Category", name=name, description=description)
+    variables = ET.SubElement(root, "ModelVariables")
+    for row in table:
+        _variable(variables, row)
+    # after every row, so that each row keeps its FMI 2.0 value reference; no start and no initial:
+    # its value at the start is fmi3EnterInitializationMode's startTime
+    ET.SubElement(variables, "Float64", {
+        "name": TIME_NAME, "valueReference": str(len(table)), "description": "Simulation time",
+        "causality": "independent", "variability": "continuous", "unit": TIME_UNIT})
+    root.append(_model_structure(table))
+    return _text(root)
+
+
+def build_description(model: str, c_files: list[str], defines: dict | None = None) -> str:
+    """The FMI 3.0 ``sources/buildDescription.xml`` of ``model``'s native FMU: one build configuration
+    (every platform) compiling ``c_files`` (paths relative to ``sources/``) as C99.
+
+    ``defines``: name -> value of the preprocessor definitions the sources need (value None: defined
+    without a value). The headers sit beside the sources (include directory ``.``, that is ``sources/``
+    itself); the C math library (libm) is declared external: the importer's toolchain provides it,
+    the FMU does not carry it.
+    """
+    if not c_files:
+        raise ValueError(f"{model}: a build configuration needs at least one source file")
+    root = ET.Element("fmiBuildDescription", fmiVersion="3.0")
+    config = ET.SubElement(root, "BuildConfiguration", modelIdentifier=model)
+    files = ET.SubElement(config, "SourceFileSet", language="C99")
+    # schema order inside a SourceFileSet: SourceFile+, PreprocessorDefinition*, IncludeDirectory*
+    for name in c_files:
+        ET.SubElement(files, "SourceFile", name=name)
+    for name, value in (defines or {}).items():
+        attrs = {"name": name}
+        if value is not None:
+            attrs["value"] = str(value)
+        ET.SubElement(files, "PreprocessorDefinition", attrs)
+    ET.SubElement(files, "IncludeDirectory", name=".")
+    ET.SubElement(config, "Library", name="m", external="true", description="the C math library (libm)")
+    return _text(root)
