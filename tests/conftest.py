@@ -25,7 +25,7 @@ for _folder in (MODELS / "sphere_plate_impact", MODELS / "bouncing_ball", MODELS
 def built_fmus(tmp_path_factory) -> Path:
     """Every FMU of the project built from the current sources (and validated) into one temp dir:
     SpherePlateImpact.fmu and BouncingBall.fmu (pythonfmu, behind the C guard), and their native
-    twins in native/ where a C compiler is available."""
+    twins, FMI 2.0 in native/ and FMI 3.0 in fmi3/, where a C compiler is available."""
     from restitution.fmu.build import build_all
 
     out = tmp_path_factory.mktemp("fmu")
@@ -62,6 +62,25 @@ def native_impact_fmu(built_fmus) -> Path:
 def native_ball_fmu(built_fmus) -> Path:
     """The native BouncingBall.fmu."""
     return _native(built_fmus, "BouncingBall")
+
+
+def _fmi3(built_fmus, model):
+    path = built_fmus / "fmi3" / f"{model}.fmu"
+    if not path.is_file():
+        pytest.skip(f"FMI 3.0 {model}.fmu not built here (needs gcc)")
+    return path
+
+
+@pytest.fixture(scope="session")
+def fmi3_impact_fmu(built_fmus) -> Path:
+    """The native FMI 3.0 SpherePlateImpact.fmu (the same C core and physics as the native FMI 2.0 one)."""
+    return _fmi3(built_fmus, "SpherePlateImpact")
+
+
+@pytest.fixture(scope="session")
+def fmi3_ball_fmu(built_fmus) -> Path:
+    """The native FMI 3.0 BouncingBall.fmu."""
+    return _fmi3(built_fmus, "BouncingBall")
 
 
 #: The two implementations of each FMU: tests that hold for both take these fixtures.

@@ -24,21 +24,14 @@ IMPACT = table("SpherePlateImpact")
 FMU_NAME = {key: row.name for key, row in IMPACT.by_key().items()}  # package keyword -> FMU name
 
 
-def _fmi3(built_fmus, model) -> Path:
-    path = built_fmus / "fmi3" / f"{model}.fmu"
-    if not path.is_file():
-        pytest.skip(f"FMI 3.0 {model}.fmu not built here (needs gcc)")
-    return path
+@pytest.fixture(scope="module")
+def fmi3_impact(fmi3_impact_fmu):
+    return fmi3_impact_fmu
 
 
 @pytest.fixture(scope="module")
-def fmi3_impact(built_fmus):
-    return _fmi3(built_fmus, "SpherePlateImpact")
-
-
-@pytest.fixture(scope="module")
-def fmi3_ball(built_fmus):
-    return _fmi3(built_fmus, "BouncingBall")
+def fmi3_ball(fmi3_ball_fmu):
+    return fmi3_ball_fmu
 
 
 class Loaded:
