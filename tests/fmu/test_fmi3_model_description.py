@@ -92,7 +92,7 @@ def test_table_round_trips_through_the_fmi3_model_description(fmu_dir):
     assert (md.fmiVersion, md.modelName, md.guid, md.description) == ("3.0", model, TOKEN, table(model).description)
     assert md.variableNamingConvention == "structured"
     cs = md.coSimulation
-    assert cs.modelIdentifier == model and md.modelExchange is None and md.scheduledExecution is None
+    assert cs.modelIdentifier == model and md.modelExchange.modelIdentifier == model and md.scheduledExecution is None
     assert cs.canHandleVariableCommunicationStepSize and cs.canGetAndSetFMUstate and cs.canSerializeFMUstate
     assert not (cs.needsExecutionTool or cs.canBeInstantiatedOnlyOncePerProcess or cs.hasEventMode
                 or cs.providesIntermediateUpdate or cs.canReturnEarlyAfterIntermediateUpdate)
@@ -137,8 +137,15 @@ def test_table_round_trips_through_the_fmi3_model_description(fmu_dir):
         assert [v.name for v in unknown.dependencies] == expected, row.name
         assert (unknown.dependenciesKind or []) == ["dependent"] * len(expected), row.name
     assert [u.variable.name for u in md.initialUnknowns] == [
-        row.name for row in rows if row.causality in ("output", "calculatedParameter")]
+        row.name for row in rows if row.causality in ("output", "calculatedParameter") or row.derivative is not None]
     assert all(u.dependencies is None for u in md.initialUnknowns)  # may depend on every known
+    # model exchange: each derivative names its state; the event indicators
+    by_name = {v.name: v for v in variables}
+    assert [u.variable.name for u in md.derivatives] == [row.name for row in rows if row.derivative is not None]
+    for row in rows:
+        derivative_of = by_name[row.name].derivative
+        assert (derivative_of.name if derivative_of is not None else None) == row.derivative, row.name
+    assert [u.variable.name for u in md.eventIndicators] == [row.name for row in rows if row.event_indicator]
 
 
 def _pint_base_unit(ureg, unit: str) -> tuple[dict, float]:

@@ -14,7 +14,8 @@ a crash fails one test. Covered, through fmpy (raw calls, statuses collected) an
   fmi2Error with a message and the instance unchanged;
 * leaks: 2,000 instantiate/free cycles and in-place state get/deserialize keep memory flat;
 * the FMI 2.0 call sequence and doStep's time and step size; fmi2Instantiate's arguments (wrong or
-  NULL GUID, NULL or empty name, NULL logger or allocator, model exchange);
+  NULL GUID, NULL or empty name, NULL logger or allocator, an unknown fmuType, model exchange where the
+  FMU does not offer it);
 * every wrong-type and unknown-reference call: fmi2Error, and the instance still correct after;
 * Ctrl-C during a long zener_method = 4 loop reaches the Python host as KeyboardInterrupt;
 * values at the ends of the declared ranges: finite results equal to the package's, or fmi2Discard
@@ -410,9 +411,12 @@ results = {
     "NULL callbacks": f(b"a", 1, guid, loc, None, 0, 0),
     "NULL logger": f(b"a", 1, guid, loc, byref(no_logger), 0, 0),
     "NULL allocator": f(b"a", 1, guid, loc, byref(no_alloc), 0, 0),
-    "model exchange": f(b"a", 0, guid, loc, byref(CALLBACKS), 0, 0),
+    "neither interface": f(b"a", 7, guid, loc, byref(CALLBACKS), 0, 0),
 }
 nulls = {k: v is None for k, v in results.items()}
+# model exchange: refused where the modelDescription does not offer it (the pythonfmu FMU), else an instance
+me = f(b"me", 0, guid, loc, byref(CALLBACKS), 0, 0)
+nulls["model exchange as declared"] = (me is None) == (MD.modelExchange is None)
 s = instance("after")  # and a normal instance still works
 s.setReal([VR["v_approach"]], [2.3])
 report(nulls=nulls, e=reals(s, ["e"])[0], log=LOG)
@@ -426,7 +430,7 @@ def test_fmi2instantiate_refuses_bad_arguments_without_crashing(any_impact_fmu, 
     assert _close(run.report["e"], _package_e(2.3))
     messages = " ".join(m for _, st, m in run.report["log"] if st == FMI_ERROR)
     for needed in ("does not match this FMU's", "GUID (NULL)", "instance name is NULL or empty",
-                   "allocateMemory or freeMemory is NULL", "model exchange is not provided"):
+                   "allocateMemory or freeMemory is NULL", "is neither fmi2ModelExchange (0) nor fmi2CoSimulation (1)"):
         assert needed in messages, needed
     assert "no logger" in run.stderr  # where there is no logger, the message goes to stderr
 

@@ -1,6 +1,7 @@
 """What hosts see of the FMUs' interface does not change by accident: each built modelDescription.xml
-(both models, both implementations) equals its checked-in copy in tests/data/model_descriptions/,
-apart from what differs between builds (the GUID and the generation time).
+(both models; the pythonfmu FMU, the native FMI 2.0 and the native FMI 3.0 FMU) equals its checked-in
+copy in tests/data/model_descriptions/, apart from what differs between builds (the GUID or
+instantiation token and the generation time).
 
 A deliberate change of the interface updates the copies in the same commit:
 
@@ -17,7 +18,7 @@ import pytest
 
 SNAPSHOTS = Path(__file__).resolve().parents[1] / "data" / "model_descriptions"
 #: Attributes that differ between two builds of the same sources.
-PER_BUILD = re.compile(r'\s(guid|generationDateAndTime)="[^"]*"')
+PER_BUILD = re.compile(r'\s(guid|instantiationToken|generationDateAndTime)="[^"]*"')
 
 
 def _normalized(fmu: Path) -> str:
@@ -26,9 +27,9 @@ def _normalized(fmu: Path) -> str:
 
 
 @pytest.mark.parametrize("model", ["SpherePlateImpact", "BouncingBall"])
-@pytest.mark.parametrize("implementation", ["python", "native"])
+@pytest.mark.parametrize("implementation", ["python", "native", "fmi3"])
 def test_model_description_equals_its_checked_in_copy(built_fmus, implementation, model):
-    fmu = built_fmus / (f"{model}.fmu" if implementation == "python" else f"native/{model}.fmu")
+    fmu = built_fmus / (f"{model}.fmu" if implementation == "python" else f"{implementation}/{model}.fmu")
     if not fmu.is_file():
         pytest.skip(f"{implementation} {model}.fmu not built here (needs gcc)")
     text = _normalized(fmu)

@@ -59,9 +59,9 @@ def test_the_c_header_names_every_value_reference_and_code(model):
     names = dict(re.findall(r"^\s+(RST_\w+) = (-?\d+),$", header, re.M))
     upper = model.upper()
     for row in table(model):
-        assert names[f"RST_{upper}_VR_{re.sub(r'[^0-9A-Za-z]', '_', row.name).upper()}"] == str(row.vr)
+        assert names[f"RST_{upper}_VR_{re.sub(r'[^0-9A-Za-z]', '_', row.name).strip('_').upper()}"] == str(row.vr)
         for word, code in (row.codes or {}).items():
-            assert names[f"RST_{upper}_{re.sub(r'[^0-9A-Za-z]', '_', row.name).upper()}_{word.upper()}"] == str(code)
+            assert names[f"RST_{upper}_{re.sub(r'[^0-9A-Za-z]', '_', row.name).strip('_').upper()}_{word.upper()}"] == str(code)
     assert f"#define RST_{upper}_N_OUTPUTS {len(table(model).outputs)}" in header
 
 

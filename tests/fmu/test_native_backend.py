@@ -115,6 +115,11 @@ _HOSTILE_DRIVER = r"""
 #include "rst_SpherePlateImpact_interface.h"
 #undef RST_MODEL_N_VARIABLES /* the generic names of the table, which a model's glue uses: here both models */
 #undef RST_MODEL_VARIABLES
+#undef RST_MODEL_N_STATES
+#undef RST_MODEL_N_EVENT_INDICATORS
+#undef RST_MODEL_STATE_VRS
+#undef RST_MODEL_DERIVATIVE_VRS
+#undef RST_MODEL_EVENT_INDICATOR_VRS
 #include "rst_BouncingBall_interface.h"
 int main(void)
 {

@@ -72,6 +72,8 @@ def complete_model_description(xml_text: str, table) -> str:
         if var.type == "Real" and var.unit is not None:
             type_node.set("unit", var.unit)
             used_units.add(var.unit)
+        if var.derivative is not None:
+            type_node.set("derivative", str(index[var.derivative]))
         if var.causality in PARAMETER_CAUSALITIES:
             low, high = var.xml_limits()
             if low is not None:
@@ -95,6 +97,7 @@ def complete_model_description(xml_text: str, table) -> str:
     for child in list(structure):
         structure.remove(child)
     outputs = ET.SubElement(structure, "Outputs")
+    derivatives = ET.SubElement(structure, "Derivatives") if table.derivatives else None
     initial = ET.SubElement(structure, "InitialUnknowns")
     for var in table.outputs:
         deps = " ".join(map(str, inputs)) if var.feedthrough else ""
@@ -102,8 +105,10 @@ def complete_model_description(xml_text: str, table) -> str:
         if deps:
             attrs["dependenciesKind"] = " ".join("dependent" for _ in inputs)
         ET.SubElement(outputs, "Unknown", attrs)
-    # InitialUnknowns: the outputs, then the calculated parameters, in value-reference order
-    for var in sorted(table.outputs + table.calculated, key=lambda v: index[v.name]):
+    for var in table.derivatives:  # may depend on every state, parameter and input (no dependencies given)
+        ET.SubElement(derivatives, "Unknown", {"index": str(index[var.name])})
+    # InitialUnknowns: the outputs, the state derivatives and the calculated parameters, in order
+    for var in sorted(table.outputs + table.derivatives + table.calculated, key=lambda v: index[v.name]):
         ET.SubElement(initial, "Unknown", {"index": str(index[var.name])})
     for element in root.iter():
         if element.text is not None and not element.text.strip():

@@ -30,7 +30,7 @@ from .compile import CFLAGS, PHYSICS_SOURCES, prepare_sources
 from .documentation import license_files
 from . import model_description3
 from .interface import c_header, model_info, model_info_header
-from .models import FOLDERS, native_sources
+from .models import FOLDERS, native_sources, table
 from . import sources
 from .sources import BUILD_INFO, FRONT, PHYSICS_C, native_source_hash
 
@@ -117,18 +117,34 @@ def write_backend(model: str, directory: Path) -> None:
     (directory / INTERFACE_HEADER.format(model=model)).write_text(c_header(model), encoding="utf-8")
 
 
-def native_model_description(xml_text: str, c_files: list[str]) -> str:
-    """The pythonfmu FMU's modelDescription.xml for the native FMU: same interface, C sources declared."""
+#: What the native FMI 2.0 FMU offers for model exchange (the same binary and front as co-simulation).
+MODEL_EXCHANGE = {"needsExecutionTool": "false", "completedIntegratorStepNotNeeded": "true",
+                  "canBeInstantiatedOnlyOncePerProcess": "false", "canNotUseMemoryManagementFunctions": "false",
+                  "canGetAndSetFMUstate": "true", "canSerializeFMUstate": "true"}
+
+
+def native_model_description(xml_text: str, c_files: list[str], model_table=None) -> str:
+    """The pythonfmu FMU's modelDescription.xml for the native FMU: same interface, C sources declared,
+    and, given the model's interface table, model exchange offered beside co-simulation (its number
+    of event indicators from the table)."""
     root = ET.fromstring(xml_text)
     root.set("generationTool", GENERATION_TOOL)
     cosim = root.find("CoSimulation")
     cosim.set("needsExecutionTool", "false")
     cosim.set("canBeInstantiatedOnlyOncePerProcess", "false")
+    cosim.set("canNotUseMemoryManagementFunctions", "false")  # the front allocates through the host's callbacks
     for old in cosim.findall("SourceFiles"):
         cosim.remove(old)
-    files = ET.SubElement(cosim, "SourceFiles")
-    for name in c_files:
-        ET.SubElement(files, "File", name=name)
+    parts = [cosim]
+    if model_table is not None:
+        root.set("numberOfEventIndicators", str(len(model_table.event_indicators)))
+        exchange = ET.Element("ModelExchange", {"modelIdentifier": cosim.get("modelIdentifier"), **MODEL_EXCHANGE})
+        root.insert(list(root).index(cosim), exchange)  # FMI 2.0 order: ModelExchange, then CoSimulation
+        parts.insert(0, exchange)
+    for part in parts:
+        files = ET.SubElement(part, "SourceFiles")
+        for name in c_files:
+            ET.SubElement(files, "File", name=name)
     ET.indent(root, "  ")
     return '<?xml version="1.0" encoding="UTF-8"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
 
@@ -178,7 +194,7 @@ def build_native_one(model: str, out_dir: Path, python_fmu: Path, log=None, fmi_
         with zipfile.ZipFile(python_fmu) as z:
             xml = z.read("modelDescription.xml").decode("utf-8")
         if fmi_version == "2.0":
-            description = native_model_description(xml, c_files)
+            description = native_model_description(xml, c_files, table(model))
         else:
             description = model_description3.model_description(model, model_info(xml)[1])
             (sources / "buildDescription.xml").write_text(model_description3.build_description(model, c_files),

@@ -104,7 +104,7 @@ def _c_double(x) -> str:
 
 def c_identifier(text: str) -> str:
     """``text`` as an upper-case C identifier part: "zener.lambda" -> "ZENER_LAMBDA"."""
-    return re.sub(r"[^0-9A-Za-z]", "_", text).upper()
+    return re.sub(r"[^0-9A-Za-z]", "_", text).strip("_").upper()
 
 
 def _c_enums(upper: str, rows) -> list[str]:
@@ -122,6 +122,25 @@ def _c_enums(upper: str, rows) -> list[str]:
     lines += ["};", "/* the codes of the Integer choices */", "enum {"]
     lines += [f"    {name} = {code}," for name, code in codes]
     return lines + ["};"]
+
+
+def _c_model_exchange(upper: str, rows) -> list[str]:
+    """The model-exchange vectors by value reference: the continuous states and their derivatives (in
+    the state vector's order) and the event indicators; ``RST_MODEL_*_VRS`` is NULL where there are none."""
+    by_name = {v.name: v for v in rows}
+    derivatives = [v for v in rows if v.derivative is not None]
+    vectors = {"STATE": [by_name[v.derivative].vr for v in derivatives], "DERIVATIVE": [v.vr for v in derivatives],
+               "EVENT_INDICATOR": [v.vr for v in rows if v.event_indicator]}
+    lines = ["/* model exchange: continuous states, their derivatives, event indicators (value references) */",
+             f"#define RST_MODEL_N_STATES {len(derivatives)}",
+             f"#define RST_MODEL_N_EVENT_INDICATORS {len(vectors['EVENT_INDICATOR'])}"]
+    for name, vrs in vectors.items():
+        if vrs:
+            lines += [f"static const unsigned int RST_{upper}_{name}_VRS[] = {{{', '.join(map(str, vrs))}}};",
+                      f"#define RST_MODEL_{name}_VRS RST_{upper}_{name}_VRS"]
+        else:
+            lines.append(f"#define RST_MODEL_{name}_VRS NULL")
+    return lines
 
 
 def c_header(model: str, rows: list[Variable] | None = None) -> str:
@@ -159,6 +178,7 @@ def c_header(model: str, rows: list[Variable] | None = None) -> str:
             f"{_c_string(v.unit)}, {_c_string(v.description)}}},")
     lines += ["};", f"#define RST_MODEL_N_VARIABLES RST_{upper}_N_VARIABLES",
               f"#define RST_MODEL_VARIABLES RST_{upper}_VARIABLES"]
+    lines += _c_model_exchange(upper, rows)
     if enums:
         lines += _c_enums(upper, rows)
         for name, values in table(model).constants.items():

@@ -58,6 +58,16 @@ CO_SIMULATION = {
     "providesIntermediateUpdate": "false",
     "canReturnEarlyAfterIntermediateUpdate": "false",
 }
+#: What the native front offers for model exchange (the same binary as co-simulation): no completed
+#: integrator step needed (no step events), no discrete-state evaluation without an update.
+MODEL_EXCHANGE = {
+    "needsExecutionTool": "false",
+    "canBeInstantiatedOnlyOncePerProcess": "false",
+    "canGetAndSetFMUState": "true",
+    "canSerializeFMUState": "true",
+    "needsCompletedIntegratorStep": "false",
+    "providesEvaluateDiscreteStates": "false",
+}
 #: Table type -> FMI 3.0 element (an Integer with choices becomes an Enumeration instead).
 ELEMENTS = {"Real": "Float64", "Integer": "Int32", "Boolean": "Boolean"}
 PARAMETER_CAUSALITIES = ("parameter", "input")
@@ -109,7 +119,7 @@ def _limit(row: Variable, text: str) -> str:
     return str(int(float(text))) if row.type == "Integer" else text
 
 
-def _variable(parent: ET.Element, row: Variable) -> None:
+def _variable(parent: ET.Element, row: Variable, table: Table) -> None:
     element = "Enumeration" if row.is_enumeration else ELEMENTS[row.type]
     attrs = {"name": row.name, "valueReference": str(row.vr), "description": row.description,
              "causality": row.causality, "variability": row.variability}
@@ -119,6 +129,8 @@ def _variable(parent: ET.Element, row: Variable) -> None:
         attrs["declaredType"] = enumeration_type(row)
     if element == "Float64" and row.unit is not None:
         attrs["unit"] = row.unit
+    if row.derivative is not None:
+        attrs["derivative"] = str(table[row.derivative].vr)
     if row.causality in PARAMETER_CAUSALITIES:
         low, high = row.xml_limits()
         if low is not None:
@@ -157,8 +169,9 @@ def _type_definitions(table: Table) -> ET.Element | None:
 
 def _model_structure(table: Table) -> ET.Element:
     """Outputs with their direct dependence on the inputs (``feedthrough``: every input, else none);
-    InitialUnknowns as in the FMI 2.0 files: the outputs and the calculated parameters, without
-    dependencies (an absent attribute: may depend on every known)."""
+    the state derivatives and event indicators (model exchange); InitialUnknowns as in the FMI 2.0
+    files: the outputs, the state derivatives and the calculated parameters, without dependencies
+    (an absent attribute: may depend on every known)."""
     node = ET.Element("ModelStructure")
     inputs = [str(row.vr) for row in table if row.causality == "input"]
     for row in table.outputs:
@@ -166,8 +179,12 @@ def _model_structure(table: Table) -> ET.Element:
         if row.feedthrough and inputs:
             attrs["dependenciesKind"] = " ".join("dependent" for _ in inputs)
         ET.SubElement(node, "Output", attrs)
-    for row in sorted(table.outputs + table.calculated, key=lambda r: r.vr):
+    for row in table.derivatives:  # may depend on every state, parameter and input (no dependencies given)
+        ET.SubElement(node, "ContinuousStateDerivative", valueReference=str(row.vr))
+    for row in sorted(table.outputs + table.derivatives + table.calculated, key=lambda r: r.vr):
         ET.SubElement(node, "InitialUnknown", valueReference=str(row.vr))
+    for row in table.event_indicators:
+        ET.SubElement(node, "EventIndicator", valueReference=str(row.vr))
     return node
 
 
@@ -200,6 +217,7 @@ def model_description(model: str, instantiation_token: str) -> str:
         "generationDateAndTime": datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ"),
         "variableNamingConvention": "structured",
     })
+    ET.SubElement(root, "ModelExchange", {"modelIdentifier": model, **MODEL_EXCHANGE})
     ET.SubElement(root, "CoSimulation", {"modelIdentifier": model, **CO_SIMULATION})
     root.append(_unit_definitions(table))
     types = _type_definitions(table)
@@ -210,7 +228,7 @@ def model_description(model: str, instantiation_token: str) -> str:
         ET.SubElement(categories, "Category", name=name, description=description)
     variables = ET.SubElement(root, "ModelVariables")
     for row in table:
-        _variable(variables, row)
+        _variable(variables, row, table)
     # after every row, so that each row keeps its FMI 2.0 value reference; no start and no initial:
     # its value at the start is fmi3EnterInitializationMode's startTime
     ET.SubElement(variables, "Float64", {

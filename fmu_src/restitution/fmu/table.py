@@ -60,6 +60,11 @@ class Variable:
     #: the choices, with ``item_descriptions``); None: a plain Integer whose description lists the codes
     enumeration: str | None = None
     item_descriptions: tuple[str, ...] | None = None
+    #: the FMU name of the continuous state this variable is the time derivative of (model exchange:
+    #: the host integrates that state with this as its derivative); None: not a derivative
+    derivative: str | None = None
+    #: a model-exchange event indicator: the host locates where it crosses zero (a state event)
+    event_indicator: bool = False
 
     @property
     def initial(self) -> str | None:
@@ -144,9 +149,11 @@ def calculated_parameter(name, key, unit, description):
     return Variable(name, key, "Real", "calculatedParameter", "tunable", unit, description)
 
 
-def local(name, key, unit, description, *, state=True):
-    """A continuous Real local variable (one the model evolves: part of the state)."""
-    return Variable(name, key, "Real", "local", "continuous", unit, description, state=state)
+def local(name, key, unit, description, *, state=True, derivative=None, event_indicator=False):
+    """A continuous Real local variable (one the model evolves: part of the state, unless it is
+    recomputed from the others, as a ``derivative`` of a continuous state or an ``event_indicator``)."""
+    return Variable(name, key, "Real", "local", "continuous", unit, description, state=state, derivative=derivative,
+                    event_indicator=event_indicator)
 
 
 class Table:
@@ -165,6 +172,9 @@ class Table:
         for row in self.rows:
             if row.type not in TYPES or row.causality not in CAUSALITIES:
                 raise ValueError(f"{model}.{row.name}: unknown type {row.type!r} or causality {row.causality!r}")
+            if row.derivative is not None and (row.derivative not in self._by_name
+                                               or self._by_name[row.derivative].type != "Real"):
+                raise ValueError(f"{model}.{row.name}: derivative of {row.derivative!r}, which is not a Real of the table")
 
     def __getitem__(self, name: str) -> Variable:
         return self._by_name[name]
@@ -191,6 +201,21 @@ class Table:
     def calculated(self) -> tuple[Variable, ...]:
         """The calculated parameters, in value-reference order."""
         return tuple(row for row in self.rows if row.causality == "calculatedParameter")
+
+    @property
+    def derivatives(self) -> tuple[Variable, ...]:
+        """The derivatives of the continuous states (model exchange), in value-reference order."""
+        return tuple(row for row in self.rows if row.derivative is not None)
+
+    @property
+    def continuous_states(self) -> tuple[Variable, ...]:
+        """The continuous states, in the order of :attr:`derivatives` (the order of the state vector)."""
+        return tuple(self._by_name[row.derivative] for row in self.derivatives)
+
+    @property
+    def event_indicators(self) -> tuple[Variable, ...]:
+        """The event indicators (model exchange), in value-reference order."""
+        return tuple(row for row in self.rows if row.event_indicator)
 
     @property
     def enumerations(self) -> dict[str, Variable]:

@@ -1,7 +1,8 @@
-/* The FMI 2.0 co-simulation layer of the front: every fmi2 function, each a translation of FMI 2.0's
- * types into the core's (rst_front.c, rst_log.c, rst_state.c) and back. What FMI 2.0 alone has lives
- * here: the host's memory callbacks, the fmuResourceLocation URI, fmi2SetupExperiment, the status
- * queries and the '%' escaping its printf-style logger needs. */
+/* The FMI 2.0 layer of the front (co-simulation and model exchange): every fmi2 function, each a
+ * translation of FMI 2.0's types into the core's (rst_front.c, rst_exchange.c, rst_log.c, rst_state.c)
+ * and back. What FMI 2.0 alone has lives here: the host's memory callbacks, the fmuResourceLocation URI,
+ * fmi2SetupExperiment, the co-simulation status queries, fmi2EventInfo and the '%' escaping its
+ * printf-style logger needs. */
 #include "rst_front_internal.h"
 
 #include <math.h>
@@ -81,9 +82,9 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
                               loggingOn != fmi2False);
     if (inst == NULL)
         return NULL;
-    if (fmuType != fmi2CoSimulation) {
-        rst_log(inst, RST_ERROR, "fmi2Instantiate: %s is a co-simulation FMU; model exchange is not provided",
-                inst->model->identifier);
+    if (fmuType != fmi2CoSimulation && fmuType != fmi2ModelExchange) {
+        rst_log(inst, RST_ERROR, "fmi2Instantiate: fmuType = %d is neither fmi2ModelExchange (0) nor "
+                "fmi2CoSimulation (1)", (int)fmuType);
         front_discard_instance(inst);
         return NULL;
     }
@@ -101,7 +102,8 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
     }
     {
         rst_release_fn release = inst->release;
-        inst = front_instantiate(inst, "fmi2Instantiate", fmuGUID, resource_dir, visible != fmi2False);
+        inst = front_instantiate(inst, "fmi2Instantiate", fmuGUID, resource_dir, visible != fmi2False,
+                                 fmuType == fmi2ModelExchange);
         if (resource_dir != NULL)
             release(resource_dir);
     }
@@ -322,4 +324,74 @@ fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReferenc
     (void)vr, (void)nvr, (void)order, (void)value;
     rst_log(inst, RST_ERROR, "fmi2GetRealOutputDerivatives is not provided (maxOutputDerivativeOrder = 0)");
     LEAVE(RST_ERROR);
+}
+
+/* ------------------------------------------------------------------------------------------------ */
+/* Model exchange                                                                                   */
+/* ------------------------------------------------------------------------------------------------ */
+fmi2Status fmi2EnterEventMode(fmi2Component c) { return (fmi2Status)front_enter_event_mode(c, "fmi2EnterEventMode"); }
+
+fmi2Status fmi2NewDiscreteStates(fmi2Component c, fmi2EventInfo *eventInfo)
+{
+    rst_event_update update;
+    rst_status status;
+    if (eventInfo == NULL)
+        return (fmi2Status)front_refuse(c, "fmi2NewDiscreteStates", RST_MODE_EVENT, "eventInfo must not be NULL");
+    status = front_update_discrete_states(c, "fmi2NewDiscreteStates", &update);
+    if (status < RST_ERROR) {
+        eventInfo->newDiscreteStatesNeeded = update.discrete_states_need_update ? fmi2True : fmi2False;
+        eventInfo->terminateSimulation = update.terminate_simulation ? fmi2True : fmi2False;
+        eventInfo->nominalsOfContinuousStatesChanged = update.nominals_changed ? fmi2True : fmi2False;
+        eventInfo->valuesOfContinuousStatesChanged = update.states_changed ? fmi2True : fmi2False;
+        eventInfo->nextEventTimeDefined = update.next_event_time_defined ? fmi2True : fmi2False;
+        eventInfo->nextEventTime = update.next_event_time;
+    }
+    return (fmi2Status)status;
+}
+
+fmi2Status fmi2EnterContinuousTimeMode(fmi2Component c)
+{
+    return (fmi2Status)front_enter_continuous_time_mode(c, "fmi2EnterContinuousTimeMode");
+}
+
+fmi2Status fmi2CompletedIntegratorStep(fmi2Component c, fmi2Boolean noSetFMUStatePriorToCurrentPoint,
+                                       fmi2Boolean *enterEventMode, fmi2Boolean *terminateSimulation)
+{
+    int enter = 0, terminate = 0;
+    rst_status status;
+    (void)noSetFMUStatePriorToCurrentPoint;
+    status = front_completed_integrator_step(c, "fmi2CompletedIntegratorStep", enterEventMode ? &enter : NULL,
+                                             terminateSimulation ? &terminate : NULL);
+    if (status < RST_ERROR) {
+        *enterEventMode = enter ? fmi2True : fmi2False;
+        *terminateSimulation = terminate ? fmi2True : fmi2False;
+    }
+    return (fmi2Status)status;
+}
+
+fmi2Status fmi2SetTime(fmi2Component c, fmi2Real time) { return (fmi2Status)front_set_time(c, "fmi2SetTime", time); }
+
+fmi2Status fmi2SetContinuousStates(fmi2Component c, const fmi2Real x[], size_t nx)
+{
+    return (fmi2Status)front_set_continuous_states(c, "fmi2SetContinuousStates", x, nx);
+}
+
+fmi2Status fmi2GetDerivatives(fmi2Component c, fmi2Real derivatives[], size_t nx)
+{
+    return (fmi2Status)front_get_derivatives(c, "fmi2GetDerivatives", derivatives, nx);
+}
+
+fmi2Status fmi2GetEventIndicators(fmi2Component c, fmi2Real eventIndicators[], size_t ni)
+{
+    return (fmi2Status)front_get_event_indicators(c, "fmi2GetEventIndicators", eventIndicators, ni);
+}
+
+fmi2Status fmi2GetContinuousStates(fmi2Component c, fmi2Real x[], size_t nx)
+{
+    return (fmi2Status)front_get_continuous_states(c, "fmi2GetContinuousStates", x, nx);
+}
+
+fmi2Status fmi2GetNominalsOfContinuousStates(fmi2Component c, fmi2Real x_nominal[], size_t nx)
+{
+    return (fmi2Status)front_get_nominals(c, "fmi2GetNominalsOfContinuousStates", x_nominal, nx);
 }

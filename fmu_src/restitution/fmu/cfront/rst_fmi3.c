@@ -1,10 +1,11 @@
-/* The FMI 3.0 co-simulation layer of the front: every fmi3 function, each a translation of FMI 3.0's
- * types into the core's (rst_front.c, rst_log.c, rst_state.c) and back. What FMI 3.0 alone has lives
- * here: the independent variable `time` (value reference n_variables, after the table), Enumerations
- * got and set with the Int64 functions, the instantiation token and resource path, the experiment given
- * to fmi3EnterInitializationMode and fmi3DoStep's out-arguments. The FMU has no event mode, clocks,
- * intermediate updates or configuration mode, and is not yet offered for model exchange or scheduled
- * execution: those functions exist (a host may look them up) and refuse with a message. */
+/* The FMI 3.0 layer of the front (co-simulation and model exchange): every fmi3 function, each a
+ * translation of FMI 3.0's types into the core's (rst_front.c, rst_exchange.c, rst_log.c, rst_state.c)
+ * and back. What FMI 3.0 alone has lives here: the independent variable `time` (value reference
+ * n_variables, after the table), Enumerations got and set with the Int64 functions, the instantiation
+ * token and resource path, the experiment given to fmi3EnterInitializationMode, fmi3DoStep's and
+ * fmi3UpdateDiscreteStates' out-arguments. The FMU has no co-simulation event mode, clocks,
+ * intermediate updates or configuration mode and is not offered for scheduled execution: those
+ * functions exist (a host may look them up) and refuse with a message. */
 #include "rst_front_internal.h"
 
 #include <math.h>
@@ -68,6 +69,44 @@ static void instantiation_message(fmi3LogMessageCallback logger, fmi3InstanceEnv
         stderr_message(name, message);
 }
 
+/* A new instance named `name` (NULL, with a message, for a NULL or empty name or out of memory). */
+static rst_instance *new_instance(const char *function, fmi3String name, fmi3Boolean logging_on,
+                                  fmi3InstanceEnvironment environment, fmi3LogMessageCallback logger)
+{
+    char message[96];
+    if (name == NULL || name[0] == '\0') {
+        snprintf(message, sizeof message, "%s: the instance name is NULL or empty; not instantiated", function);
+        instantiation_message(logger, environment, "", message);
+        return NULL;
+    }
+    return front_new_instance(&FMI3, (void (*)(void))logger, environment, calloc, free, function, name, logging_on);
+}
+
+/* The instance `inst` given its resource path (a directory with a trailing separator, or NULL) as the
+ * backend wants it: the directory itself. NULL: refused (freed, with a message). */
+static rst_instance *instantiate(rst_instance *inst, const char *function, fmi3String token, fmi3String resourcePath,
+                                 fmi3Boolean visible, int model_exchange)
+{
+    char *resource_dir = NULL;
+    rst_release_fn release = inst->release;
+    if (resourcePath != NULL && resourcePath[0] != '\0') {
+        size_t n = strlen(resourcePath);
+        resource_dir = (char *)inst->allocate(n + 1, 1);
+        if (resource_dir == NULL) {
+            rst_log(inst, RST_ERROR, "%s: out of memory", function);
+            front_discard_instance(inst);
+            return NULL;
+        }
+        memcpy(resource_dir, resourcePath, n + 1);
+        while (n > 1 && (resource_dir[n - 1] == '/' || resource_dir[n - 1] == '\\'))
+            resource_dir[--n] = '\0';
+    }
+    inst = front_instantiate(inst, function, token, resource_dir, visible, model_exchange);
+    if (resource_dir != NULL)
+        release(resource_dir);
+    return inst;
+}
+
 fmi3Instance fmi3InstantiateCoSimulation(fmi3String instanceName, fmi3String instantiationToken,
                                          fmi3String resourcePath, fmi3Boolean visible, fmi3Boolean loggingOn,
                                          fmi3Boolean eventModeUsed, fmi3Boolean earlyReturnAllowed,
@@ -78,15 +117,8 @@ fmi3Instance fmi3InstantiateCoSimulation(fmi3String instanceName, fmi3String ins
                                          fmi3IntermediateUpdateCallback intermediateUpdate)
 {
     rst_instance *inst;
-    char *resource_dir = NULL;
     (void)earlyReturnAllowed, (void)requiredIntermediateVariables, (void)intermediateUpdate; /* never returns early */
-    if (instanceName == NULL || instanceName[0] == '\0') {
-        instantiation_message(logMessage, instanceEnvironment, "",
-                              "fmi3InstantiateCoSimulation: the instance name is NULL or empty; not instantiated");
-        return NULL;
-    }
-    inst = front_new_instance(&FMI3, (void (*)(void))logMessage, instanceEnvironment, calloc, free,
-                              "fmi3InstantiateCoSimulation", instanceName, loggingOn);
+    inst = new_instance("fmi3InstantiateCoSimulation", instanceName, loggingOn, instanceEnvironment, logMessage);
     if (inst == NULL)
         return NULL;
     if (eventModeUsed || nRequiredIntermediateVariables > 0) {
@@ -96,25 +128,7 @@ fmi3Instance fmi3InstantiateCoSimulation(fmi3String instanceName, fmi3String ins
         front_discard_instance(inst);
         return NULL;
     }
-    if (resourcePath != NULL && resourcePath[0] != '\0') {
-        size_t n = strlen(resourcePath);
-        resource_dir = (char *)inst->allocate(n + 1, 1);
-        if (resource_dir == NULL) {
-            rst_log(inst, RST_ERROR, "fmi3InstantiateCoSimulation: out of memory");
-            front_discard_instance(inst);
-            return NULL;
-        }
-        memcpy(resource_dir, resourcePath, n + 1);
-        while (n > 1 && (resource_dir[n - 1] == '/' || resource_dir[n - 1] == '\\'))
-            resource_dir[--n] = '\0'; /* resourcePath ends with a separator; backends want the directory */
-    }
-    {
-        rst_release_fn release = inst->release;
-        inst = front_instantiate(inst, "fmi3InstantiateCoSimulation", instantiationToken, resource_dir, visible);
-        if (resource_dir != NULL)
-            release(resource_dir);
-    }
-    return inst;
+    return instantiate(inst, "fmi3InstantiateCoSimulation", instantiationToken, resourcePath, visible, 0);
 }
 
 fmi3Instance fmi3InstantiateModelExchange(fmi3String instanceName, fmi3String instantiationToken,
@@ -122,11 +136,11 @@ fmi3Instance fmi3InstantiateModelExchange(fmi3String instanceName, fmi3String in
                                           fmi3InstanceEnvironment instanceEnvironment,
                                           fmi3LogMessageCallback logMessage)
 {
-    (void)instantiationToken, (void)resourcePath, (void)visible, (void)loggingOn;
-    instantiation_message(logMessage, instanceEnvironment, instanceName,
-                          "fmi3InstantiateModelExchange: this FMU is a co-simulation FMU; model exchange is not "
-                          "provided");
-    return NULL;
+    rst_instance *inst = new_instance("fmi3InstantiateModelExchange", instanceName, loggingOn, instanceEnvironment,
+                                      logMessage);
+    if (inst == NULL)
+        return NULL;
+    return instantiate(inst, "fmi3InstantiateModelExchange", instantiationToken, resourcePath, visible, 1);
 }
 
 fmi3Instance fmi3InstantiateScheduledExecution(fmi3String instanceName, fmi3String instantiationToken,
@@ -169,9 +183,10 @@ fmi3Status fmi3ExitInitializationMode(fmi3Instance instance)
     return (fmi3Status)front_exit_initialization(instance, "fmi3ExitInitializationMode");
 }
 
+/* model exchange; a co-simulation instance has no event mode (hasEventMode = false) and is refused */
 fmi3Status fmi3EnterEventMode(fmi3Instance instance)
 {
-    return (fmi3Status)front_refuse(instance, "fmi3EnterEventMode", ANY_MODE, "not provided (hasEventMode = false)");
+    return (fmi3Status)front_enter_event_mode(instance, "fmi3EnterEventMode");
 }
 
 fmi3Status fmi3Terminate(fmi3Instance instance) { return (fmi3Status)front_terminate(instance, "fmi3Terminate"); }
@@ -342,8 +357,8 @@ fmi3Status fmi3GetOutputDerivatives(fmi3Instance instance, const fmi3ValueRefere
 }
 
 /* ------------------------------------------------------------------------------------------------ */
-/* Not provided: dependencies at run time, derivatives, configuration, clocks, discrete states, model  */
-/* exchange and scheduled execution                                                                  */
+/* Not provided: dependencies at run time, partial derivatives, configuration, clocks, scheduled     */
+/* execution; then model exchange                                                                    */
 /* ------------------------------------------------------------------------------------------------ */
 fmi3Status fmi3GetNumberOfVariableDependencies(fmi3Instance instance, fmi3ValueReference valueReference,
                                                size_t *nDependencies)
@@ -379,7 +394,6 @@ DERIVATIVE(DirectionalDerivative, "providesDirectionalDerivatives")
 DERIVATIVE(AdjointDerivative, "providesAdjointDerivatives")
 
 #define NO_CLOCKS "this FMU has no clocks"
-#define NO_ME "this FMU is not offered for model exchange"
 
 fmi3Status fmi3EnterConfigurationMode(fmi3Instance instance)
 {
@@ -462,75 +476,88 @@ fmi3Status fmi3UpdateDiscreteStates(fmi3Instance instance, fmi3Boolean *discrete
                                     fmi3Boolean *valuesOfContinuousStatesChanged, fmi3Boolean *nextEventTimeDefined,
                                     fmi3Float64 *nextEventTime)
 {
-    (void)discreteStatesNeedUpdate, (void)terminateSimulation, (void)nominalsOfContinuousStatesChanged;
-    (void)valuesOfContinuousStatesChanged, (void)nextEventTimeDefined, (void)nextEventTime;
-    return (fmi3Status)front_refuse(instance, "fmi3UpdateDiscreteStates", ANY_MODE,
-                                    "not provided (hasEventMode = false)");
+    rst_event_update update;
+    rst_status status;
+    if (discreteStatesNeedUpdate == NULL || terminateSimulation == NULL || nominalsOfContinuousStatesChanged == NULL ||
+        valuesOfContinuousStatesChanged == NULL || nextEventTimeDefined == NULL || nextEventTime == NULL)
+        return (fmi3Status)front_refuse(instance, "fmi3UpdateDiscreteStates", RST_MODE_EVENT,
+                                        "its out-arguments must not be NULL");
+    status = front_update_discrete_states(instance, "fmi3UpdateDiscreteStates", &update);
+    if (status < RST_ERROR) {
+        *discreteStatesNeedUpdate = update.discrete_states_need_update != 0;
+        *terminateSimulation = update.terminate_simulation != 0;
+        *nominalsOfContinuousStatesChanged = update.nominals_changed != 0;
+        *valuesOfContinuousStatesChanged = update.states_changed != 0;
+        *nextEventTimeDefined = update.next_event_time_defined != 0;
+        *nextEventTime = update.next_event_time;
+    }
+    return (fmi3Status)status;
 }
 
 fmi3Status fmi3EnterContinuousTimeMode(fmi3Instance instance)
 {
-    return (fmi3Status)front_refuse(instance, "fmi3EnterContinuousTimeMode", ANY_MODE, "not provided (" NO_ME ")");
+    return (fmi3Status)front_enter_continuous_time_mode(instance, "fmi3EnterContinuousTimeMode");
 }
 
 fmi3Status fmi3CompletedIntegratorStep(fmi3Instance instance, fmi3Boolean noSetFMUStatePriorToCurrentPoint,
                                        fmi3Boolean *enterEventMode, fmi3Boolean *terminateSimulation)
 {
-    (void)noSetFMUStatePriorToCurrentPoint, (void)enterEventMode, (void)terminateSimulation;
-    return (fmi3Status)front_refuse(instance, "fmi3CompletedIntegratorStep", ANY_MODE, "not provided (" NO_ME ")");
+    int enter = 0, terminate = 0;
+    rst_status status;
+    (void)noSetFMUStatePriorToCurrentPoint;
+    status = front_completed_integrator_step(instance, "fmi3CompletedIntegratorStep", enterEventMode ? &enter : NULL,
+                                             terminateSimulation ? &terminate : NULL);
+    if (status < RST_ERROR) {
+        *enterEventMode = enter != 0;
+        *terminateSimulation = terminate != 0;
+    }
+    return (fmi3Status)status;
 }
 
 fmi3Status fmi3SetTime(fmi3Instance instance, fmi3Float64 time)
 {
-    (void)time;
-    return (fmi3Status)front_refuse(instance, "fmi3SetTime", ANY_MODE, "not provided (" NO_ME ")");
+    return (fmi3Status)front_set_time(instance, "fmi3SetTime", time);
 }
 
 fmi3Status fmi3SetContinuousStates(fmi3Instance instance, const fmi3Float64 continuousStates[],
                                    size_t nContinuousStates)
 {
-    (void)continuousStates, (void)nContinuousStates;
-    return (fmi3Status)front_refuse(instance, "fmi3SetContinuousStates", ANY_MODE, "not provided (" NO_ME ")");
+    return (fmi3Status)front_set_continuous_states(instance, "fmi3SetContinuousStates", continuousStates,
+                                                   nContinuousStates);
 }
 
 fmi3Status fmi3GetContinuousStateDerivatives(fmi3Instance instance, fmi3Float64 derivatives[],
                                              size_t nContinuousStates)
 {
-    (void)derivatives, (void)nContinuousStates;
-    return (fmi3Status)front_refuse(instance, "fmi3GetContinuousStateDerivatives", ANY_MODE,
-                                    "not provided (" NO_ME ")");
+    return (fmi3Status)front_get_derivatives(instance, "fmi3GetContinuousStateDerivatives", derivatives,
+                                             nContinuousStates);
 }
 
 fmi3Status fmi3GetEventIndicators(fmi3Instance instance, fmi3Float64 eventIndicators[], size_t nEventIndicators)
 {
-    (void)eventIndicators, (void)nEventIndicators;
-    return (fmi3Status)front_refuse(instance, "fmi3GetEventIndicators", ANY_MODE, "not provided (" NO_ME ")");
+    return (fmi3Status)front_get_event_indicators(instance, "fmi3GetEventIndicators", eventIndicators,
+                                                  nEventIndicators);
 }
 
 fmi3Status fmi3GetContinuousStates(fmi3Instance instance, fmi3Float64 continuousStates[], size_t nContinuousStates)
 {
-    (void)continuousStates, (void)nContinuousStates;
-    return (fmi3Status)front_refuse(instance, "fmi3GetContinuousStates", ANY_MODE, "not provided (" NO_ME ")");
+    return (fmi3Status)front_get_continuous_states(instance, "fmi3GetContinuousStates", continuousStates,
+                                                   nContinuousStates);
 }
 
 fmi3Status fmi3GetNominalsOfContinuousStates(fmi3Instance instance, fmi3Float64 nominals[], size_t nContinuousStates)
 {
-    (void)nominals, (void)nContinuousStates;
-    return (fmi3Status)front_refuse(instance, "fmi3GetNominalsOfContinuousStates", ANY_MODE,
-                                    "not provided (" NO_ME ")");
+    return (fmi3Status)front_get_nominals(instance, "fmi3GetNominalsOfContinuousStates", nominals, nContinuousStates);
 }
 
 fmi3Status fmi3GetNumberOfEventIndicators(fmi3Instance instance, size_t *nEventIndicators)
 {
-    (void)nEventIndicators;
-    return (fmi3Status)front_refuse(instance, "fmi3GetNumberOfEventIndicators", ANY_MODE, "not provided (" NO_ME ")");
+    return (fmi3Status)front_get_sizes(instance, "fmi3GetNumberOfEventIndicators", NULL, nEventIndicators);
 }
 
 fmi3Status fmi3GetNumberOfContinuousStates(fmi3Instance instance, size_t *nContinuousStates)
 {
-    (void)nContinuousStates;
-    return (fmi3Status)front_refuse(instance, "fmi3GetNumberOfContinuousStates", ANY_MODE,
-                                    "not provided (" NO_ME ")");
+    return (fmi3Status)front_get_sizes(instance, "fmi3GetNumberOfContinuousStates", nContinuousStates, NULL);
 }
 
 fmi3Status fmi3ActivateModelPartition(fmi3Instance instance, fmi3ValueReference clockReference,

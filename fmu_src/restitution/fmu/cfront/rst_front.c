@@ -33,6 +33,7 @@ const char *rst_instance_name(const rst_instance *inst) { return inst->name; }
 rst_mode rst_mode_of(const rst_instance *inst) { return inst->mode; }
 double rst_start_time(const rst_instance *inst) { return inst->has_start ? inst->start_time : 0.0; }
 const char *rst_fmi_prefix(const rst_instance *inst) { return inst->api->prefix; }
+int rst_is_model_exchange(const rst_instance *inst) { return inst->model_exchange; }
 
 /* The mode as messages name it; `buffer` holds the text of the modes that name a function. */
 static const char *mode_name(const rst_instance *inst, rst_mode mode, char *buffer, size_t size)
@@ -46,6 +47,8 @@ static const char *mode_name(const rst_instance *inst, rst_mode mode, char *buff
                  inst->api->prefix);
         return buffer;
     case RST_MODE_TERMINATED: return "terminated";
+    case RST_MODE_EVENT: return "event mode";
+    case RST_MODE_CONTINUOUS: return "continuous-time mode";
     case RST_MODE_ERROR: return "error";
     default: return "fatal error";
     }
@@ -97,8 +100,9 @@ int front_allowed(rst_instance *inst, const char *function, unsigned int modes)
         return 0;
     }
     if (!(modes & (unsigned int)inst->mode)) {
-        rst_log(inst, RST_ERROR, "%s is not allowed in %s (%s co-simulation state machine)", function,
-                mode_name(inst, inst->mode, buffer, sizeof buffer), inst->api->standard);
+        rst_log(inst, RST_ERROR, "%s is not allowed in %s (%s %s state machine)", function,
+                mode_name(inst, inst->mode, buffer, sizeof buffer), inst->api->standard,
+                inst->model_exchange ? "model-exchange" : "co-simulation");
         return 0;
     }
     return 1;
@@ -175,8 +179,9 @@ static int is_time(const rst_instance *inst, rst_vr vr)
     return inst->api->time_variable && vr == inst->model->n_variables;
 }
 
-/* The independent variable: the start time until the first step, then the end of the last step. */
-static double current_time(const rst_instance *inst)
+/* The independent variable: the start time until initialization ends, then the end of the last step
+ * (co-simulation) or the time the host set (model exchange). */
+double rst_time(const rst_instance *inst)
 {
     if (inst->mode == RST_MODE_INSTANTIATED || inst->mode == RST_MODE_INITIALIZATION)
         return rst_start_time(inst);
@@ -209,13 +214,16 @@ static int check_vr(rst_instance *inst, const char *function, rst_vr vr, unsigne
 }
 
 /* May the host set `var` in the current mode? (Inputs and parameters in instantiated and
- * initialization mode; in step mode inputs and tunable parameters only.) */
+ * initialization mode; in step mode and event mode inputs and tunable parameters only; in
+ * continuous-time mode inputs only.) */
 static int settable(const rst_instance *inst, const rst_variable *var)
 {
     if (var->causality != RST_INPUT && var->causality != RST_PARAMETER)
         return 0;
-    if (inst->mode == RST_MODE_STEP_COMPLETE)
+    if (inst->mode == RST_MODE_STEP_COMPLETE || inst->mode == RST_MODE_EVENT)
         return var->causality == RST_INPUT || var->variability == RST_TUNABLE;
+    if (inst->mode == RST_MODE_CONTINUOUS)
+        return var->causality == RST_INPUT;
     return 1;
 }
 
@@ -238,9 +246,11 @@ static int check_set(rst_instance *inst, const char *function, rst_vr vr, unsign
                     : var->causality == RST_LOCAL ? "a local variable"
                                                   : "a calculated parameter");
         else
-            rst_log(inst, RST_ERROR, "%s: %s is a fixed parameter and cannot be set in %s (only before "
-                    "%sExitInitializationMode)", function, var->name,
-                    mode_name(inst, inst->mode, buffer, sizeof buffer), inst->api->prefix);
+            rst_log(inst, RST_ERROR, "%s: %s is a %s parameter and cannot be set in %s (only %s)", function,
+                    var->name, var->variability == RST_TUNABLE ? "tunable" : "fixed",
+                    mode_name(inst, inst->mode, buffer, sizeof buffer),
+                    var->variability == RST_TUNABLE ? "in event mode, step mode or before initialization ends"
+                                                    : "before initialization ends");
         return 0;
     }
     if (!front_in_range(var, value)) {
@@ -326,7 +336,7 @@ static rst_status get_chunk(rst_instance *inst, const char *function, unsigned i
         if (!check_vr(inst, function, vr[i], kinds))
             return RST_ERROR;
         if (is_time(inst, vr[i])) {
-            out[i] = current_time(inst);
+            out[i] = rst_time(inst);
             continue;
         }
         out[i] = inst->store[vr[i]];
@@ -344,6 +354,11 @@ static rst_status get_chunk(rst_instance *inst, const char *function, unsigned i
         for (i = 0; i < n_outputs; i++)
             out[position[i]] = output_values[i];
     return status;
+}
+
+rst_status front_get_vector(rst_instance *inst, const char *function, const unsigned int vr[], size_t n, double out[])
+{
+    return get_chunk(inst, function, RST_AS_REAL, vr, n, out);
 }
 
 rst_status front_get(void *c, const char *function, unsigned int kinds, const rst_vr vr[], size_t n,
@@ -498,9 +513,16 @@ rst_instance *front_new_instance(const rst_api *api, void (*host_logger)(void), 
 }
 
 rst_instance *front_instantiate(rst_instance *inst, const char *function, const char *token,
-                                const char *resource_dir, int visible)
+                                const char *resource_dir, int visible, int model_exchange)
 {
     rst_status status;
+    if (model_exchange && !inst->model->model_exchange) {
+        rst_log(inst, RST_ERROR, "%s: %s is a co-simulation FMU; model exchange is not provided", function,
+                inst->model->identifier);
+        free_memory(inst);
+        return NULL;
+    }
+    inst->model_exchange = model_exchange;
     if (token == NULL || strcmp(token, inst->model->guid) != 0) {
         rst_log(inst, RST_ERROR, "%s: %s %s does not match this FMU's %s (modelDescription.xml of another FMU or "
                 "another build?)", function, inst->api->token_name,
@@ -586,7 +608,8 @@ rst_status front_exit_initialization(void *c, const char *function)
     if (inst->model->exit_initialization != NULL)
         status = front_backend_status(inst, inst->model->exit_initialization(inst));
     if (status < RST_ERROR) {
-        inst->mode = RST_MODE_STEP_COMPLETE;
+        /* co-simulation steps from here; model exchange starts with an event (FMI 2.0 and 3.0) */
+        inst->mode = inst->model_exchange ? RST_MODE_EVENT : RST_MODE_STEP_COMPLETE;
         inst->has_time = inst->has_start;
         inst->next_time = inst->start_time;
         inst->last_time = inst->start_time;
@@ -597,7 +620,7 @@ rst_status front_exit_initialization(void *c, const char *function)
 rst_status front_terminate(void *c, const char *function)
 {
     rst_status status = RST_OK;
-    ENTER(function, RST_MODE_STEP_COMPLETE | RST_MODE_STEP_FAILED)
+    ENTER(function, RST_MODE_STEP_COMPLETE | RST_MODE_STEP_FAILED | ME_MODES)
     if (inst->model->terminate != NULL)
         status = front_backend_status(inst, inst->model->terminate(inst));
     if (status < RST_ERROR)

@@ -27,6 +27,8 @@
 #if defined(RST_PREFIXED)
 #define RST_MODEL RST_PREFIXED(RST_MODEL)
 #define rst_fmi_prefix RST_PREFIXED(rst_fmi_prefix)
+#define rst_is_model_exchange RST_PREFIXED(rst_is_model_exchange)
+#define rst_time RST_PREFIXED(rst_time)
 #define rst_store RST_PREFIXED(rst_store)
 #define rst_backend RST_PREFIXED(rst_backend)
 #define rst_instance_name RST_PREFIXED(rst_instance_name)
@@ -45,7 +47,18 @@ typedef enum { RST_OK = 0, RST_WARNING = 1, RST_DISCARD = 2, RST_ERROR = 3, RST_
 /* A value reference (fmi2ValueReference and fmi3ValueReference are both 32-bit unsigned). */
 typedef unsigned int rst_vr;
 
-/* The co-simulation modes, as bits (sets of modes describe where a call is allowed). FMI 2.0's
+/* What a model-exchange event update tells the host (fmi2NewDiscreteStates' fmi2EventInfo,
+ * fmi3UpdateDiscreteStates' out-arguments). */
+typedef struct {
+    int discrete_states_need_update; /* iterate: call the update again */
+    int terminate_simulation;
+    int nominals_changed;            /* nominals of the continuous states */
+    int states_changed;              /* values of the continuous states */
+    int next_event_time_defined;
+    double next_event_time;          /* [s] */
+} rst_event_update;
+
+/* The co-simulation and model-exchange modes, as bits (sets of modes describe where a call is allowed). FMI 2.0's
  * stepInProgress and stepCanceled never occur (every step here is synchronous), nor FMI 3.0's event
  * and intermediate-update modes (not offered). RST_MODE_STEP_FAILED: a step returned a discard. */
 typedef enum {
@@ -55,7 +68,9 @@ typedef enum {
     RST_MODE_STEP_FAILED = 8,
     RST_MODE_TERMINATED = 16,
     RST_MODE_ERROR = 32,
-    RST_MODE_FATAL = 64 /* latched: every later call returns an error without reaching the backend */
+    RST_MODE_FATAL = 64, /* latched: every later call returns an error without reaching the backend */
+    RST_MODE_EVENT = 128,      /* model exchange: event mode */
+    RST_MODE_CONTINUOUS = 256  /* model exchange: continuous-time mode */
 } rst_mode;
 
 /* A model: its identity, its interface table and the backend's hooks. Every hook is optional (NULL:
@@ -68,6 +83,15 @@ typedef struct {
     const rst_variable *variables; /* indexed by value reference */
     size_t n_variables;
     size_t backend_size;           /* bytes of zeroed backend data allocated with each instance */
+    /* Model exchange (a model that offers it; the front refuses it for the others): the continuous
+     * states and their derivatives (value references, in the state vector's order), the event
+     * indicators. Derivatives and indicators are variables the backend computes in get_outputs;
+     * states are variables of the store, which the host sets (the backend's set hook hears of it). */
+    int model_exchange;
+    size_t n_states;
+    const unsigned int *state_vrs, *derivative_vrs;
+    size_t n_event_indicators;
+    const unsigned int *event_indicator_vrs;
 
     /* fmi2Instantiate, after the front's checks; `resource_dir` is the resource directory (FMI 2.0:
      * the decoded fmuResourceLocation; FMI 3.0: resourcePath) or NULL when the host gave none.
@@ -99,7 +123,15 @@ typedef struct {
     /* fmi2SetFMUstate: the store holds a validated snapshot; make the backend take every state
      * variable from it */
     rst_status (*restore_state)(rst_instance *inst);
+    /* fmi2NewDiscreteStates / fmi3UpdateDiscreteStates (model exchange, event mode, at rst_time):
+     * handle the event; `result` starts all zero */
+    rst_status (*update_discrete_states)(rst_instance *inst, rst_event_update *result);
 } rst_model;
+
+/* The model-exchange vectors of a glue's RST_MODEL, from its generated interface header. */
+#define RST_MODEL_EXCHANGE_VECTORS                                                                   \
+    .n_states = RST_MODEL_N_STATES, .state_vrs = RST_MODEL_STATE_VRS, .derivative_vrs = RST_MODEL_DERIVATIVE_VRS, \
+    .n_event_indicators = RST_MODEL_N_EVENT_INDICATORS, .event_indicator_vrs = RST_MODEL_EVENT_INDICATOR_VRS
 
 /* Defined by the glue file compiled together with the front (one model per binary). */
 extern const rst_model RST_MODEL;
@@ -111,6 +143,8 @@ const char *rst_instance_name(const rst_instance *inst);
 rst_mode rst_mode_of(const rst_instance *inst);
 double rst_start_time(const rst_instance *inst); /* from fmi2SetupExperiment or fmi3EnterInitializationMode (0 before) */
 const char *rst_fmi_prefix(const rst_instance *inst); /* "fmi2" or "fmi3": FMI function names in messages */
+int rst_is_model_exchange(const rst_instance *inst);    /* instantiated for model exchange */
+double rst_time(const rst_instance *inst); /* [s] the current time: start, end of the last step, or set (ME) */
 /* Log through the host's logger: RST_WARNING and worse always (they say why a call failed);
  * RST_OK messages only when the host enabled debug logging for logAll. */
 void rst_log(rst_instance *inst, rst_status status, const char *format, ...)

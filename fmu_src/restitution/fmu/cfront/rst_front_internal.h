@@ -44,6 +44,18 @@
 #define front_reset RST_PREFIXED(front_reset)
 #define front_do_step RST_PREFIXED(front_do_step)
 #define front_refuse RST_PREFIXED(front_refuse)
+#define front_enter_event_mode RST_PREFIXED(front_enter_event_mode)
+#define front_enter_continuous_time_mode RST_PREFIXED(front_enter_continuous_time_mode)
+#define front_update_discrete_states RST_PREFIXED(front_update_discrete_states)
+#define front_completed_integrator_step RST_PREFIXED(front_completed_integrator_step)
+#define front_set_time RST_PREFIXED(front_set_time)
+#define front_set_continuous_states RST_PREFIXED(front_set_continuous_states)
+#define front_get_continuous_states RST_PREFIXED(front_get_continuous_states)
+#define front_get_derivatives RST_PREFIXED(front_get_derivatives)
+#define front_get_event_indicators RST_PREFIXED(front_get_event_indicators)
+#define front_get_nominals RST_PREFIXED(front_get_nominals)
+#define front_get_sizes RST_PREFIXED(front_get_sizes)
+#define front_get_vector RST_PREFIXED(front_get_vector)
 #define front_set_debug_logging RST_PREFIXED(front_set_debug_logging)
 #define front_decode_file_uri RST_PREFIXED(front_decode_file_uri)
 #define front_get_state RST_PREFIXED(front_get_state)
@@ -64,10 +76,12 @@
 #define RST_STATE_MAGIC 0x52535453u    /* "RSTS" */
 #define RST_ALL_CATEGORIES 31u         /* the five log categories, all on */
 
+#define ME_MODES (RST_MODE_EVENT | RST_MODE_CONTINUOUS)
 #define ANY_LIVE_MODE (RST_MODE_INSTANTIATED | RST_MODE_INITIALIZATION | RST_MODE_STEP_COMPLETE | RST_MODE_STEP_FAILED | \
-                       RST_MODE_TERMINATED | RST_MODE_ERROR)
-#define GET_MODES (RST_MODE_INITIALIZATION | RST_MODE_STEP_COMPLETE | RST_MODE_STEP_FAILED | RST_MODE_TERMINATED | RST_MODE_ERROR)
-#define SET_MODES (RST_MODE_INSTANTIATED | RST_MODE_INITIALIZATION | RST_MODE_STEP_COMPLETE)
+                       RST_MODE_TERMINATED | RST_MODE_ERROR | ME_MODES)
+#define GET_MODES (RST_MODE_INITIALIZATION | RST_MODE_STEP_COMPLETE | RST_MODE_STEP_FAILED | RST_MODE_TERMINATED | \
+                   RST_MODE_ERROR | ME_MODES)
+#define SET_MODES (RST_MODE_INSTANTIATED | RST_MODE_INITIALIZATION | RST_MODE_STEP_COMPLETE | ME_MODES)
 
 /* A message waiting to reach the host's logger: messages of a call are delivered after the call has
  * released the instance's lock, so a logger may call back into the same instance (FMI 2.0 does not
@@ -112,6 +126,7 @@ struct rst_instance {
     unsigned int magic;
     const rst_model *model;
     const rst_api *api;
+    int model_exchange; /* instantiated for model exchange (else co-simulation) */
     char *name;
     void (*host_logger)(void); /* the host's logger, of the version layer's type (api->emit casts it back) */
     void *environment;         /* what the host passes back to its logger */
@@ -124,7 +139,7 @@ struct rst_instance {
     double start_time;
     int has_time;       /* next_time is known: the t the next step must have */
     double next_time;
-    double last_time;   /* end of the last successful step (fmi2LastSuccessfulTime) */
+    double last_time;   /* end of the last successful step (fmi2LastSuccessfulTime); model exchange: the time set */
     rst_status last_step_status;
     size_t n_state;     /* state variables of the table */
     rst_state *states;  /* FMU states made by this instance, to tell ours from any other pointer */
@@ -166,6 +181,8 @@ int front_allowed(rst_instance *inst, const char *function, unsigned int modes);
 rst_status front_backend_status(rst_instance *inst, rst_status status);       /* Error, Fatal: change mode */
 
 /* Values (rst_front.c). */
+/* Reads the variables `vr` (at most 64) through the backend as a get call would (locked, mode checked). */
+rst_status front_get_vector(rst_instance *inst, const char *function, const unsigned int vr[], size_t n, double out[]);
 int front_in_range(const rst_variable *var, double value);
 void front_describe_value(rst_type type, double value, char *out, size_t size);
 const char *front_type_name(rst_type type);
@@ -179,7 +196,7 @@ rst_instance *front_new_instance(const rst_api *api, void (*host_logger)(void), 
 /* Checks the GUID (FMI 3.0: instantiation token) and runs the backend's instantiate: the instance, or
  * NULL (freed, with a message). */
 rst_instance *front_instantiate(rst_instance *inst, const char *function, const char *token,
-                                const char *resource_dir, int visible);
+                                const char *resource_dir, int visible, int model_exchange);
 void front_discard_instance(rst_instance *inst); /* frees an instance that never reached the host */
 void front_free_instance(void *c);
 /* `kinds`: the rst_access kinds this call may touch; `n_values` must equal `n` (one value each). */
@@ -211,6 +228,20 @@ rst_message *front_take_messages(rst_instance *inst);
 void front_deliver_messages(rst_instance *inst, rst_message *messages);
 rst_status front_set_debug_logging(void *c, const char *function, int logging_on, size_t n,
                                    const char *const categories[]);
+
+/* Model exchange (rst_exchange.c). */
+rst_status front_enter_event_mode(void *c, const char *function);
+rst_status front_enter_continuous_time_mode(void *c, const char *function);
+rst_status front_update_discrete_states(void *c, const char *function, rst_event_update *result);
+rst_status front_completed_integrator_step(void *c, const char *function, int *enter_event_mode, int *terminate);
+rst_status front_set_time(void *c, const char *function, double time);
+rst_status front_set_continuous_states(void *c, const char *function, const double x[], size_t n);
+rst_status front_get_continuous_states(void *c, const char *function, double x[], size_t n);
+rst_status front_get_derivatives(void *c, const char *function, double dx[], size_t n);
+rst_status front_get_event_indicators(void *c, const char *function, double z[], size_t n);
+rst_status front_get_nominals(void *c, const char *function, double nominals[], size_t n);
+/* the sizes of the state vector and of the event indicators (FMI 3.0 asks for them) */
+rst_status front_get_sizes(void *c, const char *function, size_t *n_states, size_t *n_event_indicators);
 
 /* FMU states (rst_state.c). */
 void front_free_states(rst_instance *inst);

@@ -119,6 +119,13 @@ static int check_snapshot(rst_instance *inst, const char *function, const rst_st
         rst_log(inst, RST_ERROR, "%s: the state's mode or times are invalid", function);
         return 0;
     }
+    if (inst->model_exchange ? (s->mode & (RST_MODE_STEP_COMPLETE | RST_MODE_STEP_FAILED)) != 0
+                             : (s->mode & ME_MODES) != 0) {
+        rst_log(inst, RST_ERROR, "%s: the state was taken from a %s instance; this one is %s", function,
+                inst->model_exchange ? "co-simulation" : "model-exchange",
+                inst->model_exchange ? "model exchange" : "co-simulation");
+        return 0;
+    }
     for (i = 0; i < inst->model->n_variables; i++) {
         const rst_variable *var = &inst->model->variables[i];
         double value;

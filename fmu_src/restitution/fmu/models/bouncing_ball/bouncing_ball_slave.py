@@ -127,7 +127,7 @@ def bounce_train(t0, u, e, g, v_min, limit):
 _INITIAL_STATE = {
     "h": 0.0, "v": 0.0, "v_approach": 0.0, "impacts": 0, "t_impact": -1.0, "v_impact": 0.0,
     "t_rebound": -1.0, "v_rebound": 0.0, "e_applied": 0.0, "in_contact": False, "at_rest": False,
-    "t_start": 0.0, "h_start": 0.0, "v_start": 0.0,
+    "t_start": 0.0, "h_start": 0.0, "v_start": 0.0, "der_h": 0.0, "der_v": 0.0, "contact_indicator": 0.0,
 }
 
 
@@ -208,16 +208,26 @@ class BouncingBall(Fmi2Slave):
         s = self._s
         if s["at_rest"]:
             s["h"], s["v"], s["v_approach"] = 0.0, 0.0, 0.0
-            return
-        if s["in_contact"]:
+        elif s["in_contact"]:
             s["h"], s["v"], s["v_approach"] = 0.0, -s["v_impact"], s["v_impact"]
-            return
-        g = float(self._values["g"])
-        # within the flight: a flight shorter than the clock's resolution must not extrapolate past its end
-        dt = min(max(t - s["t_start"], 0.0), flight_duration(s["h_start"], s["v_start"], g))
-        s["h"] = max(s["h_start"] + s["v_start"] * dt - 0.5 * g * dt * dt, 0.0)
-        s["v"] = s["v_start"] - g * dt
-        s["v_approach"] = max(-s["v"], 0.0)
+        else:
+            g = float(self._values["g"])
+            # within the flight: a flight shorter than the clock's resolution must not extrapolate past its end
+            dt = min(max(t - s["t_start"], 0.0), flight_duration(s["h_start"], s["v_start"], g))
+            s["h"] = max(s["h_start"] + s["v_start"] * dt - 0.5 * g * dt * dt, 0.0)
+            s["v"] = s["v_start"] - g * dt
+            s["v_approach"] = max(-s["v"], 0.0)
+        self._update_derivatives()
+
+    def _update_derivatives(self):
+        """der(h), der(v) and the contact indicator from the state (the native model exchange's
+        equations: flight under gravity; nothing moves at the plate)."""
+        s = self._s
+        if s["at_rest"] or s["in_contact"]:
+            s["der_h"], s["der_v"] = 0.0, 0.0
+        else:
+            s["der_h"], s["der_v"] = s["v"], -float(self._values["g"])
+        s["contact_indicator"] = 1.0 if s["at_rest"] else s["h"]
 
     def _impact(self, t, v, count):
         """The last of `count` contacts: at time t [s] with approach speed v [m/s]."""

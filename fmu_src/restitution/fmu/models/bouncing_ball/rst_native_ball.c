@@ -48,29 +48,38 @@ static double flight_duration(double h_start, double v_start, double g)
     return (v_start + sqrt(v_start * v_start + 2.0 * g * h_start)) / g;
 }
 
+/* _update_derivatives: der(h), der(v) and the contact indicator from the state (flight under
+ * gravity; nothing moves at the plate; at rest the indicator stays at 1 m: no more contacts). */
+static void update_derivatives(double *values)
+{
+    int still = AT(AT_REST) != 0.0 || AT(IN_CONTACT) != 0.0;
+    AT(DER_H) = still ? 0.0 : AT(V);
+    AT(DER_V) = still ? 0.0 : -AT(G);
+    AT(CONTACT_INDICATOR) = AT(AT_REST) != 0.0 ? 1.0 : AT(H);
+}
+
 /* _update_outputs: height [m], velocity [m/s] and approach speed [m/s] at time t [s]. */
 static void update_outputs(double *values, double t)
 {
     double g, dt, h, duration;
     if (AT(AT_REST) != 0.0) {
         AT(H) = AT(V) = AT(V_APPROACH) = 0.0;
-        return;
-    }
-    if (AT(IN_CONTACT) != 0.0) {
+    } else if (AT(IN_CONTACT) != 0.0) {
         AT(H) = 0.0;
         AT(V) = -AT(V_IMPACT);
         AT(V_APPROACH) = AT(V_IMPACT);
-        return;
+    } else {
+        g = AT(G);
+        dt = t - AT(FLIGHT_T_START);
+        dt = dt >= 0.0 ? dt : 0.0;
+        duration = flight_duration(AT(FLIGHT_H_START), AT(FLIGHT_V_START), g);
+        dt = dt <= duration ? dt : duration;
+        h = AT(FLIGHT_H_START) + AT(FLIGHT_V_START) * dt - 0.5 * g * dt * dt;
+        AT(H) = h >= 0.0 ? h : 0.0;
+        AT(V) = AT(FLIGHT_V_START) - g * dt;
+        AT(V_APPROACH) = -AT(V) >= 0.0 ? -AT(V) : 0.0;
     }
-    g = AT(G);
-    dt = t - AT(FLIGHT_T_START);
-    dt = dt >= 0.0 ? dt : 0.0;
-    duration = flight_duration(AT(FLIGHT_H_START), AT(FLIGHT_V_START), g);
-    dt = dt <= duration ? dt : duration;
-    h = AT(FLIGHT_H_START) + AT(FLIGHT_V_START) * dt - 0.5 * g * dt * dt;
-    AT(H) = h >= 0.0 ? h : 0.0;
-    AT(V) = AT(FLIGHT_V_START) - g * dt;
-    AT(V_APPROACH) = -AT(V) >= 0.0 ? -AT(V) : 0.0;
+    update_derivatives(values);
 }
 
 /* _impact: the last of `count` contacts, at time t [s] with approach speed v [m/s]. */
@@ -145,6 +154,7 @@ void rst_ball_clear(double *values)
     AT(V_REBOUND) = 0.0;
     AT(E_APPLIED) = 0.0;
     AT(IN_CONTACT) = AT(AT_REST) = 0.0;
+    AT(DER_H) = AT(DER_V) = AT(CONTACT_INDICATOR) = 0.0;
     start_flight(values, 0.0, 0.0, 0.0);
 }
 
@@ -184,4 +194,25 @@ void rst_ball_do_step(double *values, double current_time, double step_size)
         }
     }
     update_outputs(values, end);
+}
+
+void rst_ball_states_changed(double *values)
+{
+    if (AT(AT_REST) != 0.0) { /* at rest the ball stays on the plate whatever a solver hands back */
+        AT(H) = AT(V) = 0.0;
+    }
+    AT(V_APPROACH) = -AT(V) >= 0.0 ? -AT(V) : 0.0;
+    update_derivatives(values);
+}
+
+int rst_ball_contact_event(double *values, double t)
+{
+    if (AT(AT_REST) != 0.0 || !(AT(H) <= 0.0 && AT(V) < 0.0))
+        return 0; /* no contact: another event, or the crossing of the ball leaving the plate */
+    impact(values, t, -AT(V), 1.0);
+    rebound(values, t);
+    AT(H) = 0.0;
+    AT(V) = AT(FLIGHT_V_START); /* the rebound speed, or 0 at rest */
+    rst_ball_states_changed(values);
+    return 1;
 }

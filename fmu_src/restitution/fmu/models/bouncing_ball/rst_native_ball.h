@@ -13,6 +13,8 @@
 #define rst_ball_clear RST_PREFIXED(rst_ball_clear)
 #define rst_ball_initialize RST_PREFIXED(rst_ball_initialize)
 #define rst_ball_do_step RST_PREFIXED(rst_ball_do_step)
+#define rst_ball_states_changed RST_PREFIXED(rst_ball_states_changed)
+#define rst_ball_contact_event RST_PREFIXED(rst_ball_contact_event)
 #endif
 
 #include <stddef.h>
@@ -25,5 +27,14 @@ void rst_ball_initialize(double *values, double start_time);
 
 /* fmi2DoStep from `current_time` [s] over `step_size` [s]: locates every contact inside the step. */
 void rst_ball_do_step(double *values, double current_time, double step_size);
+
+/* Model exchange: the host set h and v (or an input or parameter): the approach speed, der(h), der(v)
+ * and the contact indicator follow from them. */
+void rst_ball_states_changed(double *values);
+
+/* Model exchange, at an event at time `t` [s]: a ball at or below the plate moving down meets it
+ * (counted, its time and speed recorded) and rebounds with the COR on its input, or comes to rest.
+ * Returns 1 when h and v changed. */
+int rst_ball_contact_event(double *values, double t);
 
 #endif

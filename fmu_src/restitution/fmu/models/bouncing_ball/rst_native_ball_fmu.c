@@ -1,6 +1,9 @@
 /* The native BouncingBall FMU: the C front (cfront/rst_front.h) bound to the native ball
  * (rst_native_ball.h). The ball's whole state lives in the front's value store, so the front's
- * FMU-state snapshot of the store is the ball's state and nothing needs saving or restoring here. */
+ * FMU-state snapshot of the store is the ball's state and nothing needs saving or restoring here.
+ * Co-simulation: the ball's own step (every contact located in closed form). Model exchange: the host
+ * integrates h and v, locates each contact as a zero crossing of contact_indicator, and the event
+ * update rebounds the ball with the COR on its input (or brings it to rest). */
 #include "rst_front.h"
 
 #include "rst_BouncingBall_interface.h" /* generated: restitution.fmu.interface.c_header */
@@ -32,7 +35,24 @@ static rst_status do_step(rst_instance *inst, double t, double h)
     return RST_OK;
 }
 
+/* Model exchange: the host set the states (h, v), an input or a parameter; what depends on them follows. */
+static rst_status set(rst_instance *inst, rst_type type, const rst_vr vr[], size_t n, const double values[])
+{
+    (void)type, (void)vr, (void)n, (void)values;
+    if (rst_is_model_exchange(inst))
+        rst_ball_states_changed(rst_store(inst));
+    return RST_OK;
+}
+
+/* Model exchange: the contact located by the host's solver (contact_indicator crossed zero). */
+static rst_status update_discrete_states(rst_instance *inst, rst_event_update *result)
+{
+    result->states_changed = rst_ball_contact_event(rst_store(inst), rst_time(inst));
+    return RST_OK;
+}
+
 const rst_model RST_MODEL = {
     .identifier = RST_MODEL_IDENTIFIER, .guid = RST_MODEL_GUID,
     .variables = RST_MODEL_VARIABLES, .n_variables = RST_MODEL_N_VARIABLES, .backend_size = 0,
-    .instantiate = instantiate, .exit_initialization = exit_initialization, .do_step = do_step, .reset = reset};
+    .instantiate = instantiate, .exit_initialization = exit_initialization, .do_step = do_step, .reset = reset,
+    .set = set, .update_discrete_states = update_discrete_states, .model_exchange = 1, RST_MODEL_EXCHANGE_VECTORS};

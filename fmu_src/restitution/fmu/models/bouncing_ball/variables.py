@@ -2,7 +2,9 @@
 
 Parameters and the input carry the slave's names; outputs and locals the key of the quantity the
 ball evolves (all of them are part of the FMU state). No output depends directly on the input at
-the same communication point: the COR acts only inside fmi2DoStep.
+the same communication point: the COR acts only inside fmi2DoStep (co-simulation) or at the contact
+event (model exchange, where h and v are the continuous states, der(h) and der(v) their derivatives
+and contact_indicator the event indicator; these three are recomputed, not part of the state).
 """
 from __future__ import annotations
 
@@ -56,4 +58,12 @@ TABLE = Table("BouncingBall", "Ball in free flight above a plate; locates each c
     local("flight.t_start", "t_start", "s", "Start time of the current free flight"),
     local("flight.h_start", "h_start", "m", "Height at the start of the current free flight"),
     local("flight.v_start", "v_start", "m/s", "Upward velocity at the start of the current free flight"),
+    # model exchange: the host integrates h and v between the contacts, located as state events
+    local("der(h)", "der_h", "m/s", "Time derivative of h: v in flight, 0 at rest (model exchange: the host "
+          "integrates h with it)", state=False, derivative="h"),
+    local("der(v)", "der_v", "m/s2", "Time derivative of v: -g in flight, 0 at rest (model exchange: the host "
+          "integrates v with it)", state=False, derivative="v"),
+    local("contact_indicator", "contact_indicator", "m", "Event indicator of the contact with the plate: h in "
+          "flight (a zero crossing is a contact: model exchange), 1 m at rest (no more contacts)", state=False,
+          event_indicator=True),
 ))

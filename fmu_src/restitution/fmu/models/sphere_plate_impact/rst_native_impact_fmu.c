@@ -1,6 +1,7 @@
 /* The native SpherePlateImpact FMU: the C front (cfront/rst_front.h) bound to the native backend
  * (rst_native_impact.h). The front checks every call and value; this file only decides when to
- * evaluate: lazily, when an output is read or a step taken after an input or parameter changed. */
+ * evaluate: lazily, when an output is read or a step taken after an input or parameter changed.
+ * The same holds for model exchange, where the model has no states and no events. */
 #include "rst_front.h"
 
 #include <stdio.h>
@@ -113,4 +114,6 @@ const rst_model RST_MODEL = {
     .identifier = RST_MODEL_IDENTIFIER, .guid = RST_MODEL_GUID,
     .variables = RST_MODEL_VARIABLES, .n_variables = RST_MODEL_N_VARIABLES, .backend_size = sizeof(impact_backend),
     .instantiate = instantiate, .exit_initialization = exit_initialization, .accept = accept, .set = set,
-    .get_outputs = get_outputs, .do_step = do_step, .reset = changed, .restore_state = changed};
+    .get_outputs = get_outputs, .do_step = do_step, .reset = changed, .restore_state = changed,
+    /* model exchange: no states and no events, the outputs a function of the inputs (direct feedthrough) */
+    .model_exchange = 1, RST_MODEL_EXCHANGE_VECTORS};

@@ -1,0 +1,186 @@
+/* The front's model exchange, for every FMI version: the event and continuous-time modes, time, the
+ * continuous states, their derivatives and the event indicators. The model names its state vector,
+ * derivatives and indicators by value reference (rst_model.state_vrs, ...): states live in the value
+ * store like every variable (so FMU states, get and set need nothing more), and derivatives and
+ * indicators are variables the backend computes, read as a get call reads them.
+ *
+ * Modes (FMI 2.0 section 3.2.3, FMI 3.0 section 3.2): initialization ends in event mode; the host
+ * updates the discrete states there until no further update is needed, enters continuous-time mode,
+ * integrates (time, states, derivatives, indicators), and comes back to event mode at an event.
+ * Wrong modes and arguments are refused with an error and change nothing, as everywhere in the front.
+ */
+#include "rst_front_internal.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#define VECTOR_MODES (RST_MODE_INITIALIZATION | ME_MODES | RST_MODE_TERMINATED)
+#define CHUNK 64
+
+/* Is this a model-exchange instance whose vector has `expected` elements where the host gave `n` (and a
+ * non-NULL array where n > 0)? Logs why not. */
+static int check_vector(rst_instance *inst, const char *function, const void *array, size_t n, size_t expected,
+                        const char *what)
+{
+    if (!inst->model_exchange) {
+        rst_log(inst, RST_ERROR, "%s: this instance is a co-simulation instance (model exchange only)", function);
+        return 0;
+    }
+    if (n != expected) {
+        rst_log(inst, RST_ERROR, "%s: %u %s asked for; %s has %u", function, (unsigned int)n, what,
+                inst->model->identifier, (unsigned int)expected);
+        return 0;
+    }
+    if (n > 0 && array == NULL) {
+        rst_log(inst, RST_ERROR, "%s: the array of %u %s is NULL", function, (unsigned int)n, what);
+        return 0;
+    }
+    return 1;
+}
+
+/* Reads the variables `vrs` through the backend, CHUNK at a time. */
+static rst_status read_vector(rst_instance *inst, const char *function, const unsigned int *vrs, size_t n,
+                              double out[])
+{
+    size_t i0;
+    rst_status status = RST_OK;
+    for (i0 = 0; i0 < n; i0 += CHUNK) {
+        size_t m = n - i0 < CHUNK ? n - i0 : CHUNK;
+        rst_status s = front_get_vector(inst, function, vrs + i0, m, out + i0);
+        status = s > status ? s : status;
+        if (s >= RST_ERROR)
+            break;
+    }
+    return status;
+}
+
+static int only_model_exchange(rst_instance *inst, const char *function)
+{
+    if (inst->model_exchange)
+        return 1;
+    rst_log(inst, RST_ERROR, "%s: this instance is a co-simulation instance (model exchange only)", function);
+    return 0;
+}
+
+rst_status front_enter_event_mode(void *c, const char *function)
+{
+    ENTER(function, RST_MODE_CONTINUOUS)
+    inst->mode = RST_MODE_EVENT;
+    LEAVE(RST_OK);
+}
+
+rst_status front_enter_continuous_time_mode(void *c, const char *function)
+{
+    ENTER(function, RST_MODE_EVENT)
+    inst->mode = RST_MODE_CONTINUOUS;
+    LEAVE(RST_OK);
+}
+
+rst_status front_update_discrete_states(void *c, const char *function, rst_event_update *result)
+{
+    rst_status status = RST_OK;
+    ENTER(function, RST_MODE_EVENT)
+    memset(result, 0, sizeof *result);
+    if (inst->model->update_discrete_states != NULL)
+        status = front_backend_status(inst, inst->model->update_discrete_states(inst, result));
+    LEAVE(status);
+}
+
+rst_status front_completed_integrator_step(void *c, const char *function, int *enter_event_mode, int *terminate)
+{
+    ENTER(function, RST_MODE_CONTINUOUS)
+    if (enter_event_mode == NULL || terminate == NULL) {
+        rst_log(inst, RST_ERROR, "%s: enterEventMode and terminateSimulation must not be NULL", function);
+        LEAVE(RST_ERROR);
+    }
+    *enter_event_mode = 0; /* no step events: every event is a state event located by the host */
+    *terminate = 0;
+    LEAVE(RST_OK);
+}
+
+rst_status front_set_time(void *c, const char *function, double time)
+{
+    char text[40];
+    ENTER(function, ME_MODES)
+    if (!isfinite(time)) {
+        rst_format_double(time, text, sizeof text);
+        rst_log(inst, RST_ERROR, "%s: time = %s must be finite", function, text);
+        LEAVE(RST_ERROR);
+    }
+    inst->last_time = time;
+    LEAVE(RST_OK);
+}
+
+rst_status front_set_continuous_states(void *c, const char *function, const double x[], size_t n)
+{
+    size_t i;
+    char text[40];
+    rst_status status = RST_OK;
+    ENTER(function, RST_MODE_CONTINUOUS | RST_MODE_EVENT | RST_MODE_INITIALIZATION)
+    if (!check_vector(inst, function, x, n, inst->model->n_states, "continuous states"))
+        LEAVE(RST_ERROR);
+    for (i = 0; i < n; i++)
+        if (!isfinite(x[i])) {
+            rst_format_double(x[i], text, sizeof text);
+            rst_log(inst, RST_ERROR, "%s: %s = %s must be finite; nothing was changed", function,
+                    inst->model->variables[inst->model->state_vrs[i]].name, text);
+            LEAVE(RST_ERROR);
+        }
+    for (i = 0; i < n; i++)
+        inst->store[inst->model->state_vrs[i]] = x[i];
+    if (inst->model->set != NULL && n > 0)
+        status = front_backend_status(inst, inst->model->set(inst, RST_REAL, inst->model->state_vrs, n, x));
+    LEAVE(status);
+}
+
+rst_status front_get_continuous_states(void *c, const char *function, double x[], size_t n)
+{
+    ENTER(function, VECTOR_MODES)
+    if (!check_vector(inst, function, x, n, inst->model->n_states, "continuous states"))
+        LEAVE(RST_ERROR);
+    LEAVE(read_vector(inst, function, inst->model->state_vrs, n, x));
+}
+
+rst_status front_get_derivatives(void *c, const char *function, double dx[], size_t n)
+{
+    ENTER(function, VECTOR_MODES)
+    if (!check_vector(inst, function, dx, n, inst->model->n_states, "state derivatives"))
+        LEAVE(RST_ERROR);
+    LEAVE(read_vector(inst, function, inst->model->derivative_vrs, n, dx));
+}
+
+rst_status front_get_event_indicators(void *c, const char *function, double z[], size_t n)
+{
+    ENTER(function, VECTOR_MODES)
+    if (!check_vector(inst, function, z, n, inst->model->n_event_indicators, "event indicators"))
+        LEAVE(RST_ERROR);
+    LEAVE(read_vector(inst, function, inst->model->event_indicator_vrs, n, z));
+}
+
+rst_status front_get_nominals(void *c, const char *function, double nominals[], size_t n)
+{
+    size_t i;
+    ENTER(function, VECTOR_MODES)
+    if (!check_vector(inst, function, nominals, n, inst->model->n_states, "nominals"))
+        LEAVE(RST_ERROR);
+    for (i = 0; i < n; i++)
+        nominals[i] = 1.0; /* the default: the table declares no nominal */
+    LEAVE(RST_OK);
+}
+
+rst_status front_get_sizes(void *c, const char *function, size_t *n_states, size_t *n_event_indicators)
+{
+    ENTER(function, ANY_LIVE_MODE)
+    if (!only_model_exchange(inst, function))
+        LEAVE(RST_ERROR);
+    if (n_states == NULL && n_event_indicators == NULL) {
+        rst_log(inst, RST_ERROR, "%s: the size argument is NULL", function);
+        LEAVE(RST_ERROR);
+    }
+    if (n_states != NULL)
+        *n_states = inst->model->n_states;
+    if (n_event_indicators != NULL)
+        *n_event_indicators = inst->model->n_event_indicators;
+    LEAVE(RST_OK);
+}

@@ -1,0 +1,167 @@
+"""Model exchange of the native FMUs, FMI 2.0 (``native/``) and FMI 3.0 (``fmi3/``): one archive offers
+co-simulation and model exchange from the same binary. BouncingBall has the continuous states h and v,
+one event indicator, and a contact is a state event that the host's solver locates; SpherePlateImpact
+has no states and its outputs are a function of its inputs."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from fmpy import extract, read_model_description, simulate_fmu
+
+from fmi_child import run_child
+
+H0, G = 0.3, 9.80665
+E, V_MIN = 0.8, 0.5
+#: fmpy's CVode tolerance for these runs: an event time is located to about this relative accuracy
+RTOL = 1e-8
+
+
+@pytest.fixture(params=["fmi2", "fmi3"])
+def me_ball(request, native_ball_fmu, fmi3_ball_fmu):
+    return native_ball_fmu if request.param == "fmi2" else fmi3_ball_fmu
+
+
+@pytest.fixture(params=["fmi2", "fmi3"])
+def me_impact(request, native_impact_fmu, fmi3_impact_fmu):
+    return native_impact_fmu if request.param == "fmi2" else fmi3_impact_fmu
+
+
+def analytic_contacts(h0=H0, g=G, e=E, v_min=V_MIN):
+    """Times [s] and approach speeds [m/s] of the contacts of a ball dropped from rest at h0 that rebounds
+    with a constant COR e until it would leave slower than v_min (closed form: free fall, then flights
+    of 2 v/g from the plate)."""
+    v = math.sqrt(2.0 * g * h0)
+    t = v / g
+    times, speeds = [t], [v]
+    while e * v >= v_min:
+        v *= e
+        t += 2.0 * v / g
+        times.append(t)
+        speeds.append(v)
+    return np.array(times), np.array(speeds)
+
+
+def test_both_interfaces_are_declared_in_one_archive(me_ball, me_impact):
+    for fmu in (me_ball, me_impact):
+        md = read_model_description(str(fmu))
+        assert md.modelExchange is not None and md.coSimulation is not None
+        assert md.modelExchange.modelIdentifier == md.coSimulation.modelIdentifier
+    md = read_model_description(str(me_ball))
+    states = [v.derivative.name for v in md.modelVariables if v.derivative is not None]
+    assert states == ["h", "v"] and md.numberOfEventIndicators == 1
+
+
+def test_the_ball_meets_the_plate_at_the_analytic_times_and_comes_to_rest(me_ball):
+    """With e = 0.8 and v_min = 0.5 m/s the contacts fall at the closed-form times within the solver's
+    tolerance (1e-6 s at RTOL = 1e-8 over 2 s: each located time carries the error of the flights
+    before it); the ball comes to rest at the contact whose rebound would be slower than v_min, as
+    an event, and stays on the plate to the end of a run 5x longer (no Zeno chatter: the count of
+    contacts is exact)."""
+    times, speeds = analytic_contacts()
+    result = simulate_fmu(str(me_ball), fmi_type="ModelExchange", stop_time=5 * times[-1], output_interval=1e-3,
+                          relative_tolerance=RTOL, start_values={"e": E, "v_min": V_MIN, "h0": H0},
+                          output=["h", "v", "impacts", "t_impact", "v_impact", "at_rest"])
+    assert result["impacts"][-1] == len(times)
+    located = [result["t_impact"][np.argmax(result["impacts"] == k)] for k in range(1, len(times) + 1)]
+    speeds_found = [result["v_impact"][np.argmax(result["impacts"] == k)] for k in range(1, len(times) + 1)]
+    np.testing.assert_allclose(located, times, rtol=0, atol=1e-6)
+    np.testing.assert_allclose(speeds_found, speeds, rtol=1e-5)
+    rest = result[result["time"] > times[-1] + 1e-3]
+    assert rest["at_rest"].all() and (rest["h"] == 0.0).all() and (rest["v"] == 0.0).all()
+    assert (result["h"] >= -1e-6).all()  # the solver never lets the ball through the plate by more than it locates
+
+
+def test_impact_outputs_follow_the_inputs_as_in_co_simulation(me_impact):
+    """SpherePlateImpact has no states: run as model exchange with a speed held on its input, its
+    outputs equal the co-simulation run of the same binary at the same speed (the same C evaluation)."""
+    for v in (0.05, 2.3, 40.0):
+        outputs = ["e", "jgm.e", "zener.e", "zener.lambda", "zener.t_contact"]
+        me = simulate_fmu(str(me_impact), fmi_type="ModelExchange", stop_time=0.01, output_interval=0.005,
+                          start_values={"v_approach": v}, output=outputs)
+        cs = simulate_fmu(str(me_impact), fmi_type="CoSimulation", stop_time=0.01, output_interval=0.005,
+                          start_values={"v_approach": v}, output=outputs)
+        for name in outputs:
+            assert me[name][-1] == pytest.approx(cs[name][-1], rel=1e-15, abs=0), (v, name)
+
+
+HOSTILE_ME = r'''
+from fmpy.fmi2 import FMU2Model, fmi2EventInfo
+s = FMU2Model(guid=MD.guid, unzipDirectory=UNZIP, modelIdentifier=MD.modelExchange.modelIdentifier,
+              instanceName="me")
+s.instantiate(callbacks=CALLBACKS, loggingOn=True)
+got = {}
+
+
+def raw(fmu, name, *args):
+    """The status of an FMI function the fmpy class does not wrap for this interface."""
+    function = getattr(fmu.dll, name)
+    function.restype = c_int
+    return function(c_void_p(fmu.component), *args)
+
+
+s.setupExperiment(startTime=0.0)
+s.enterInitializationMode()
+s.exitInitializationMode()
+got["do_step_in_me"] = raw(s, "fmi2DoStep", c_double(0.0), c_double(1e-3), c_int(1))
+info = fmi2EventInfo()
+got["new_discrete_states"] = status(s.fmi2NewDiscreteStates, s.component, ctypes.byref(info))
+s.enterContinuousTimeMode()
+got["new_discrete_states_in_continuous"] = status(s.fmi2NewDiscreteStates, s.component, ctypes.byref(info))
+x = (c_double * 2)(0.3, 0.0)
+got["get_states"] = status(s.fmi2GetContinuousStates, s.component, x, 2)
+got["states"] = list(x)
+bad = (c_double * 2)(float("nan"), 1.0)
+got["nan_state"] = status(s.fmi2SetContinuousStates, s.component, bad, 2)
+got["wrong_count"] = status(s.fmi2GetDerivatives, s.component, x, 3)
+got["null_array"] = status(s.fmi2GetEventIndicators, s.component, None, 1)
+got["nan_time"] = status(s.fmi2SetTime, s.component, float("nan"))
+s.fmi2GetContinuousStates(s.component, x, 2)
+got["kept_states"] = list(x)
+dx = (c_double * 2)()
+s.fmi2GetDerivatives(s.component, dx, 2)
+got["derivatives"] = list(dx)
+z = (c_double * 1)()
+s.fmi2GetEventIndicators(s.component, z, 1)
+got["indicator"] = list(z)
+got["null_out"] = status(s.fmi2CompletedIntegratorStep, s.component, 1, None, None)
+state = s.getFMUstate()
+data = s.serializeFMUstate(state)
+got["round_trip"] = status(s.deSerializeFMUstate, data)
+s.terminate()
+s.freeInstance()
+cs = FMU2Slave(guid=MD.guid, unzipDirectory=UNZIP, modelIdentifier=MD.coSimulation.modelIdentifier, instanceName="cs")
+cs.instantiate(callbacks=CALLBACKS, loggingOn=True)
+cs.setupExperiment(startTime=0.0)
+cs.enterInitializationMode()
+got["me_call_on_cs"] = raw(cs, "fmi2GetContinuousStates", x, c_size_t(2))
+got["me_state_into_cs"] = status(cs.deSerializeFMUstate, data)
+cs.freeInstance()
+got["fatal_logged"] = any(st == 4 for _n, st, _m in LOG)
+got["messages"] = [m for _n, _st, m in LOG]
+report(**got)
+'''
+
+
+def test_hostile_model_exchange_calls_are_refused_and_keep_the_states(native_ball_fmu, tmp_path):
+    """(FMI 2.0, in a child process.) Calls of the wrong interface or mode, wrong vector sizes, NULL arrays,
+    a NaN state or time: fmi2Error with a message, the states kept; an FMU state of the model-exchange
+    instance round-trips, and a co-simulation instance refuses it. Nothing is ever fatal."""
+    unzip = extract(str(native_ball_fmu), str(tmp_path / "unzip"))
+    child = run_child(HOSTILE_ME, native_ball_fmu, unzip)
+    assert child.returncode == 0 and child.report is not None, child.explain()
+    got = child.report
+    for key in ("do_step_in_me", "new_discrete_states_in_continuous", "nan_state", "wrong_count", "null_array",
+                "nan_time", "null_out", "me_call_on_cs", "me_state_into_cs"):
+        assert got[key] == 3, f"{key}: status {got[key]}"
+    assert got["new_discrete_states"] == 0 and got["get_states"] == 0 and got["round_trip"] == 0
+    assert got["states"] == [H0, 0.0] and got["kept_states"] == [H0, 0.0]
+    assert got["derivatives"] == [0.0, -G] and got["indicator"] == [H0]
+    assert not got["fatal_logged"]
+    text = "\n".join(got["messages"])
+    for needed in ("fmi2DoStep is not allowed in event mode (FMI 2.0 model-exchange state machine)",
+                   "h = nan must be finite; nothing was changed", "3 state derivatives asked for; BouncingBall has 2",
+                   "this instance is a co-simulation instance (model exchange only)",
+                   "the state was taken from a model-exchange instance; this one is co-simulation"):
+        assert needed in text, needed
