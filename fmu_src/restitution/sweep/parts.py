@@ -10,7 +10,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .table import COLUMNS, VALIDITY, SweepResult, assemble, table_counts, write_csv_rows
+from .table import (COLUMNS, VALIDITY, SweepResult, arrow_table, assemble, parquet_options, table_counts,
+                    write_csv_rows)
 
 __all__ = ["PartStore", "DiskSweepResult", "ResumeError"]
 
@@ -105,20 +106,19 @@ class DiskSweepResult(SweepResult):
         keep = self.info.get("keep")
         starts = sorted(self.chunk_counts)
         if suffix.lower() == ".parquet":
-            import pyarrow as pa
             import pyarrow.parquet as pq
 
             writer = None
             try:
                 for a in starts:
                     cols = assemble(self.spec, [store.read(a)[0]], keep)
-                    table = pa.table({k: (v.tolist() if v.dtype == object else v) for k, v in cols.items()})
+                    table = arrow_table(cols)
                     if writer is None:
-                        writer = pq.ParquetWriter(path, table.schema)
+                        writer = pq.ParquetWriter(path, table.schema, **parquet_options(cols))
                     writer.write_table(table)
                 if writer is None:  # no chunk finished: an empty table with the columns
                     cols = assemble(self.spec, [], keep)
-                    pq.write_table(pa.table({k: v.tolist() for k, v in cols.items()}), path)
+                    pq.write_table(arrow_table(cols), path, **parquet_options(cols))
             finally:
                 if writer is not None:
                     writer.close()
