@@ -10,8 +10,9 @@ programs, then measures, every ratio in this one run:
 1. one impact (set v_approach, doStep, get all 11 Real and 6 Boolean outputs) through fmpy's
    ``FMU2Slave``, raw calls: native against the floor (goal <= 1.5x), and the pythonfmu FMU;
 2. the same in a plain C host (``env -i PATH=/usr/bin:/bin``): pythonfmu against native (goal native
-   >= 30x faster), the native FMU's absolute figure (goal < 1 us), the floor, and the floor's four
-   calls one by one (where the front's time goes);
+   >= 30x faster), the native FMU's absolute figure (goal < 1 us), the native FMI 3.0 FMU against the
+   native FMI 2.0 one (goal <= 1.1x), the floor, and the floor's four calls one by one (where the
+   front's time goes);
 3. the C physics (``rst_impact``) against the package's scalar ``restitution.impact``.
 
 Prints the headline next to the goals and writes DIR/native_cost.md (DIR defaults to docs/).
@@ -81,14 +82,14 @@ def run(quick: bool = False, out_dir: Path | None = None, verbose: bool = True) 
            "date": datetime.date.today().isoformat(), "step": timing.STEP}
     say(f"machine: {res['machine']['cpu']}, {res['machine']['cores']} cores, load {res['machine']['load_start']:.1f}")
     with tempfile.TemporaryDirectory(prefix="bench_native-") as tmp:
-        say("building the FMUs (pythonfmu, native, floor) and the C hosts ...")
+        say("building the FMUs (pythonfmu, native FMI 2.0 and 3.0, floor) and the C hosts ...")
         built = build.build_all(Path(tmp), log=lambda message: say(message, file=sys.stderr))
         _, reals, bools = timing._interfaces(built.model_description)
         res["n_reals"], res["n_bools"] = len(reals), len(bools)
         say("fmpy round trips ...")
         res["fmpy"] = timing.fmpy_round_trips(built, page.FMU_ROWS, reps, seconds)
         say("C host round trips ...")
-        res["c_host"] = timing.c_host_round_trips(built, page.FMU_ROWS, reps, seconds)
+        res["c_host"] = timing.c_host_round_trips(built, page.C_HOST_ROWS, reps, seconds)
         say("C host, the floor's calls one by one ...")
         res["calls"] = timing.c_host_round_trips(built, ("floor",), reps, seconds / 2, each_call=True)
         say("C physics against the package ...")
@@ -99,6 +100,7 @@ def run(quick: bool = False, out_dir: Path | None = None, verbose: bool = True) 
         "native_over_floor_fmpy": (fm.ratio("native", "floor"), fm.spread("native", "floor")),
         "python_over_native_c_host": (ch.ratio("pythonfmu", "native"), ch.spread("pythonfmu", "native")),
         "native_c_host": (statistics.median(native), (min(native), max(native))),
+        "fmi3_over_native_c_host": (ch.ratio("fmi3", "native"), ch.spread("fmi3", "native")),
         "package_over_c_physics": (ph.ratio("package exact", "C exact"), ph.spread("package exact", "C exact")),
     }
     res["machine"]["load_end"] = os.getloadavg()[0]

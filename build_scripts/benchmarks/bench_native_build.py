@@ -1,7 +1,8 @@
 """What build_scripts/benchmarks/bench_native.py times, built into a scratch directory.
 
-* the pythonfmu ``SpherePlateImpact.fmu`` (behind the project's C guard) and the native one
-  (``native/SpherePlateImpact.fmu``), by the project's own build functions;
+* the pythonfmu ``SpherePlateImpact.fmu`` (behind the project's C guard), the native one
+  (``native/SpherePlateImpact.fmu``, FMI 2.0) and the native FMI 3.0 one (``fmi3/SpherePlateImpact.fmu``: the
+  same core behind the FMI 3.0 layer), by the project's own build functions;
 * the *floor*: an FMU with the native FMU's modelDescription, compiled from the same C front
   (``fmu_src/restitution/fmu/cfront``), the same generated interface table and the same compiler and
   flags (``build_native.compile_binary``), with a glue file (``bench_c/floor_fmu.c``) whose backend
@@ -9,7 +10,8 @@
   above it is the physics and its glue; the floor itself is what the C front costs;
 * the plain C timing host (``bench_c/timing_host.c``) and the C-physics loop (``bench_c/physics_loop.c``).
 
-Each FMU is returned unzipped (``binaries/linux64/<model>.so``, ``resources/``, modelDescription.xml).
+Each FMU is returned unzipped (``binaries/linux64/<model>.so`` or, FMI 3.0, ``binaries/x86_64-linux/<model>.so``,
+``resources/``, modelDescription.xml).
 """
 from __future__ import annotations
 
@@ -32,17 +34,18 @@ BENCH_C = Path(__file__).resolve().parent / "bench_c"
 #: each doing nothing; outputs are constants (Reals 0.5, Booleans true).
 FLOOR_GLUE = BENCH_C / "floor_fmu.c"
 
-#: A plain C FMI 2.0 host that times round trips (no Python in it; the pythonfmu FMU's guard starts its
+#: A plain C FMI 2.0 and FMI 3.0 host that times round trips (no Python in it; the pythonfmu FMU's guard starts its
 #: own interpreter). Every FMU named on the command line is opened (dlopen RTLD_LOCAL), instantiated and
 #: initialised; then, REPS times, each FMU in turn (the first one rotating) runs round trips for
 #: BATCH_SECONDS / 10 untimed, then for BATCH_SECONDS timed (64 between clock readings). One round
 #: trip: fmi2SetReal v_approach (a new value every time, so the model is evaluated), fmi2DoStep,
-#: fmi2GetReal of the Real outputs, fmi2GetBoolean of the Boolean outputs. Times are CPU time of the
+#: fmi2GetReal of the Real outputs, fmi2GetBoolean of the Boolean outputs (an FMI 3.0 FMU: fmi3SetFloat64,
+#: fmi3DoStep, fmi3GetFloat64, fmi3GetBoolean, the same value references). Times are CPU time of the
 #: calling thread (CLOCK_THREAD_CPUTIME_ID): every FMU here computes in the caller's thread.
 #: ``each_call`` instead of ``round_trip`` times each of the four calls alone, batch after batch.
 #:
 #: usage: bench_host round_trip|each_call BATCH_SECONDS REPS VR_V REAL_VRS BOOL_VRS
-#:        {LABEL BINARY RESOURCE_URI GUID}...
+#:        {LABEL 2|3 BINARY RESOURCE_URI|RESOURCE_PATH GUID|TOKEN}...
 #: (VRS comma-separated); prints "BATCH <label>[/<call>] <rep> <seconds per round trip or call>" per batch.
 TIMING_HOST = BENCH_C / "timing_host.c"
 
@@ -53,39 +56,44 @@ PHYSICS_LOOP = BENCH_C / "physics_loop.c"
 
 @dataclass(frozen=True)
 class Unzipped:
-    """An FMU ready for a host: its unzipped directory, binary, resources URI and GUID."""
+    """An FMU ready for a host: its unzipped directory, FMI version, binary, resources and GUID."""
 
     label: str
     directory: Path
-    guid: str
+    guid: str  #: FMI 3.0: the instantiation token (the same GUID)
+    version: int = 2
 
     @property
     def binary(self) -> Path:
-        return self.directory / "binaries" / "linux64" / f"{MODEL}.so"
+        return self.directory / "binaries" / ("linux64" if self.version == 2 else "x86_64-linux") / f"{MODEL}.so"
 
     @property
     def resource_uri(self) -> str:
-        return (self.directory / "resources").resolve().as_uri()
+        """What instantiation is given: FMI 2.0 a file: URI, FMI 3.0 a native path ending with a separator."""
+        resources = (self.directory / "resources").resolve()
+        return resources.as_uri() if self.version == 2 else f"{resources}/"
 
 
 @dataclass(frozen=True)
 class Built:
     python: Unzipped  # pythonfmu behind the C guard
     native: Unzipped  # the C front + native physics
+    fmi3: Unzipped  # the same, behind the FMI 3.0 layer
     floor: Unzipped  # the C front + a backend that does nothing
     host: Path  # the C timing host
     physics_loop: Path  # the C physics loop
     model_description: str  # the pythonfmu FMU's (the native one's interface)
 
 
-def _unzip(fmu: Path, directory: Path, label: str) -> Unzipped:
+def _unzip(fmu: Path, directory: Path, label: str, guid: str | None = None, version: int = 2) -> Unzipped:
     from restitution.fmu.interface import model_info
 
     with zipfile.ZipFile(fmu) as z:
         z.extractall(directory)
-        _, guid = model_info(z.read("modelDescription.xml").decode("utf-8"))
+        if guid is None:
+            _, guid = model_info(z.read("modelDescription.xml").decode("utf-8"))
     (directory / "resources").mkdir(exist_ok=True)
-    return Unzipped(label, directory, guid)
+    return Unzipped(label, directory, guid, version)
 
 
 def build_floor(work: Path, model_description: str) -> Path:
@@ -125,7 +133,7 @@ def _compile(out: Path, sources: list[Path], includes: list[Path], libs: list[st
 def build_all(work: Path, log=None) -> Built:
     """Build everything the benchmark times into ``work`` (an empty scratch directory)."""
     from restitution.fmu.build import build_one
-    from restitution.fmu.build_native import build_native_one, fmi2_include_dir
+    from restitution.fmu.build_native import build_native_one, fmi_include_dir
     from restitution.fmu.compile import prepare_sources
 
     log = log or (lambda message: None)
@@ -134,14 +142,32 @@ def build_all(work: Path, log=None) -> Built:
     fmus = work / "fmus"
     python_fmu = build_one(MODEL, fmus, log=log)
     native_fmu = build_native_one(MODEL, fmus, python_fmu, log=log)
+    fmi3_fmu = build_native_one(MODEL, fmus, python_fmu, log=log, fmi_version="3.0")
     with zipfile.ZipFile(python_fmu) as z:
         xml = z.read("modelDescription.xml").decode("utf-8")
     python = _unzip(python_fmu, work / "python", "pythonfmu")
     native = _unzip(native_fmu, work / "native", "native")
+    fmi3 = _unzip(fmi3_fmu, work / "fmi3", "fmi3", guid=native.guid, version=3)  # the token is the GUID
+    _same_value_references(native_fmu, fmi3_fmu)
     floor = Unzipped("floor", build_floor(work, xml), native.guid)
-    host = _compile(work / "bench_host", [TIMING_HOST], [fmi2_include_dir()], ["-ldl"])
+    host = _compile(work / "bench_host", [TIMING_HOST], sorted({fmi_include_dir("2.0"), fmi_include_dir("3.0")}),
+                    ["-ldl"])
     src = prepare_sources(work / "physics")
     loop = _compile(work / "physics_loop", [PHYSICS_LOOP, src / "rst_physics.c"],
                     [src], ["-lm"])
-    return Built(python, native, floor, host, loop, xml)
+    return Built(python, native, fmi3, floor, host, loop, xml)
+
+
+def _same_value_references(fmi2_fmu: Path, fmi3_fmu: Path) -> None:
+    """The timing host gives both versions the value references of the FMI 2.0 description: check they agree."""
+    from xml.etree import ElementTree as ET
+
+    refs = []
+    for fmu in (fmi2_fmu, fmi3_fmu):
+        with zipfile.ZipFile(fmu) as z:
+            root = ET.fromstring(z.read("modelDescription.xml"))
+        refs.append({v.get("name"): v.get("valueReference") for v in root.find("ModelVariables")
+                     if v.get("name") != "time"})
+    if refs[0] != refs[1]:
+        raise RuntimeError("the FMI 2.0 and FMI 3.0 FMUs have different value references")
 

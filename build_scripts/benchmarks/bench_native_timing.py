@@ -145,14 +145,15 @@ def c_host_round_trips(built: Built, labels: tuple, reps: int, seconds: float, e
     """Seconds per round trip in the C timing host, run as tests/hosts/test_c_host_impact.py runs its host:
     ``env -i PATH=/usr/bin:/bin`` (no virtual environment, PYTHONPATH or LD_PRELOAD; the pythonfmu
     FMU's guard finds its interpreter from resources/python_env.txt). ``each_call``: seconds per call
-    of each of the four calls made alone (labels ``<fmu>/<fmi2 function>``)."""
-    fmus = {"native": built.native, "floor": built.floor, "pythonfmu": built.python}
+    of each of the four calls made alone (labels ``<fmu>/<fmi2 function>``). ``fmi3`` is the native FMI 3.0
+    FMU, timed through its own fmi3 functions in the same process, batches interleaved with the others."""
+    fmus = {"native": built.native, "floor": built.floor, "pythonfmu": built.python, "fmi3": built.fmi3}
     v, reals, bools = _interfaces(built.model_description)
     cmd = ["env", "-i", "PATH=/usr/bin:/bin", str(built.host), "each_call" if each_call else "round_trip",
            repr(seconds), str(reps), str(v), ",".join(map(str, reals)), ",".join(map(str, bools))]
     for label in labels:
         f = fmus[label]
-        cmd += [label, str(f.binary), f.resource_uri, f.guid]
+        cmd += [label, str(f.version), str(f.binary), f.resource_uri, f.guid]
     done = subprocess.run(cmd, capture_output=True, text=True, env={"PATH": "/usr/bin:/bin"},
                           timeout=600 + 10 * reps * seconds * len(labels))
     if done.returncode != 0:

@@ -109,10 +109,9 @@ def test_fmpy_extraction_under_a_non_ascii_tmpdir(impact_fmu, tmp_path):
 
 @pytest.fixture(scope="module")
 def c_host(tmp_path_factory):
-    exe = tmp_path_factory.mktemp("c_host") / "fmi2_script_host"
-    subprocess.run(["gcc", "-O2", "-Wall", "-Wextra", "-Werror", "-o", str(exe),
-                    str(ROOT / "tests" / "c_host" / "fmi2_script_host.c"), "-ldl"], check=True)
-    return exe
+    from script_host import build_host
+
+    return build_host(tmp_path_factory.mktemp("c_host") / "fmi2_script_host", 2)
 
 
 def _c_host(host, unzip, guid, script, model="SpherePlateImpact"):

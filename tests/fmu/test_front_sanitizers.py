@@ -1,13 +1,14 @@
 """The C front under AddressSanitizer, UndefinedBehaviorSanitizer and LeakSanitizer, with hostile calls.
 
-The native FMUs (front + backend + physics, from their own sources/) and the guard in front of
-pythonfmu (front + pythonfmu backend + Python loader) are recompiled with
-``-fsanitize=address,undefined -fno-sanitize-recover=all`` and driven by the plain C host
-(tests/c_host/fmi2_script_host.c, sanitized too) through a script of hostile calls generated from
+The native FMUs, FMI 2.0 and FMI 3.0 (front + version layer + backend + physics, from their own
+sources/), and the guard in front of pythonfmu (front + pythonfmu backend + Python loader) are recompiled
+with ``-fsanitize=address,undefined -fno-sanitize-recover=all`` and driven by the plain C host
+(tests/c_host/fmi_script_host.c, built for the FMU's FMI version, sanitized too) through a script of
+hostile calls generated from
 the interface table: every variable set to NaN, infinities, values just outside its range and the
 wrong type; unknown value references; String calls; calls in the wrong mode; bad step sizes and
 times; garbage, truncated, flipped and foreign serialized states; a pointer that is no state;
-fmi2Instantiate with each bad argument; instances freed with states still allocated. Any memory
+instantiation with each bad argument (each version's own); instances freed with states still allocated. Any memory
 error, undefined behaviour or leak (native FMUs: the process ends with every instance freed)
 makes the sanitizer exit non-zero with a report, which the test shows.
 """
@@ -24,6 +25,8 @@ import pytest
 
 from restitution.fmu.interface import variables
 
+from script_host import build_host, interface
+
 ROOT = Path(__file__).resolve().parents[2]
 SANITIZE = ["-g", "-O1", "-fno-omit-frame-pointer", "-fsanitize=address,undefined", "-fno-sanitize-recover=all"]
 
@@ -33,18 +36,22 @@ pytestmark = [
 ]
 
 
-def _fmi2_headers():
-    from restitution.fmu.build_native import fmi2_include_dir
+def _fmi_headers(version: int):
+    from restitution.fmu.build_native import fmi_include_dir
 
-    return fmi2_include_dir()
+    return fmi_include_dir(f"{version}.0")
 
 
 @pytest.fixture(scope="module")
-def host(tmp_path_factory):
-    exe = tmp_path_factory.mktemp("asan_host") / "fmi2_script_host"
-    subprocess.run(["gcc", *SANITIZE, "-Wall", "-Wextra", "-Werror", "-o", str(exe),
-                    str(ROOT / "tests" / "c_host" / "fmi2_script_host.c"), "-ldl"], check=True)
-    return exe
+def hosts(tmp_path_factory):
+    """The script host, sanitized, for FMI 2.0 and FMI 3.0: {2: exe, 3: exe}."""
+    out = tmp_path_factory.mktemp("asan_host")
+    return {v: build_host(out / f"fmi{v}_script_host", v, flags=SANITIZE) for v in (2, 3)}
+
+
+@pytest.fixture(scope="module")
+def host(hosts):
+    return hosts[2]
 
 
 def _unpack(fmu, dest):
@@ -56,10 +63,13 @@ def _unpack(fmu, dest):
 def _sanitized_native(fmu, model, dest):
     """The native FMU unpacked, its Linux binary rebuilt from its own sources/ with the sanitizers."""
     unpacked = _unpack(fmu, dest)
+    fmi = interface(fmu)
     sources = sorted(str(p) for p in (unpacked / "sources").glob("*.c"))
+    binary = unpacked / "binaries" / fmi.binary_dirs[0] / f"{model}.so"
+    assert binary.is_file()  # replaced by the sanitized build
     subprocess.run(["gcc", "-std=c99", *SANITIZE, "-Wall", "-Wextra", "-Werror", "-pedantic", "-ffp-contract=off",
                     "-shared", "-fPIC", "-pthread", f"-I{unpacked / 'sources'}",
-                    f"-I{_fmi2_headers()}", "-o", str(unpacked / "binaries" / "linux64" / f"{model}.so"), *sources, "-lm"],
+                    f"-I{_fmi_headers(fmi.version)}", "-o", str(binary), *sources, "-lm"],
                    check=True, capture_output=True, text=True)
     return unpacked
 
@@ -81,24 +91,29 @@ def _sanitized_guard(fmu, model, dest):
     return unpacked
 
 
-#: the script host's bad instantiations (instantiate_bad KIND)
-BAD_KINDS = ("null_name", "empty_name", "wrong_guid", "null_guid", "null_callbacks", "null_logger", "null_alloc",
-             "model_exchange", "bad_uri")
+#: the bad instantiations of each FMI version (the script host's instantiate_bad kinds)
+BAD_INSTANTIATIONS = {
+    2: ("null_name", "empty_name", "wrong_guid", "null_guid", "null_callbacks", "null_logger", "null_alloc",
+        "model_exchange", "bad_uri"),
+    3: ("null_name", "empty_name", "wrong_guid", "null_guid", "wrong_guid_no_logger", "event_mode",
+        "intermediate_update", "model_exchange", "scheduled_execution"),
+}
 
 
-def _hostile_script(model, state_files, other_model_state):
+def _hostile_script(model, state_files, other_model_state, fmi):
+    """The hostile calls, from the interface table; ``fmi`` (script_host.Interface) says with which call
+    each variable is got and set (FMI 3.0: Enumerations with Int64) and which calls are the wrong ones."""
     rows = variables(model)
     n = len(rows)
-    kinds = {"Real": "real", "Integer": "integer", "Boolean": "boolean"}
-    lines = [f"instantiate_bad {kind}" for kind in BAD_KINDS]
+    all_kinds = {"real", "integer", "boolean"} | ({"enumeration"} if fmi.version == 3 else set())
+    lines = [f"instantiate_bad {kind}" for kind in BAD_INSTANTIATIONS[fmi.version]]
     lines += ["instantiate hostile", "instantiate spare",
               # wrong mode: before initialization
               "step 0 0.0 0.1", "get_real 0 0", "exit_init 0", "terminate 0", "get_state 0", "serialize 0",
               "setup 0 0.0", "setup 0 1.0", "enter_init 0"]
     for v in rows:
-        kind = kinds[v.type]
-        for wrong in kinds.values():
-            if wrong != kind:
+        kind = fmi.kind[v.name]
+        for wrong in sorted(all_kinds - {kind}):
                 lines.append(f"get_{wrong} 0 {v.vr}")
                 lines.append(f"set_{wrong} 0 {v.vr} 1" if wrong != "real" else f"set_real 0 {v.vr} 1.5")
         if v.causality in ("parameter", "input") and v.type == "Real":
@@ -108,7 +123,10 @@ def _hostile_script(model, state_files, other_model_state):
                 lines.append(f"set_real 0 {v.vr} {bad}")
         if v.causality in ("parameter", "input") and v.type == "Integer":
             for bad in (-2147483648, 2147483647, int(v.interval[0]) - 1, int(v.interval[1]) + 1):
-                lines.append(f"set_integer 0 {v.vr} {bad}")
+                lines.append(f"set_{kind} 0 {v.vr} {bad}")
+            if kind == "enumeration" and fmi.version == 3:  # Int64: beyond any Int32 and any double's integer
+                for bad in (-9223372036854775808, 9223372036854775807, 2 ** 53 + 1):
+                    lines.append(f"set_enumeration 0 {v.vr} {bad}")
         if v.causality in ("output", "local"):
             lines.append(f"set_{kind} 0 {v.vr} 0")
     for vr in (n, n + 1, 2 ** 31, 2 ** 32 - 1):
@@ -177,10 +195,7 @@ def genuine_states(built_fmus, tmp_path_factory):
     return paths
 
 
-def _run(host, unpacked, model, script, leaks: bool):
-    from fmpy import read_model_description
-
-    guid = read_model_description(str(unpacked / "modelDescription.xml")).guid
+def _run(host, unpacked, model, script, leaks: bool, guid: str):
     env = {"PATH": "/usr/bin:/bin",
            "ASAN_OPTIONS": f"detect_leaks={int(leaks)}:abort_on_error=0:exitcode=99",
            "UBSAN_OPTIONS": "print_stacktrace=1:halt_on_error=1:exitcode=98"}
@@ -188,7 +203,9 @@ def _run(host, unpacked, model, script, leaks: bool):
                           input="\n".join(script) + "\n", capture_output=True, text=True, timeout=600)
 
 
-def _assert_clean(proc, script, model_exchange=False):
+def _assert_clean(proc, script, kinds, model_exchange=False):
+    """The run was clean and went to its end, nothing was fatal, and every bad instantiation of
+    ``kinds`` returned NULL, but model exchange where the FMU offers it (``model_exchange``)."""
     report = proc.stderr[-6000:]
     assert proc.returncode == 0, f"exit {proc.returncode}\n{report}"
     for marker in ("ERROR: AddressSanitizer", "runtime error:", "ERROR: LeakSanitizer"):
@@ -199,17 +216,30 @@ def _assert_clean(proc, script, model_exchange=False):
     bad = [line for line in proc.stdout.splitlines() if line.startswith("BAD_INSTANCE")]
     # every bad instantiation refused; model exchange is no bad argument where the FMU offers it
     expected = {f"BAD_INSTANCE {kind} {'NONNULL' if kind == 'model_exchange' and model_exchange else 'NULL'}"
-                for kind in BAD_KINDS}
-    assert set(bad) == expected and len(bad) == len(BAD_KINDS), bad
+                for kind in kinds}
+    assert set(bad) == expected and len(bad) == len(kinds), bad
 
 
+@pytest.mark.parametrize("folder", ["native", "fmi3"])
 @pytest.mark.parametrize("model", ["SpherePlateImpact", "BouncingBall"])
-def test_native_fmu_hostile_calls_under_sanitizers(built_fmus, host, genuine_states, model, tmp_path):
-    fmu = built_fmus / "native" / f"{model}.fmu"
+def test_native_fmu_hostile_calls_under_sanitizers(built_fmus, hosts, genuine_states, model, folder, tmp_path):
+    """The native FMU of each FMI version (native/: FMI 2.0, fmi3/: FMI 3.0). The hostile states are made
+    from states the FMI 2.0 FMU serialized: both versions share one state format (the core's rst_state.c),
+    so the genuine one restores in either and its damaged versions must be refused by both."""
+    fmu = built_fmus / folder / f"{model}.fmu"
+    if not fmu.is_file():
+        pytest.skip(f"{folder}/{model}.fmu not built here (needs gcc)")
+    fmi = interface(fmu)
     unpacked = _sanitized_native(fmu, model, tmp_path / "fmu")
     other = genuine_states["BouncingBall" if model == "SpherePlateImpact" else "SpherePlateImpact"]
-    script = _hostile_script(model, _state_files(tmp_path / "states", genuine_states[model]), other)
-    _assert_clean(_run(host, unpacked, model, script, leaks=True), script, model_exchange=True)
+    script = _hostile_script(model, _state_files(tmp_path / "states", genuine_states[model]), other, fmi)
+    proc = _run(hosts[fmi.version], unpacked, model, script, leaks=True, guid=fmi.token)
+    _assert_clean(proc, script, BAD_INSTANTIATIONS[fmi.version], model_exchange=True)
+    assert proc.stdout.startswith(f"INFO {fmi.version}.0 "), proc.stdout[:200]
+    # the genuine state (serialized by another instance) restores; a damaged one never does
+    statuses = [line.split() for line in proc.stdout.splitlines() if line.startswith("STATUS deserialize")]
+    assert [s[3] for s in statuses if s[1] == "deserialize"] == ["OK", "OK"], statuses
+    assert all(s[3] == "Error" for s in statuses if s[1] == "deserialize_file"), statuses
 
 
 @pytest.mark.slow
@@ -218,7 +248,9 @@ def test_guard_hostile_calls_under_sanitizers(built_fmus, host, genuine_states, 
     """The guard in a plain C host that starts Python: memory errors and undefined behaviour only
     (the embedded interpreter is never finalized, so its memory is left to the process exit)."""
     fmu = built_fmus / f"{model}.fmu"
+    fmi = interface(fmu)
     unpacked = _sanitized_guard(fmu, model, tmp_path / "fmu")
     other = genuine_states["BouncingBall" if model == "SpherePlateImpact" else "SpherePlateImpact"]
-    script = _hostile_script(model, _state_files(tmp_path / "states", genuine_states[model]), other)
-    _assert_clean(_run(host, unpacked, model, script, leaks=False), script)
+    script = _hostile_script(model, _state_files(tmp_path / "states", genuine_states[model]), other, fmi)
+    _assert_clean(_run(host, unpacked, model, script, leaks=False, guid=fmi.token), script,
+                  BAD_INSTANTIATIONS[fmi.version])

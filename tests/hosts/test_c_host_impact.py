@@ -1,7 +1,8 @@
-"""SpherePlateImpact.fmu in a plain C FMI 2.0 host, as a desktop simulation tool runs it: both
-implementations (pythonfmu behind the C guard, and native).
+"""SpherePlateImpact.fmu in a plain C FMI host, as a desktop simulation tool runs it: both
+implementations (pythonfmu behind the C guard, and native), and the native FMU as FMI 2.0 and as FMI 3.0.
 
-The host (tests/c_host/fmi2_script_host.c, compiled here with the system C compiler) opens
+The host (tests/c_host/fmi_script_host.c, compiled here with the system C compiler, once per FMI
+version, ``-DFMI_VERSION=2|3``) opens
 the FMU binary with dlopen(RTLD_LOCAL) and runs with a minimal environment: ``env -i
 PATH=/usr/bin:/bin`` (no LD_PRELOAD, no PYTHONPATH/PYTHONHOME, no virtual environment). The
 pythonfmu FMU's loader must find the interpreter and packages it was built with by itself; the
@@ -31,8 +32,9 @@ import restitution as r
 from restitution.agreement import tolerances
 from restitution.cosim import impact_fmu_parameters
 
+from script_host import build_host, interface
+
 ROOT = Path(__file__).resolve().parents[2]
-HOST_SOURCE = ROOT / "tests" / "c_host" / "fmi2_script_host.c"
 MODEL = "SpherePlateImpact"
 
 pytestmark = [
@@ -53,10 +55,23 @@ SPEEDS = [0.0, 1e-3, 0.5, 2.3, 30.0]
 
 
 @pytest.fixture(scope="module")
-def host(tmp_path_factory):
-    exe = tmp_path_factory.mktemp("c_host") / "fmi2_script_host"
-    subprocess.run(["gcc", "-O2", "-Wall", "-Wextra", "-Werror", "-o", str(exe), str(HOST_SOURCE), "-ldl"], check=True)
-    return exe
+def hosts(tmp_path_factory):
+    """The script host built for FMI 2.0 and for FMI 3.0: {2: exe, 3: exe}."""
+    out = tmp_path_factory.mktemp("c_host")
+    return {v: build_host(out / f"fmi{v}_script_host", v) for v in (2, 3)}
+
+
+@pytest.fixture(scope="module")
+def host(hosts):
+    return hosts[2]
+
+
+@pytest.fixture(scope="module", params=["python", "native", "fmi3"])
+def host_impact_fmu(request):
+    """SpherePlateImpact.fmu as pythonfmu (FMI 2.0), native FMI 2.0 and native FMI 3.0 (the native ones
+    skip, saying so, where gcc did not build them)."""
+    fixture = {"python": "impact_fmu", "native": "native_impact_fmu", "fmi3": "fmi3_impact_fmu"}[request.param]
+    return request.getfixturevalue(fixture)
 
 
 @pytest.fixture(scope="module")
@@ -108,18 +123,19 @@ def same(got, want, tol):
     return got == want or (math.isnan(got) and math.isnan(want)) or abs(got - want) <= tol
 
 
-def test_the_fmu_runs_in_a_plain_c_host_and_matches_the_package(host, any_impact_fmu, fmu_info, tmp_path):
-    native = "native" in any_impact_fmu.parts
-    vr = fmu_info["vr"]
+def test_the_fmu_runs_in_a_plain_c_host_and_matches_the_package(hosts, host_impact_fmu, tmp_path):
+    """The same script for the three FMUs; only the calls differ where the versions do (the host's
+    -DFMI_VERSION: FMI 3.0 gives the start time to fmi3EnterInitializationMode, sets the Enumerations
+    with fmi3SetInt64 and reads the Booleans as C bool)."""
+    fmu = interface(host_impact_fmu)
+    native = fmu.version == 3 or "native" in host_impact_fmu.parts
+    vr = fmu.vr
     script, expected = [], []  # expected: ("real"/"bool", reference value, context) per value printed
     clock = [0.0, 0.0]  # each instance's communication point
 
     def set_all(slot, settings):
         for name, value in settings.items():
-            if fmu_info["type"][name] == "Integer":
-                script.append(f"set_integer {slot} {vr[name]} {int(value)}")
-            else:
-                script.append(f"set_real {slot} {vr[name]} {float(value)!r}")
+            script.append(fmu.set(slot, name, value))
 
     def step(slot):
         script.append(f"step {slot} {clock[slot]!r} 0.001")
@@ -173,8 +189,9 @@ def test_the_fmu_runs_in_a_plain_c_host_and_matches_the_package(host, any_impact
     read(1, {}, "after reset")
     script += ["free_state 0", "free_state 1", "terminate 0", "terminate 1", "free 0", "free 1"]
 
-    run = run_host(host, unpack(any_impact_fmu, tmp_path / "fmu"), fmu_info["guid"], script)
+    run = run_host(hosts[fmu.version], unpack(host_impact_fmu, tmp_path / "fmu"), fmu.token, script)
     assert run.returncode == 0, run.stdout[-3000:] + run.stderr  # also: no crash at process exit
+    assert run.stdout.startswith(f"INFO {fmu.version}.0 "), run.stdout[:200]
     assert run.libpython == (not native), "libpython is in the native FMU's process" if native else run.stdout[-300:]
     if not native:
         assert any("pythonfmu guard: started embedded Python" in line for line in run.logs), run.logs[:3]

@@ -17,10 +17,10 @@ from xml.etree import ElementTree
 
 import pytest
 
+from script_host import build_host
 from toy_fmu import build_plain_toy
 
 ROOT = Path(__file__).resolve().parents[2]
-HOST_SOURCE = ROOT / "tests" / "c_host" / "fmi2_script_host.c"
 MAKE_STANDALONE = ROOT / "fmu_src" / "restitution" / "fmu" / "build_guard.py"
 
 pytestmark = [
@@ -98,8 +98,7 @@ def built(tmp_path_factory):
     shutil.copy(plain, standalone)
     _load_make_standalone().make_standalone(standalone)
 
-    host = work / "fmi2_script_host"
-    subprocess.run(["gcc", "-O2", "-Wall", "-Wextra", "-Werror", "-o", str(host), str(HOST_SOURCE), "-ldl"], check=True)
+    host = build_host(work / "fmi2_script_host", 2)
     return {"work": work, "plain": plain, "fmu": standalone, "host": host, "guid": _guid(standalone)}
 
 

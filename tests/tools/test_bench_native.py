@@ -44,6 +44,7 @@ def test_quick_run_writes_the_page_with_every_row(quick):
         assert f"| {goal} |" in line
     for label in page.FMU_ROWS:  # fmpy and C host tables
         assert len(row(f"{label} (")) == 2, label
+    assert len(row("fmi3 (")) == 1  # the native FMI 3.0 FMU: C host table only
     for call in page.CALLS:
         row(f"`{call}`")
     for method in timing.METHODS:

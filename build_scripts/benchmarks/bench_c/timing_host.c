@@ -7,20 +7,30 @@
 #include <time.h>
 
 #include "fmi2FunctionTypes.h"
+#include "fmi3FunctionTypes.h"
 
 #define MAX_FMUS 8
 #define MAX_VRS 64
 
+/* One FMU of either FMI version: the four calls of a round trip through the version's own functions
+ * (FMI 3.0: fmi3SetFloat64, fmi3DoStep with its out-arguments, fmi3GetFloat64, fmi3GetBoolean with C bool). */
 typedef struct {
     const char *label;
+    int version; /* 2 or 3 */
     void *dl;
-    fmi2Component c;
+    void *c;
     fmi2SetRealTYPE *set_real;
     fmi2DoStepTYPE *do_step;
     fmi2GetRealTYPE *get_real;
     fmi2GetBooleanTYPE *get_boolean;
     fmi2FreeInstanceTYPE *free_instance;
     fmi2TerminateTYPE *terminate;
+    fmi3SetFloat64TYPE *set_float64;
+    fmi3DoStepTYPE *do_step3;
+    fmi3GetFloat64TYPE *get_float64;
+    fmi3GetBooleanTYPE *get_boolean3;
+    fmi3FreeInstanceTYPE *free_instance3;
+    fmi3TerminateTYPE *terminate3;
     double t;
     long k;
 } fmu;
@@ -31,6 +41,13 @@ static void logger(fmi2ComponentEnvironment env, fmi2String name, fmi2Status sta
     (void)env;
     if (status != fmi2OK)
         fprintf(stderr, "LOG %s %d %s: %s\n", name ? name : "?", (int)status, category ? category : "",
+                message ? message : "");
+}
+
+static void logger3(fmi3InstanceEnvironment env, fmi3Status status, fmi3String category, fmi3String message)
+{
+    if (status != fmi3OK)
+        fprintf(stderr, "LOG %s %d %s: %s\n", env ? (const char *)env : "?", (int)status, category ? category : "",
                 message ? message : "");
 }
 
@@ -80,10 +97,41 @@ static double sink;
 #define ROUND_TRIP (SET | STEP | GET_REAL | GET_BOOLEAN)
 static const char *const CALL_NAMES[] = {"fmi2SetReal", "fmi2DoStep", "fmi2GetReal", "fmi2GetBoolean"};
 
+/* n FMI 3.0 round trips made of the `calls`; the status of every call OR-ed together (0: every call
+ * returned fmi3OK) */
+static int round_trips3(fmu *f, int calls, long n)
+{
+    fmi3Float64 reals[MAX_VRS];
+    fmi3Boolean bools[MAX_VRS];
+    fmi3Boolean event, terminate, early;
+    fmi3Float64 last;
+    const fmi3Float64 h = 1e-3;
+    int bad = 0;
+    long i;
+    reals[0] = 0.0, bools[0] = fmi3False;
+    for (i = 0; i < n; i++) {
+        fmi3Float64 v = 0.1 + 1e-6 * (double)(f->k++ % 1000000);
+        if (calls & SET)
+            bad |= (int)f->set_float64(f->c, &vr_v, 1, &v, 1);
+        if (calls & STEP) {
+            bad |= (int)f->do_step3(f->c, f->t, h, fmi3True, &event, &terminate, &early, &last);
+            f->t += h;
+        }
+        if (calls & GET_REAL)
+            bad |= (int)f->get_float64(f->c, vr_reals, n_reals, reals, n_reals);
+        if (calls & GET_BOOLEAN)
+            bad |= (int)f->get_boolean3(f->c, vr_bools, n_bools, bools, n_bools);
+        sink += reals[0] + (double)bools[0];
+    }
+    return bad;
+}
+
 /* n round trips made of the `calls` (ROUND_TRIP: all four); the status of every call OR-ed together
  * (0: every call returned fmi2OK) */
 static int round_trips(fmu *f, int calls, long n)
 {
+    if (f->version == 3)
+        return round_trips3(f, calls, n);
     fmi2Real reals[MAX_VRS];
     fmi2Boolean bools[MAX_VRS];
     const fmi2Real h = 1e-3;
@@ -124,17 +172,68 @@ static double timed_batch(fmu *f, int calls, double seconds)
     return elapsed / (double)count;
 }
 
+/* Open, instantiate and initialise an FMI 2.0 FMU; 0 on success. */
+static int open2(fmu *f, const char *resource_uri, const char *guid)
+{
+    static fmi2CallbackFunctions callbacks = {logger, calloc, free, NULL, NULL};
+    fmi2InstantiateTYPE *instantiate;
+    fmi2SetupExperimentTYPE *setup;
+    fmi2EnterInitializationModeTYPE *enter_init;
+    fmi2ExitInitializationModeTYPE *exit_init;
+    LOAD(instantiate, "fmi2Instantiate");
+    LOAD(setup, "fmi2SetupExperiment");
+    LOAD(enter_init, "fmi2EnterInitializationMode");
+    LOAD(exit_init, "fmi2ExitInitializationMode");
+    LOAD(f->set_real, "fmi2SetReal");
+    LOAD(f->do_step, "fmi2DoStep");
+    LOAD(f->get_real, "fmi2GetReal");
+    LOAD(f->get_boolean, "fmi2GetBoolean");
+    LOAD(f->terminate, "fmi2Terminate");
+    LOAD(f->free_instance, "fmi2FreeInstance");
+    f->c = instantiate(f->label, fmi2CoSimulation, guid, resource_uri, &callbacks, fmi2False, fmi2False);
+    if (f->c == NULL) {
+        fprintf(stderr, "%s: fmi2Instantiate returned NULL\n", f->label);
+        return 1;
+    }
+    return setup(f->c, fmi2False, 0.0, 0.0, fmi2False, 0.0) != fmi2OK || enter_init(f->c) != fmi2OK
+           || exit_init(f->c) != fmi2OK;
+}
+
+/* Open, instantiate and initialise an FMI 3.0 FMU (resource path: a native directory path); 0 on success. */
+static int open3(fmu *f, const char *resource_path, const char *token)
+{
+    fmi3InstantiateCoSimulationTYPE *instantiate;
+    fmi3EnterInitializationModeTYPE *enter_init;
+    fmi3ExitInitializationModeTYPE *exit_init;
+    LOAD(instantiate, "fmi3InstantiateCoSimulation");
+    LOAD(enter_init, "fmi3EnterInitializationMode");
+    LOAD(exit_init, "fmi3ExitInitializationMode");
+    LOAD(f->set_float64, "fmi3SetFloat64");
+    LOAD(f->do_step3, "fmi3DoStep");
+    LOAD(f->get_float64, "fmi3GetFloat64");
+    LOAD(f->get_boolean3, "fmi3GetBoolean");
+    LOAD(f->terminate3, "fmi3Terminate");
+    LOAD(f->free_instance3, "fmi3FreeInstance");
+    f->c = instantiate(f->label, token, resource_path, fmi3False, fmi3False, fmi3False, fmi3False, NULL, 0,
+                       (fmi3InstanceEnvironment)f->label, logger3, NULL);
+    if (f->c == NULL) {
+        fprintf(stderr, "%s: fmi3InstantiateCoSimulation returned NULL\n", f->label);
+        return 1;
+    }
+    return enter_init(f->c, fmi3False, 0.0, 0.0, fmi3False, 0.0) != fmi3OK || exit_init(f->c) != fmi3OK;
+}
+
+#define PER_FMU 5 /* LABEL FMI_VERSION BINARY RESOURCES GUID */
 int main(int argc, char **argv)
 {
     fmu fmus[MAX_FMUS];
-    fmi2CallbackFunctions callbacks = {logger, calloc, free, NULL, NULL};
     double batch;
     long reps, r;
     int m = 0, i, each;
-    if (argc < 11 || (argc - 7) % 4 != 0 || (argc - 7) / 4 > MAX_FMUS
+    if (argc < 7 + PER_FMU || (argc - 7) % PER_FMU != 0 || (argc - 7) / PER_FMU > MAX_FMUS
             || (strcmp(argv[1], "round_trip") != 0 && strcmp(argv[1], "each_call") != 0)) {
         fprintf(stderr, "usage: %s round_trip|each_call BATCH_SECONDS REPS VR_V REAL_VRS BOOL_VRS "
-                "{LABEL BINARY RESOURCE_URI GUID}...\n", argv[0]);
+                "{LABEL 2|3 BINARY RESOURCE_URI|RESOURCE_PATH GUID|TOKEN}...\n", argv[0]);
         return 1;
     }
     each = strcmp(argv[1], "each_call") == 0;
@@ -143,37 +242,22 @@ int main(int argc, char **argv)
     vr_v = (fmi2ValueReference)strtoul(argv[4], NULL, 10);
     n_reals = parse_vrs(argv[5], vr_reals);
     n_bools = parse_vrs(argv[6], vr_bools);
-    for (i = 7; i + 3 < argc; i += 4, m++) {
+    for (i = 7; i + PER_FMU - 1 < argc; i += PER_FMU, m++) {
         fmu *f = &fmus[m];
-        fmi2InstantiateTYPE *instantiate;
-        fmi2SetupExperimentTYPE *setup;
-        fmi2EnterInitializationModeTYPE *enter_init;
-        fmi2ExitInitializationModeTYPE *exit_init;
         memset(f, 0, sizeof *f);
         f->label = argv[i];
-        f->dl = dlopen(argv[i + 1], RTLD_NOW | RTLD_LOCAL);
+        f->version = atoi(argv[i + 1]);
+        if (f->version != 2 && f->version != 3) {
+            fprintf(stderr, "%s: FMI version %s is not 2 or 3\n", f->label, argv[i + 1]);
+            return 1;
+        }
+        f->dl = dlopen(argv[i + 2], RTLD_NOW | RTLD_LOCAL);
         if (f->dl == NULL) {
             fprintf(stderr, "%s: dlopen failed: %s\n", f->label, dlerror());
             return 2;
         }
-        LOAD(instantiate, "fmi2Instantiate");
-        LOAD(setup, "fmi2SetupExperiment");
-        LOAD(enter_init, "fmi2EnterInitializationMode");
-        LOAD(exit_init, "fmi2ExitInitializationMode");
-        LOAD(f->set_real, "fmi2SetReal");
-        LOAD(f->do_step, "fmi2DoStep");
-        LOAD(f->get_real, "fmi2GetReal");
-        LOAD(f->get_boolean, "fmi2GetBoolean");
-        LOAD(f->terminate, "fmi2Terminate");
-        LOAD(f->free_instance, "fmi2FreeInstance");
-        f->c = instantiate(f->label, fmi2CoSimulation, argv[i + 3], argv[i + 2], &callbacks, fmi2False, fmi2False);
-        if (f->c == NULL) {
-            fprintf(stderr, "%s: fmi2Instantiate returned NULL\n", f->label);
-            return 3;
-        }
-        if (setup(f->c, fmi2False, 0.0, 0.0, fmi2False, 0.0) != fmi2OK || enter_init(f->c) != fmi2OK
-                || exit_init(f->c) != fmi2OK) {
-            fprintf(stderr, "%s: initialisation failed\n", f->label);
+        if ((f->version == 2 ? open2 : open3)(f, argv[i + 3], argv[i + 4])) {
+            fprintf(stderr, "%s: instantiation or initialisation failed\n", f->label);
             return 3;
         }
     }
@@ -193,8 +277,13 @@ int main(int argc, char **argv)
             }
         }
     for (i = 0; i < m; i++) {
-        fmus[i].terminate(fmus[i].c);
-        fmus[i].free_instance(fmus[i].c);
+        if (fmus[i].version == 3) {
+            fmus[i].terminate3(fmus[i].c);
+            fmus[i].free_instance3(fmus[i].c);
+        } else {
+            fmus[i].terminate(fmus[i].c);
+            fmus[i].free_instance(fmus[i].c);
+        }
     }
     fprintf(stderr, "checksum %g\n", sink);
     return 0;
