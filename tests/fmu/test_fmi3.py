@@ -263,7 +263,7 @@ def test_fmi3_hostile_calls_are_refused_with_an_error_and_keep_the_values(fmi3_i
     assert got["wrong_token"] is None and got["event_mode"] is None and got["model_exchange_wrong_token"] is None
     assert 4 not in got["statuses_logged"]
     text = "\n".join(got["messages"])
-    for needed in ("v_approach = -1.0 is outside the allowed range", "is a Enumeration variable, not Int32",
+    for needed in ("v_approach = -1.0 is outside the allowed range", "is an Enumeration variable, not Int32",
                    "time is the independent variable and cannot be set", "fmi3DoStep is not allowed in instantiated",
                    "1 value references", "must not be NULL", "instantiation token {not-the-token} does not match",
                    "event mode is not provided", "fmi3InstantiateModelExchange: instantiation token",

@@ -173,6 +173,12 @@ static const char *access_name(const rst_instance *inst, unsigned int kinds)
     return "?";
 }
 
+/* "a" or "an" before a type name ("an Integer", "an Enumeration", "a Real"). */
+static const char *article(const char *name)
+{
+    return strchr("AEIOU", name[0]) != NULL ? "an" : "a";
+}
+
 /* Is `vr` the independent variable time (FMI 3.0)? */
 static int is_time(const rst_instance *inst, rst_vr vr)
 {
@@ -195,8 +201,8 @@ static int check_vr(rst_instance *inst, const char *function, rst_vr vr, unsigne
     if (is_time(inst, vr)) {
         if (kinds & RST_AS_REAL)
             return 1;
-        rst_log(inst, RST_ERROR, "%s: time (value reference %u) is a %s variable, not %s", function, vr,
-                access_name(inst, RST_AS_REAL), access_name(inst, kinds));
+        rst_log(inst, RST_ERROR, "%s: time (value reference %u) is %s %s variable, not %s", function, vr,
+                article(access_name(inst, RST_AS_REAL)), access_name(inst, RST_AS_REAL), access_name(inst, kinds));
         return 0;
     }
     if (vr >= inst->model->n_variables) {
@@ -206,8 +212,9 @@ static int check_vr(rst_instance *inst, const char *function, rst_vr vr, unsigne
     }
     var = &inst->model->variables[vr];
     if (!(kinds & (unsigned int)access_of(var))) {
-        rst_log(inst, RST_ERROR, "%s: %s (value reference %u) is a %s variable, not %s", function, var->name, vr,
-                access_name(inst, (unsigned int)access_of(var)), access_name(inst, kinds));
+        const char *type = access_name(inst, (unsigned int)access_of(var));
+        rst_log(inst, RST_ERROR, "%s: %s (value reference %u) is %s %s variable, not %s", function, var->name, vr,
+                article(type), type, access_name(inst, kinds));
         return 0;
     }
     return 1;
@@ -390,14 +397,16 @@ rst_status front_refuse_type(void *c, const char *function, const char *type_nam
     ENTER(function, set ? SET_MODES : GET_MODES)
     for (i = 0; i < n; i++) {
         if (vr != NULL && is_time(inst, vr[i]))
-            rst_log(inst, RST_ERROR, "%s: time is a %s variable, not %s", function, access_name(inst, RST_AS_REAL),
-                    type_name);
+            rst_log(inst, RST_ERROR, "%s: time is %s %s variable, not %s", function,
+                    article(access_name(inst, RST_AS_REAL)), access_name(inst, RST_AS_REAL), type_name);
         else if (vr == NULL || vr[i] >= inst->model->n_variables)
             rst_log(inst, RST_ERROR, "%s: unknown value reference %u (this FMU has no %s variables)", function,
                     vr ? vr[i] : 0u, type_name);
-        else
-            rst_log(inst, RST_ERROR, "%s: %s is a %s variable, not %s", function, inst->model->variables[vr[i]].name,
-                    access_name(inst, (unsigned int)access_of(&inst->model->variables[vr[i]])), type_name);
+        else {
+            const char *type = access_name(inst, (unsigned int)access_of(&inst->model->variables[vr[i]]));
+            rst_log(inst, RST_ERROR, "%s: %s is %s %s variable, not %s", function, inst->model->variables[vr[i]].name,
+                    article(type), type, type_name);
+        }
         LEAVE(RST_ERROR);
     }
     LEAVE(RST_OK);
