@@ -58,13 +58,11 @@ class ImpactFMU:
     def sweep(self, t, v) -> dict:
         """Outputs for every (plate thickness t [m], approach speed v [m/s]) pair (broadcast)."""
         t, v = np.broadcast_arrays(np.asarray(t, float), np.asarray(v, float))
-        slave = self.fmu.slave
-        vr_t, vr_v = self.fmu.vr("plate.t"), self.fmu.vr("v_approach")
-        vrs = [self.fmu.vr(n) for n in OUTPUTS]
+        set_inputs, read = self.fmu.writer("plate.t", "v_approach"), self.fmu.reader(*OUTPUTS)
         out = np.empty((t.size, len(OUTPUTS)))
         for i, (ti, vi) in enumerate(zip(t.ravel(), v.ravel())):
-            slave.setReal([vr_t, vr_v], [float(ti), float(vi)])
-            out[i] = slave.getReal(vrs)
+            set_inputs([float(ti), float(vi)])
+            out[i] = read()
         self.evaluations += t.size
         return {k: out[:, j].reshape(t.shape) for j, k in enumerate(KEYS)}
 

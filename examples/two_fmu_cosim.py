@@ -20,12 +20,14 @@ the impact FMU at the exact impact instants) over the first five bounces:
   rebounds at once with the COR held on its input, computed for the speed it had at the
   last communication point; the timing is right, the COR (and so the apex) is off.
 * ``libcosim``: OSP libcosim's fixedStep algorithm, configured from an
-  OspSystemStructure.xml written under examples/output/osp/. libcosim reads each FMU's
+  OspSystemStructure.xml written under examples/output/osp/ (FMI 2.0 FMUs only: libcosim
+  through libcosimpy 0.0.6 refuses FMI 3.0 FMUs, so with ``--fmu-dir DIR/fmi3`` this master is
+  left out). libcosim reads each FMU's
   outputs right after its step, so the loop ball -> impact -> ball lags one more step:
   the waiting ball gets the COR for the speed it had at the last communication point
   before the contact, not for its impact speed; both the timing and the COR are off.
 * ``fmpy state restore``: FixedStepMaster with ``event=("ball.impacts", "ball.t_impact")``:
-  every step starts with fmi2GetFMUstate; when the ball reports a contact inside the step,
+  every step starts by saving the FMU states; when the ball reports a contact inside the step,
   both FMUs are restored, stepped exactly to the reported contact time, the values are
   exchanged there, and the step is finished.
 
@@ -175,11 +177,22 @@ def plot(rows, traces, exact, path: Path, dpi: int = 90, show: bool = False, t_e
     return path
 
 
-def run(show_plot: bool = False, steps=(1e-2, 1e-3, 1e-4, 1e-5), fmu_dir=None, drop_height: float = 0.3,
-        t_end: float = 1.0, n_bounces: int = 5, masters=MASTERS, out_dir=None, dpi: int = 90,
-        osp_dir=None, repeat: int = 1, verbose: bool = True) -> dict:
-    """Run every master at every communication step; write the PNG; return rows and results.
+def masters_for(*fmus) -> tuple:
+    """The masters that can load these FMUs: every one, less libcosim for FMI 3.0 FMUs (libcosimpy 0.0.6
+    refuses them: "Unsupported FMI version")."""
+    from fmpy import read_model_description
 
+    fmi3 = any(read_model_description(str(fmu)).fmiVersion.startswith("3") for fmu in fmus)
+    return tuple(m for m in MASTERS if not (fmi3 and m == LIBCOSIM))
+
+
+def run(show_plot: bool = False, steps=(1e-2, 1e-3, 1e-4, 1e-5), fmu_dir=None, drop_height: float = 0.3,
+        t_end: float = 1.0, n_bounces: int = 5, masters=None, out_dir=None, dpi: int = 90,
+        osp_dir=None, repeat: int = 1, verbose: bool = True) -> dict:
+    """Run every master (``masters``: default, every one that can load the FMUs, :func:`masters_for`) at
+    every communication step; write the PNG; return rows and results.
+
+    ``fmu_dir``: the folder with both FMUs (FMI 2.0: ``DIR`` or ``DIR/native``; FMI 3.0: ``DIR/fmi3``).
     ``osp_dir``: where the OspSystemStructure.xml files go (default: ``out_dir/osp``).
     ``repeat``: runs per master and step; the wall time reported is the shortest.
     """
@@ -187,6 +200,14 @@ def run(show_plot: bool = False, steps=(1e-2, 1e-3, 1e-4, 1e-5), fmu_dir=None, d
         ball_fmu, impact_fmu = Path(fmu_dir) / "BouncingBall.fmu", Path(fmu_dir) / "SpherePlateImpact.fmu"
     else:
         ball_fmu, impact_fmu = build_default_fmu(model="BouncingBall"), build_default_fmu()
+    possible = masters_for(ball_fmu, impact_fmu)
+    if masters is None:
+        masters = possible
+        if verbose and len(masters) < len(MASTERS):
+            print(f"{LIBCOSIM} left out: libcosim (libcosimpy 0.0.6) does not load FMI 3.0 FMUs")
+    unsupported = [m for m in masters if m in MASTERS and m not in possible]
+    if unsupported:
+        raise ValueError(f"master(s) {unsupported} cannot load the FMI 3.0 FMUs in {Path(impact_fmu).parent}")
     out_dir = Path(out_dir or OUTPUT)
     osp_dir = Path(osp_dir) if osp_dir is not None else out_dir / "osp"
     sphere, plate = default_system()
@@ -255,7 +276,8 @@ def _run(show_plot, steps, ball_fmu, impact_fmu, params, drop_height, t_end, n_b
 if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--fmu-dir", type=Path, default=None,
-                        help="folder with BouncingBall.fmu and SpherePlateImpact.fmu (default: dist/, built if missing)")
+                        help="folder with BouncingBall.fmu and SpherePlateImpact.fmu: dist/ (the default, "
+                             "built if missing), dist/native or dist/fmi3")
     parser.add_argument("--steps", type=float, nargs="+", default=[1e-2, 1e-3, 1e-4, 1e-5])
     parser.add_argument("--show", action="store_true", help="show the plot window")
     args = parser.parse_args()

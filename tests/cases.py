@@ -88,3 +88,9 @@ CASES = st.fixed_dictionaries({
     "zener_method": st.sampled_from(("exact", "paper_fit", "linear")),
     "plasticity": st.sampled_from(r.EFFECT_MODES), "plate_waves": st.sampled_from(r.EFFECT_MODES),
 })
+
+
+def runs_ode(fmu) -> bool:
+    """Whether the FMU at path ``fmu`` (a fixture's) computes zener_method = 4 (ode): the pythonfmu FMU
+    does, the native ones (FMI 2.0 in native/, FMI 3.0 in fmi3/) refuse it (docs/implementations.md)."""
+    return not ({"native", "fmi3"} & set(fmu.parts))

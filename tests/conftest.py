@@ -83,20 +83,50 @@ def fmi3_ball_fmu(built_fmus) -> Path:
     return _fmi3(built_fmus, "BouncingBall")
 
 
-#: The two implementations of each FMU: tests that hold for both take these fixtures.
+def _implementation(built_fmus, model, which) -> Path:
+    """``model``.fmu as ``which``: "python" (pythonfmu), "native" (FMI 2.0 C) or "fmi3" (FMI 3.0 C)."""
+    if which == "python":
+        return built_fmus / f"{model}.fmu"
+    return _native(built_fmus, model) if which == "native" else _fmi3(built_fmus, model)
+
+
+#: The two FMI 2.0 implementations of each FMU: tests that hold for both take these fixtures
+#: (any_impact_fmu, any_ball_fmu), the tests that make raw fmi2 calls among them.
 IMPLEMENTATIONS = ("python", "native")
+#: Every FMU an fmpy host runs through restitution.cosim.FmuInstance: the two FMI 2.0 implementations
+#: and the FMI 3.0 one (any_version_impact_fmu, any_version_ball_fmu).
+VERSIONS = ("python", "native", "fmi3")
 
 
 @pytest.fixture(scope="session", params=IMPLEMENTATIONS)
 def any_impact_fmu(request, built_fmus) -> Path:
-    """SpherePlateImpact.fmu, once as the pythonfmu FMU and once as the native one."""
-    return built_fmus / "SpherePlateImpact.fmu" if request.param == "python" else _native(built_fmus, "SpherePlateImpact")
+    """SpherePlateImpact.fmu, once as the pythonfmu FMU and once as the native one (FMI 2.0)."""
+    return _implementation(built_fmus, "SpherePlateImpact", request.param)
 
 
 @pytest.fixture(scope="session", params=IMPLEMENTATIONS)
 def any_ball_fmu(request, built_fmus) -> Path:
-    """BouncingBall.fmu, once as the pythonfmu FMU and once as the native one."""
-    return built_fmus / "BouncingBall.fmu" if request.param == "python" else _native(built_fmus, "BouncingBall")
+    """BouncingBall.fmu, once as the pythonfmu FMU and once as the native one (FMI 2.0)."""
+    return _implementation(built_fmus, "BouncingBall", request.param)
+
+
+@pytest.fixture(scope="session", params=VERSIONS)
+def any_version_impact_fmu(request, built_fmus) -> Path:
+    """SpherePlateImpact.fmu as the pythonfmu FMU, the native FMI 2.0 one and the native FMI 3.0 one."""
+    return _implementation(built_fmus, "SpherePlateImpact", request.param)
+
+
+@pytest.fixture(scope="session", params=VERSIONS)
+def any_version_ball_fmu(request, built_fmus) -> Path:
+    """BouncingBall.fmu as the pythonfmu FMU, the native FMI 2.0 one and the native FMI 3.0 one."""
+    return _implementation(built_fmus, "BouncingBall", request.param)
+
+
+@pytest.fixture(scope="session", params=VERSIONS)
+def any_version_fmu_dir(request, built_fmus) -> Path:
+    """The folder with both FMUs: the pythonfmu ones, the native FMI 2.0 ones (native/), the FMI 3.0
+    ones (fmi3/)."""
+    return _implementation(built_fmus, "SpherePlateImpact", request.param).parent
 
 
 #: Test files whose results depend on floating-point kernels: .ci/run runs them (``-m numerics``)

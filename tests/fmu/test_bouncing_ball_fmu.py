@@ -1,5 +1,6 @@
-"""BouncingBall.fmu on its own (fmpy), both implementations (pythonfmu behind the C guard, and
-native): interface, exact free flight, contact inside the step, state save/restore and bad input."""
+"""BouncingBall.fmu on its own (fmpy), every implementation (pythonfmu behind the C guard, native FMI 2.0
+and native FMI 3.0; the modelDescription test: the two FMI 2.0 ones, tests/fmu/test_fmi3_model_description.py
+has FMI 3.0's): interface, exact free flight, contact inside the step, state save/restore and bad input."""
 import math
 import zipfile
 from xml.etree import ElementTree as ET
@@ -13,13 +14,13 @@ G = 9.80665
 
 
 @pytest.fixture(scope="module")
-def ball_fmu(any_ball_fmu):
-    return any_ball_fmu
+def ball_fmu(any_version_ball_fmu):
+    return any_version_ball_fmu
 
 
-def test_interface(ball_fmu):
-    assert validate_fmu(str(ball_fmu)) == []
-    with zipfile.ZipFile(ball_fmu) as z:
+def test_interface(any_ball_fmu):
+    assert validate_fmu(str(any_ball_fmu)) == []
+    with zipfile.ZipFile(any_ball_fmu) as z:
         root = ET.fromstring(z.read("modelDescription.xml"))
     assert root.find("CoSimulation").get("canGetAndSetFMUstate") == "true"
     found = {sv.get("name"): (sv.get("causality"), sv[0].get("unit")) for sv in root.find("ModelVariables")}
@@ -55,13 +56,13 @@ def test_elastic_bounces_are_exact_for_any_step(ball_fmu, step):
 def test_wait_mode_step_to_the_reported_contact_time(ball_fmu):
     t1 = math.sqrt(2 * 0.3 / G)
     with FmuInstance(ball_fmu, "ball", parameters={"h0": 0.3}) as ball:
-        state = ball.slave.getFMUstate()
+        state = ball.get_state()
         ball.do_step(0.0, 0.3)
         count, t_imp, in_contact, v_app = ball.get("impacts", "t_impact", "in_contact", "v_approach")
         assert count == 1 and in_contact and t_imp == pytest.approx(t1, abs=1e-15)
         assert v_app == pytest.approx(G * t1, rel=1e-12)  # waits at the plate with its impact speed
-        ball.slave.setFMUstate(state)
-        ball.slave.freeFMUstate(state)
+        ball.set_state(state)
+        ball.free_state(state)
         assert ball.get("impacts", "h") == [0, pytest.approx(0.3)]
         ball.do_step(0.0, t_imp)  # exactly to the contact: it is seen within this step
         assert ball.get("impacts", "in_contact", "h") == [1, True, 0.0]

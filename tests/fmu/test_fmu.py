@@ -130,15 +130,17 @@ E_DEFAULT_AT_2_3 = apparent_cor(table_material("s2_tool_steel"), table_material(
 
 @pytest.mark.parametrize("name,value", [("v_approach", -1.0), ("v_approach", math.nan), ("plate.nu", 0.5),
                                         ("sphere.E", math.inf), ("plate.t", 0.0), ("zener_method", 7)])
-def test_bad_input_is_refused_not_fatal(any_impact_fmu, name, value):
-    """fmi2Error with a message naming the variable, the value and the range; the previous value is
-    kept, so the instance goes on computing the right numbers; the other instance is untouched."""
-    with FmuInstance(any_impact_fmu, "bad") as bad, FmuInstance(any_impact_fmu, "good") as good:
+def test_bad_input_is_refused_not_fatal(any_version_impact_fmu, name, value):
+    """Error (fmi2Error, fmi3Error) with a message naming the variable, the value and the range; the
+    previous value is kept, so the instance goes on computing the right numbers; the other instance is
+    untouched."""
+    fmu = any_version_impact_fmu
+    with FmuInstance(fmu, "bad") as bad, FmuInstance(fmu, "good") as good:
         good.set(v_approach=2.3)
         bad.set(v_approach=2.3)
         with pytest.raises(FmiStatusError) as err:
             bad.set(**{name: value})
-        assert err.value.status == 3  # fmi2Error, never fmi2Fatal (4)
+        assert err.value.status == 3  # Error, never Fatal (4)
         logged = " ".join(m for _, m in bad.messages)
         assert name in logged and repr(value) in logged and "allowed range" in logged
         bad.do_step(step_size=0.01)
@@ -147,17 +149,35 @@ def test_bad_input_is_refused_not_fatal(any_impact_fmu, name, value):
         assert good.get("e")[0] == pytest.approx(E_DEFAULT_AT_2_3, rel=1e-8)
 
 
-def test_state_round_trip(any_impact_fmu):
-    with FmuInstance(any_impact_fmu) as fmu:
+def test_the_fmi_version_and_variable_kinds_are_read_from_the_model_description(any_version_impact_fmu):
+    """FmuInstance takes the version from the modelDescription and names every variable's kind in FMI 2.0's
+    words for both versions (an FMI 3.0 Float64 is a Real); an Enumeration is set by item name or code."""
+    from fmpy import read_model_description
+
+    md = read_model_description(str(any_version_impact_fmu))
+    with FmuInstance(any_version_impact_fmu) as fmu:
+        assert fmu.fmi_version == md.fmiVersion and fmu.fmi_version in ("2.0", "3.0")
+        assert fmu.slave.__class__.__name__ == ("FMU3Slave" if md.fmiVersion == "3.0" else "FMU2Slave")
+        assert [fmu.kind(n) for n in ("e", "valid", "plate.material")] == ["Real", "Boolean", "Enumeration"]
+        # zener_method: an Integer in FMI 2.0 (its codes in the description), an Enumeration in FMI 3.0
+        assert fmu.kind("zener_method") == ("Enumeration" if md.fmiVersion == "3.0" else "Integer")
+        fmu.set(**{"plate.material": "brass_260", "sphere.material": 0})
+        assert fmu.get("plate.material", "sphere.material", "plate.used.E") == [1, 0, 103e9]  # Table 3: brass
+
+
+def test_state_round_trip(any_version_impact_fmu):
+    with FmuInstance(any_version_impact_fmu) as fmu:
         fmu.set(v_approach=1.7, **{"plate.t": 3e-3})
         before = fmu.get_reals(list(REAL_OUTPUTS))
-        state = fmu.slave.getFMUstate()
-        blob = fmu.slave.serializeFMUstate(state)
+        state = fmu.get_state()
+        blob = fmu.serialize_state(state)
         fmu.set(v_approach=4.0, **{"plate.t": 1e-2})
         assert fmu.get_reals(["e"])[0] != before[0]
-        fmu.slave.setFMUstate(fmu.slave.deSerializeFMUstate(blob))
+        copy = fmu.deserialize_state(blob)
+        fmu.set_state(copy)
         assert fmu.get_reals(list(REAL_OUTPUTS)) == before
-        fmu.slave.freeFMUstate(state)
+        fmu.free_state(copy)
+        fmu.free_state(state)
 
 
 def test_a_non_finite_output_is_an_evaluation_failure(impact_fmu, monkeypatch):

@@ -1,15 +1,15 @@
-"""SpherePlateImpact.fmu, both implementations (pythonfmu behind the C guard, and native), under
-bad input, many instances, state round trips and a million steps (fmpy host); the pythonfmu one
-also next to a different pythonfmu FMU.
+"""SpherePlateImpact.fmu, every implementation (pythonfmu behind the C guard, native FMI 2.0, native
+FMI 3.0; all through restitution.cosim.FmuInstance), under bad input, many instances, state round
+trips and a million steps (fmpy host); the pythonfmu one also next to a different pythonfmu FMU.
 
 * Every input and parameter set to NaN, +inf, -inf, a negative value, zero where a positive
-  value is needed, nu >= 0.5, an integer code out of range: fmi2SetXXX returns fmi2Error and
-  the FMU logs one message naming the variable, its value and the allowed range; the previous
-  value is kept, so outputs and fmi2DoStep go on as before (never fmi2Fatal); another instance
-  stepping alongside is unaffected.
+  value is needed, nu >= 0.5, an integer code out of range: the set call returns Error
+  (fmi2Error, fmi3Error) and the FMU logs one message naming the variable, its value and the
+  allowed range; the previous value is kept, so outputs and steps go on as before (never
+  Fatal); another instance stepping alongside is unaffected.
 * Eight instances with different materials stepped interleaved give the same bits as one at
   a time, and the package's numbers (within each output's conditioning, restitution.agreement).
-* fmi2Get/SetFMUstate and (de)serialization round-trip every variable exactly.
+* Getting and setting FMU states and (de)serializing them round-trip every variable exactly.
 * One million steps in one instance: unchanged results, resident memory growing < 1 MiB.
 """
 from __future__ import annotations
@@ -29,6 +29,7 @@ from restitution.agreement import disagreements, tolerances
 from restitution.cosim import FmiStatusError, FmuInstance, impact_fmu_parameters
 from restitution.model import DOMAIN
 
+from cases import runs_ode
 from toy_fmu import build_toy_fmu
 
 FMI_OK, FMI_DISCARD, FMI_ERROR, FMI_FATAL = 0, 2, 3, 4
@@ -111,8 +112,8 @@ def assert_outputs(fmu, settings, context=""):
 
 
 @pytest.fixture(scope="module")
-def unzipped(any_impact_fmu, tmp_path_factory):
-    return extract(str(any_impact_fmu), str(tmp_path_factory.mktemp("unzipped")))
+def unzipped(any_version_impact_fmu, tmp_path_factory):
+    return extract(str(any_version_impact_fmu), str(tmp_path_factory.mktemp("unzipped")))
 
 
 GOOD_SETTINGS = {**impact_fmu_parameters(r.Sphere(r.MATERIALS["tungsten_carbide"], 4.76e-3),
@@ -120,9 +121,9 @@ GOOD_SETTINGS = {**impact_fmu_parameters(r.Sphere(r.MATERIALS["tungsten_carbide"
 
 
 @pytest.fixture(scope="module")
-def bystander(any_impact_fmu, unzipped):
+def bystander(any_version_impact_fmu, unzipped):
     """An instance that keeps stepping, with valid values, next to every misbehaving one."""
-    with FmuInstance(any_impact_fmu, "bystander", unzip_dir=unzipped, parameters=GOOD_SETTINGS) as fmu:
+    with FmuInstance(any_version_impact_fmu, "bystander", unzip_dir=unzipped, parameters=GOOD_SETTINGS) as fmu:
         yield fmu
 
 
@@ -131,9 +132,9 @@ def _message_for(name, value, allowed):
 
 
 @pytest.mark.parametrize("name,value", BAD, ids=[f"{n}={v!r}" for n, v in BAD])
-def test_bad_value_is_refused_and_the_previous_one_kept(any_impact_fmu, unzipped, bystander, name, value):
+def test_bad_value_is_refused_and_the_previous_one_kept(any_version_impact_fmu, unzipped, bystander, name, value):
     start, allowed = INPUTS[name]
-    with FmuInstance(any_impact_fmu, "bad", unzip_dir=unzipped) as bad:
+    with FmuInstance(any_version_impact_fmu, "bad", unzip_dir=unzipped) as bad:
         bad.set(v_approach=2.3)
         bad.do_step(step_size=1e-3)
         bystander.do_step(step_size=1e-3)
@@ -158,7 +159,7 @@ def test_bad_value_is_refused_and_the_previous_one_kept(any_impact_fmu, unzipped
 
         # refused in a vector call too: all or nothing, with a valid neighbour
         other, other_value = ("plate.t", 3e-3) if name != "plate.t" else ("sphere.d", 4e-3)
-        if bad.variables[name].type == "Real":
+        if bad.kind(name) == "Real":
             with pytest.raises(FmiStatusError):
                 bad.set(**{other: other_value, name: value})
             assert bad.get(other) == [INPUTS[other][0]]
@@ -170,20 +171,20 @@ def _same(a, b):
 
 
 @pytest.mark.parametrize("name,value", [("plate.t", NAN), ("sphere.nu", 0.5), ("zener_method", 9), ("v_approach", -INF)])
-def test_bad_value_during_initialization(any_impact_fmu, unzipped, name, value):
-    """Set between fmi2EnterInitializationMode and fmi2ExitInitializationMode: same behaviour."""
+def test_bad_value_during_initialization(any_version_impact_fmu, unzipped, name, value):
+    """Set in initialization mode (between entering and exiting it): same behaviour."""
     with pytest.raises(FmiStatusError) as err:
-        FmuInstance(any_impact_fmu, "init", unzip_dir=unzipped, parameters={name: value})
+        FmuInstance(any_version_impact_fmu, "init", unzip_dir=unzipped, parameters={name: value})
     assert err.value.status == FMI_ERROR and _message_for(name, value, INPUTS[name][1]) in str(err.value)
 
 
 @pytest.mark.parametrize("name,value", [("sphere.E", 1e13), ("plate.t", 1e-7), ("sphere.d", 1e-6),
                                         ("plate.E", 1e5), ("v_approach", 1e4), ("sphere.rho", 1e5),
                                         ("plate.t", 100.0), ("sphere.Sy", 1e3)])
-def test_valid_but_absurd_values_give_the_packages_numbers(any_impact_fmu, unzipped, name, value):
+def test_valid_but_absurd_values_give_the_packages_numbers(any_version_impact_fmu, unzipped, name, value):
     """At the ends of the declared domain (physically extreme) the model stays finite (the domain is
     declared so that it does): the step succeeds with the package's numbers, and valid values after."""
-    with FmuInstance(any_impact_fmu, "absurd", unzip_dir=unzipped) as fmu:
+    with FmuInstance(any_version_impact_fmu, "absurd", unzip_dir=unzipped) as fmu:
         fmu.set(**{name: value})
         fmu.do_step(step_size=1e-3)
         assert_outputs(fmu, {name: value}, name)
@@ -219,14 +220,14 @@ def _speeds(i, n=40):
     return [0.01 + 0.37 * i + 0.25 * k + 1e-3 * k * k for k in range(n)]
 
 
-def test_eight_instances_interleaved_equal_one_at_a_time(any_impact_fmu, unzipped):
+def test_eight_instances_interleaved_equal_one_at_a_time(any_version_impact_fmu, unzipped):
     settings = _eight_settings()
-    if "native" in any_impact_fmu.parts:  # ode (zener_method = 4) is the Python FMU's only
+    if not runs_ode(any_version_impact_fmu):  # ode (zener_method = 4) is the Python FMU's only
         settings = [dict(s, zener_method=1) if s["zener_method"] == 4 else s for s in settings]
     n = 40
 
     def make(i):
-        return FmuInstance(any_impact_fmu, f"m{i}", unzip_dir=unzipped, parameters=settings[i])
+        return FmuInstance(any_version_impact_fmu, f"m{i}", unzip_dir=unzipped, parameters=settings[i])
 
     interleaved = [[] for _ in settings]
     instances = [make(i) for i in range(len(settings))]
@@ -298,16 +299,16 @@ STATE_CASES = {
 
 
 @pytest.mark.parametrize("case", list(STATE_CASES))
-def test_state_get_set_and_serialize_round_trip_exactly(any_impact_fmu, unzipped, case):
+def test_state_get_set_and_serialize_round_trip_exactly(any_version_impact_fmu, unzipped, case):
     settings = STATE_CASES[case]
-    if settings.get("zener_method") == 4 and "native" in any_impact_fmu.parts:
+    if settings.get("zener_method") == 4 and not runs_ode(any_version_impact_fmu):
         pytest.skip("zener_method = 4 (ode) is the Python FMU's only")
-    with FmuInstance(any_impact_fmu, "state", unzip_dir=unzipped, parameters=settings) as fmu, \
-            FmuInstance(any_impact_fmu, "other", unzip_dir=unzipped) as other:
+    with FmuInstance(any_version_impact_fmu, "state", unzip_dir=unzipped, parameters=settings) as fmu, \
+            FmuInstance(any_version_impact_fmu, "other", unzip_dir=unzipped) as other:
         fmu.do_step(0.0, 0.5)
         before = _snapshot(fmu)
-        state = fmu.slave.getFMUstate()
-        blob = fmu.slave.serializeFMUstate(state)
+        state = fmu.get_state()
+        blob = fmu.serialize_state(state)
         assert 0 < len(blob) < 10_000
 
         fmu.set(**_eight_settings()[7], v_approach=4.0, plasticity=1)  # change everything
@@ -315,19 +316,19 @@ def test_state_get_set_and_serialize_round_trip_exactly(any_impact_fmu, unzipped
         changed = _snapshot(fmu)
         assert changed != before
 
-        fmu.slave.setFMUstate(state)  # in memory: back to t = 0.5
+        fmu.set_state(state)  # in memory: back to t = 0.5
         assert _snapshot(fmu) == before
         fmu.do_step(0.5, 0.5)
         assert_outputs(fmu, settings, case)
 
-        copy = other.slave.deSerializeFMUstate(blob)  # serialized, into a different fresh instance
-        other.slave.setFMUstate(copy)
+        copy = other.deserialize_state(blob)  # serialized, into a different fresh instance
+        other.set_state(copy)
         assert _snapshot(other) == before
         other.do_step(0.5, 0.5)
         assert_outputs(other, settings, case)
-        assert other.slave.serializeFMUstate(copy) == blob  # and again, byte for byte
-        other.slave.freeFMUstate(copy)
-        fmu.slave.freeFMUstate(state)
+        assert other.serialize_state(copy) == blob  # and again, byte for byte
+        other.free_state(copy)
+        fmu.free_state(state)
 
 
 # --- a long run -------------------------------------------------------------------------------------
@@ -341,32 +342,28 @@ def _rss_kib() -> int:
 
 @pytest.mark.slow
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc/self/status")
-def test_one_million_steps_unchanged_results_flat_memory(any_impact_fmu, unzipped, record_property):
-    """1e6 x (fmi2SetReal v, fmi2DoStep, fmi2GetReal e, v_rebound), v cycling through four values so
-    that every step evaluates the model; raw FMI calls through fmpy's bindings (no per-call arrays)."""
-    from fmpy.fmi2 import fmi2Real, fmi2ValueReference
-
+def test_one_million_steps_unchanged_results_flat_memory(any_version_impact_fmu, unzipped, record_property):
+    """1e6 x (set v, step, get e and v_rebound), v cycling through four values so that every step
+    evaluates the model; FmuInstance's writer, do_step and reader: raw FMI calls through fmpy's bindings
+    with arrays allocated once (no per-call arrays), raising on any status above Warning."""
     speeds = [2.3, 0.05, 11.0, 0.7]
-    with FmuInstance(any_impact_fmu, "long", unzip_dir=unzipped, parameters=_eight_settings()[0]) as fmu:
+    with FmuInstance(any_version_impact_fmu, "long", unzip_dir=unzipped, parameters=_eight_settings()[0]) as fmu:
         expected = []
         for v in speeds:  # the FMU's own first answers, checked against the package within conditioning
             fmu.set(v_approach=v)
             assert_outputs(fmu, {**_eight_settings()[0], "v_approach": v})
             expected.append(tuple(fmu.get_reals(["e", "v_rebound"])))
-        s = fmu.slave
-        set_real, get_real, do_step, c = s.fmi2SetReal, s.fmi2GetReal, s.fmi2DoStep, s.component
-        vr_in = (fmi2ValueReference * 1)(fmu.vr("v_approach"))
-        vr_out = (fmi2ValueReference * 2)(fmu.vr("e"), fmu.vr("v_rebound"))
-        value, out = (fmi2Real * 1)(), (fmi2Real * 2)()
+        set_speed, do_step, get = fmu.writer("v_approach"), fmu.do_step, fmu.reader("e", "v_rebound")
+        inputs = [[v] for v in speeds]
+        expected = [list(pair) for pair in expected]
         h = 1e-3
 
         def run(first, count):
             wrong = 0
             for k in range(first, first + count):
-                value[0] = speeds[k & 3]
-                status = set_real(c, vr_in, 1, value) | do_step(c, k * h, h, 1) | get_real(c, vr_out, 2, out)
-                e, v_reb = expected[k & 3]
-                if status != 0 or out[0] != e or out[1] != v_reb:
+                set_speed(inputs[k & 3])
+                do_step(k * h, h)
+                if get() != expected[k & 3]:
                     wrong += 1
             return wrong
 

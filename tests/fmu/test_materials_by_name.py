@@ -1,5 +1,6 @@
-"""Materials by name in both implementations of SpherePlateImpact: sphere.material and plate.material
-are Enumerations whose items are "custom" and every preset of docs/materials.md; a preset replaces the
+"""Materials by name in every SpherePlateImpact FMU (pythonfmu, native FMI 2.0, native FMI 3.0; the
+modelDescription test: the FMI 2.0 ones, test_fmi3_model_description.py has FMI 3.0's): sphere.material and
+plate.material are Enumerations whose items are "custom" and every preset of docs/materials.md; a preset replaces the
 body's four numeric parameters, and sphere.used.* / plate.used.* show the values the model uses.
 
 The expected values come from the presets (restitution.MATERIALS, themselves checked against the
@@ -35,22 +36,22 @@ def test_the_enumeration_lists_custom_and_every_preset(any_impact_fmu):
 
 @pytest.mark.parametrize("body", ["sphere", "plate"])
 @pytest.mark.parametrize("preset", PRESETS)
-def test_a_preset_by_name_is_the_same_as_its_numbers(any_impact_fmu, body, preset):
+def test_a_preset_by_name_is_the_same_as_its_numbers(any_version_impact_fmu, body, preset):
     material = r.MATERIALS[preset]
     numbers = {f"{body}.{p}": float(getattr(material, p)) for p in PROPS}
-    with FmuInstance(any_impact_fmu, parameters={f"{body}.material": preset}) as by_name:
+    with FmuInstance(any_version_impact_fmu, parameters={f"{body}.material": preset}) as by_name:
         by_name.set(v_approach=2.3)
         used = _used(by_name, body)
         e_by_name = by_name.get("e")[0]
-    with FmuInstance(any_impact_fmu, parameters=numbers) as by_numbers:
+    with FmuInstance(any_version_impact_fmu, parameters=numbers) as by_numbers:
         by_numbers.set(v_approach=2.3)
         e_by_numbers = by_numbers.get("e")[0]
     assert used == {p: float(getattr(material, p)) for p in PROPS}
     assert e_by_name == pytest.approx(e_by_numbers, rel=1e-14, abs=1e-15)
 
 
-def test_custom_uses_the_numbers_and_a_preset_ignores_them(any_impact_fmu):
-    with FmuInstance(any_impact_fmu, parameters={"plate.E": 100e9, "plate.rho": 3000.0}) as fmu:
+def test_custom_uses_the_numbers_and_a_preset_ignores_them(any_version_impact_fmu):
+    with FmuInstance(any_version_impact_fmu, parameters={"plate.E": 100e9, "plate.rho": 3000.0}) as fmu:
         fmu.set(v_approach=2.3)
         assert _used(fmu, "plate")["E"] == 100e9 and _used(fmu, "plate")["rho"] == 3000.0
         custom = fmu.get("e")[0]
@@ -65,30 +66,29 @@ def test_custom_uses_the_numbers_and_a_preset_ignores_them(any_impact_fmu):
 
 
 @pytest.mark.parametrize("code", [-1, len(PRESETS) + 1, 2 ** 31 - 1])
-def test_a_code_outside_the_items_is_refused_and_the_previous_kept(any_impact_fmu, code):
-    with FmuInstance(any_impact_fmu, parameters={"sphere.material": "brass_260"}) as fmu:
+def test_a_code_outside_the_items_is_refused_and_the_previous_kept(any_version_impact_fmu, code):
+    with FmuInstance(any_version_impact_fmu, parameters={"sphere.material": "brass_260"}) as fmu:
         with pytest.raises(FmiStatusError, match=r"sphere\.material = -?\d+ is outside the allowed range"):
             fmu.set(**{"sphere.material": code})
         assert fmu.get("sphere.material") == [1] and _used(fmu, "sphere")["E"] == 103e9
     with pytest.raises(ValueError, match=r"'steel' is not one of its items: custom, brass_260"):
-        FmuInstance(any_impact_fmu, parameters={"sphere.material": "steel"})
+        FmuInstance(any_version_impact_fmu, parameters={"sphere.material": "steel"})
 
 
-def test_the_used_values_cannot_be_set(any_impact_fmu):
-    with FmuInstance(any_impact_fmu) as fmu:
+def test_the_used_values_cannot_be_set(any_version_impact_fmu):
+    with FmuInstance(any_version_impact_fmu) as fmu:
         with pytest.raises(FmiStatusError, match=r"sphere\.used\.E is a calculated parameter and cannot be set"):
             fmu.set(**{"sphere.used.E": 1e9})
 
 
-def test_an_fmu_state_carries_the_materials(any_impact_fmu):
-    with FmuInstance(any_impact_fmu, parameters={"plate.material": "borosilicate_glass"}) as fmu:
+def test_an_fmu_state_carries_the_materials(any_version_impact_fmu):
+    with FmuInstance(any_version_impact_fmu, parameters={"plate.material": "borosilicate_glass"}) as fmu:
         fmu.set(v_approach=1.0)
-        slave = fmu.slave
-        state = slave.getFMUstate()
+        state = fmu.get_state()
         glass = fmu.get("e")[0]
         fmu.set(**{"plate.material": "brass_260"})
         assert fmu.get("e")[0] != glass
-        slave.setFMUstate(state)
-        slave.freeFMUstate(state)
+        fmu.set_state(state)
+        fmu.free_state(state)
         assert fmu.get("plate.material") == [6] and fmu.get("e")[0] == glass
         assert _used(fmu, "plate")["nu"] == 0.2

@@ -91,10 +91,13 @@ def test_native_fmu_validates_and_has_no_python(native_fmu):
 
 
 @needs_front
+@pytest.mark.parametrize("version", ["native_impact_fmu", "fmi3_impact_fmu"])
 @pytest.mark.parametrize("method", ["exact", "paper_fit", "linear"])
-def test_native_fmu_equals_the_package(native_fmu, method):
+def test_native_fmu_equals_the_package(request, version, method):
+    """The native FMU, FMI 2.0 and FMI 3.0 (the same C behind either version layer), through FmuInstance."""
     from restitution.cosim import FmuInstance
 
+    native_fmu = request.getfixturevalue(version)
     rng = np.random.default_rng(7)
     for pair in ("s2/al6061", "T4-A1", "glass/glass", "nu0/nu0.499"):
         for t_over_d in (0.05, 1.0, 100.0):
@@ -186,10 +189,10 @@ FMU_CODES = {"restitution_model": {m: i + 1 for i, m in enumerate(r.RESTITUTION_
 
 
 @pytest.fixture(scope="module")
-def any_instance(any_impact_fmu):
+def any_instance(any_version_impact_fmu):
     from restitution.cosim import FmuInstance
 
-    with FmuInstance(any_impact_fmu, "hypothesis") as fmu:
+    with FmuInstance(any_version_impact_fmu, "hypothesis") as fmu:
         yield fmu
 
 
@@ -198,8 +201,8 @@ def any_instance(any_impact_fmu):
 @given(CASES, st.sampled_from([0.0, 1e-6, 1e-3]))
 def test_both_fmus_equal_the_package_over_the_declared_domain(any_instance, case, effect_tolerance):
     """For cases drawn from the whole declared domain (all methods both implementations run, models and
-    effect modes), each FMU (pythonfmu and native) answers every set and the step with fmi2OK (FmuInstance
-    raises otherwise), every Real output is finite, and every output and flag equals the package's
+    effect modes), each FMU (pythonfmu, native FMI 2.0, native FMI 3.0) answers every set and the step with
+    OK (FmuInstance raises otherwise), every Real output is finite, and every output and flag equals the package's
     published value within its conditioning; the two implementations then agree with each other within
     twice that."""
     fmu = any_instance

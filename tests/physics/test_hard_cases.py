@@ -35,7 +35,7 @@ from restitution.model import DOMAIN, ZENER_SLOPE_BOUND
 from restitution.zener_exact import E_INF
 
 from agree import assert_agree, stack
-from cases import D, FMU_FLAGS, FMU_REALS, PAIRS, SPEEDS, T_OVER_D, params_for
+from cases import D, FMU_FLAGS, FMU_REALS, PAIRS, SPEEDS, T_OVER_D, params_for, runs_ode
 
 pytestmark = pytest.mark.filterwarnings("error")
 
@@ -325,11 +325,11 @@ def test_ode_method_respects_the_exact_bounds_at_any_tolerance(rtol):
     assert tau00 == pytest.approx(zener.TAU0_HERTZ, rel=max(rtol, 1e-12) * 100)
 
 
-# --- the same through the FMU (both implementations) ----------------------------------------------------
+# --- the same through the FMU (every implementation: pythonfmu, native FMI 2.0, native FMI 3.0) -------
 @pytest.fixture(scope="module")
-def fmu(any_impact_fmu):
-    with FmuInstance(any_impact_fmu, "hard") as instance:
-        instance.native = "native" in any_impact_fmu.parts  # ode (zener_method = 4) is the Python FMU's only
+def fmu(any_version_impact_fmu):
+    with FmuInstance(any_version_impact_fmu, "hard") as instance:
+        instance.native = not runs_ode(any_version_impact_fmu)  # ode (zener_method = 4) is the Python FMU's only
         yield instance
 
 

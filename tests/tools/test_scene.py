@@ -328,9 +328,10 @@ def test_report_with_ode_on_the_table(instance):
     assert rep.times[("all_on", "ode")] > 3 * rep.times[("scene", "ode")]
 
 
-def test_command_line_run_and_report(any_impact_fmu, tmp_path, capsys):
-    """Through either FMU (the native one with --fmu DIR/native/SpherePlateImpact.fmu)."""
-    impact_fmu = any_impact_fmu
+def test_command_line_run_and_report(any_version_impact_fmu, tmp_path, capsys):
+    """Through every FMU: --fmu DIR/SpherePlateImpact.fmu, DIR/native/SpherePlateImpact.fmu (FMI 2.0) and
+    DIR/fmi3/SpherePlateImpact.fmu (FMI 3.0)."""
+    impact_fmu = any_version_impact_fmu
     path = SCENES / "glass_marble_glass_plate.toml"
     assert main(["run", str(path), "--fmu", str(impact_fmu), "--out", str(tmp_path), "--no-progress"]) == 0
     printed = capsys.readouterr().out
@@ -357,12 +358,12 @@ BOUNCE_TABLE = "bounce height after each impact [mm] (e [1])"
 CELL = re.compile(r"(\S+) \((\S+)\)")
 
 
-def test_run_prints_the_bounce_heights_and_cor_of_each_drop(any_impact_fmu, tmp_path, capsys):
+def test_run_prints_the_bounce_heights_and_cor_of_each_drop(any_version_impact_fmu, tmp_path, capsys):
     """The answer on screen: per drop, the height after each of the first impacts and its COR. The
     first is checked against the package alone: e at v0 = sqrt(2 g h0), and the rebound apex e^2 h0
     (energy), to the 4 and 3 digits printed."""
     path = SCENES / "steel_ball_thin_aluminium.toml"
-    assert main(["run", str(path), "--fmu", str(any_impact_fmu), "--out", str(tmp_path), "--no-plot",
+    assert main(["run", str(path), "--fmu", str(any_version_impact_fmu), "--out", str(tmp_path), "--no-plot",
                  "--no-progress"]) == 0
     table = capsys.readouterr().out.split(BOUNCE_TABLE, 1)[1].splitlines()
     for drop in load_scene(path).drops():
@@ -397,13 +398,13 @@ drop_heights = "1 m"
 """
 
 
-def test_a_drop_still_bouncing_at_its_limit_warns_and_exits_3(any_impact_fmu, tmp_path, capsys):
+def test_a_drop_still_bouncing_at_its_limit_warns_and_exits_3(any_version_impact_fmu, tmp_path, capsys):
     """Glass on a 3 m glass block loses almost nothing per impact (neither body yields, the plate is
     a half-space for Zener: e within 1e-4 of 1), so the ball never comes to rest: everything is
     written, a warning says why and what to change, and the exit status is not 0."""
     scene = tmp_path / "endless.toml"
     scene.write_text(ENDLESS_SCENE)
-    status = main(["run", str(scene), "--fmu", str(any_impact_fmu), "--out", str(tmp_path / "out"), "--no-plot",
+    status = main(["run", str(scene), "--fmu", str(any_version_impact_fmu), "--out", str(tmp_path / "out"), "--no-plot",
                    "--no-progress"])
     captured = capsys.readouterr()
     assert status == 3

@@ -494,12 +494,14 @@ def cli_built_fmus(tmp_path_factory):
     return out
 
 
-def test_cli_fmu_back_end_on_the_built_fmus_python_and_native(tmp_path, cli_built_fmus):
+@pytest.mark.parametrize("native_dir", ["native", "fmi3"])
+def test_cli_fmu_back_end_on_the_built_fmus_python_and_native(tmp_path, cli_built_fmus, native_dir):
     """--fmu DIR/SpherePlateImpact.fmu and DIR/native/SpherePlateImpact.fmu (C only: the sweep refused it
-    with a traceback, looking for the bundled Python package) give the same table, refused cases too."""
-    native = cli_built_fmus / "native" / "SpherePlateImpact.fmu"
+    with a traceback, looking for the bundled Python package), or DIR/fmi3/SpherePlateImpact.fmu (FMI 3.0,
+    the same C), give the same table, refused cases too."""
+    native = cli_built_fmus / native_dir / "SpherePlateImpact.fmu"
     if not native.is_file():
-        pytest.skip("no native FMU built here")
+        pytest.skip(f"no {native_dir} FMU built here")
     args = ["--pair", "s2_tool_steel/al_6061", "--grid", "v=geomspace:0.1:100:10", "--grid", "t/d=0.05,1",
             "--random", "sphere.E=normal_rel:0.6", "--samples", "3", "--seed", "4", "--backend", "fmu",
             "--scheduler", "serial", "--no-plot"]

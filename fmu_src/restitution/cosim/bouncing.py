@@ -18,7 +18,7 @@ function that returns a non-finite e or v_rebound (e.g. an FMU whose inputs are 
 reads NaN) stops the drop with ValueError instead of bouncing on NaN.
 
 fmpy's ``simulate_fmu`` has no events in co-simulation (docs/fmi_tools.md), hence this master
-on ``fmpy.fmi2.FMU2Slave`` (through :class:`~restitution.cosim.fmu.FmuInstance`).
+on fmpy (through :class:`~restitution.cosim.fmu.FmuInstance`: FMI 2.0 and FMI 3.0 FMUs alike).
 """
 from __future__ import annotations
 
@@ -110,19 +110,18 @@ def fmu_rebound(instance):
     """Rebound function backed by a SpherePlateImpact :class:`FmuInstance`.
 
     At each impact: set ``v_approach``, read the outputs (direct feedthrough: valid right
-    after fmi2SetReal, no step needed). The master steps the FMU across each flight, on the FMU's
+    after the set call, no step needed). The master steps the FMU across each flight, on the FMU's
     own clock (FMI 2.0 steps must follow each other), so a second drop through the same instance
     continues that clock where the first ended; the impact model does not depend on time.
     """
     names = list(RECORDED)
     fields_ = [RECORDED[n] for n in names]
-    vr_in = instance.vr("v_approach")
-    vrs = [instance.vr(n) for n in names]
-    slave = instance.slave
+    set_speed = instance.writer("v_approach")
+    read = instance.reader(*names)
 
     def rebound(v):
-        slave.setReal([vr_in], [v])
-        return dict(zip(fields_, slave.getReal(vrs)))
+        set_speed([v])
+        return dict(zip(fields_, read()))
 
     def advance(_t, dt):
         if dt > 0.0:

@@ -1,18 +1,19 @@
-"""Fixed-step co-simulation masters for connected FMUs, on fmpy (``FmuInstance``).
+"""Fixed-step co-simulation masters for connected FMUs, on fmpy (``FmuInstance``: FMI 2.0 and FMI 3.0
+FMUs alike, mixed as they come).
 
 :class:`FixedStepMaster` couples several FMU instances through named connections
 ``("ball.v_approach", "impact.v_approach")``: every FMU steps over the same communication
 step with the inputs of the last communication point (Jacobi stepping); at each
 communication point the connections are transferred *in the order given*, so a chain
 through a direct-feedthrough FMU (ball -> impact -> ball: the impact FMU's COR is valid
-right after fmi2SetReal) is resolved at that point, with no extra step of delay.
+right after its input is set) is resolved at that point, with no extra step of delay.
 
 Two ways to run it:
 
 * ``run(step, stop)``: plain fixed communication step. An event inside a step (the ball
   touching the plate) is seen by the master only at the end of the step.
 * ``run(step, stop, event=("ball.impacts", "ball.t_impact"))``: step with state restore.
-  Before each step the master saves every FMU's state (fmi2GetFMUstate); when the event
+  Before each step the master saves every FMU's state (fmi2GetFMUstate / fmi3GetFMUState); when the event
   counter output changes during the step, it restores all states, steps exactly to the
   event time the FMU reported, transfers the connections there (so the impact FMU sees the
   true impact speed and the ball gets its COR), and finishes the step. This needs
@@ -72,32 +73,25 @@ class FixedStepMaster:
             src_i, src_v = _split(source)
             dst_i, dst_v = _split(target)
             src, dst = self.fmus[src_i], self.fmus[dst_i]
-            if src.variables[src_v].type != "Real" or dst.variables[dst_v].type != "Real":
+            if src.kind(src_v) != "Real" or dst.kind(dst_v) != "Real":
                 raise ValueError(f"connection {source} -> {target}: only Real connections are supported")
-            self._links.append((src.slave, src.vr(src_v), dst.slave, dst.vr(dst_v)))
+            self._links.append((src.reader(src_v), dst.writer(dst_v)))
 
     # --- helpers --------------------------------------------------------------------------
     def exchange(self):
         """Transfer every connection once, in order."""
-        for src, src_vr, dst, dst_vr in self._links:
-            dst.setReal([dst_vr], src.getReal([src_vr]))
+        for read, write in self._links:
+            write(read())
 
     def _recorder(self, names):
-        groups = {}  # (instance, kind) -> (vrs, names)
+        """[(reader, names)]: one reader per instance (one FMI call per variable type)."""
+        groups = {}  # instance -> (variables, names)
         for name in names:
             inst_name, var = _split(name)
-            inst = self.fmus[inst_name]
-            kind = inst.variables[var].type
-            kind = "Real" if kind == "Real" else "Boolean" if kind == "Boolean" else "Integer"
-            vrs, keys = groups.setdefault((inst_name, kind), ([], []))
-            vrs.append(inst.vr(var))
+            variables, keys = groups.setdefault(inst_name, ([], []))
+            variables.append(var)
             keys.append(name)
-        readers = []
-        for (inst_name, kind), (vrs, keys) in groups.items():
-            slave = self.fmus[inst_name].slave
-            get = {"Real": slave.getReal, "Integer": slave.getInteger, "Boolean": slave.getBoolean}[kind]
-            readers.append((get, vrs, keys))
-        return readers
+        return [(self.fmus[inst_name].reader(*variables), keys) for inst_name, (variables, keys) in groups.items()]
 
     def _step_all(self, t, dt):
         for inst in self.fmus.values():
@@ -125,26 +119,25 @@ class FixedStepMaster:
         def sample(t):
             rows_t.append(t)
             row = []
-            for get, vrs, _keys in readers:
-                row.extend(get(vrs))
+            for read, _keys in readers:
+                row.extend(read())
             rows.append(row)
 
         if event is not None:
             cnt_inst, cnt_var = _split(event[0])
             time_inst, time_var = _split(event[1])
-            counter = (self.fmus[cnt_inst].slave, [self.fmus[cnt_inst].vr(cnt_var)])
-            event_time = (self.fmus[time_inst].slave, [self.fmus[time_inst].vr(time_var)])
+            counter = self.fmus[cnt_inst].reader(cnt_var)
+            event_time = self.fmus[time_inst].reader(time_var)
             saved = list(self.fmus if stateful is None else stateful)
             if cnt_inst not in saved or time_inst not in saved:
                 raise ValueError(f"the event FMU {cnt_inst!r} must be among the stateful FMUs {saved}")
             trial = [self.fmus[name] for name in saved]
             others = [inst for name, inst in self.fmus.items() if name not in saved]
-            slaves = [inst.slave for inst in trial]
         steps = rollbacks = 0
         self.exchange()
         sample(start_time)
         if event is not None:
-            count = counter[0].getInteger(counter[1])[0]
+            count = counter()[0]
         wall = _time.perf_counter()
         for k in range(n):
             t = start_time + k * step_size
@@ -154,28 +147,28 @@ class FixedStepMaster:
                 steps += 1
             else:
                 for _ in range(max_events_per_step):
-                    states = [s.getFMUstate() for s in slaves]
+                    states = [inst.get_state() for inst in trial]
                     for inst in trial:
                         inst.do_step(t, t_next - t)
-                    new_count = counter[0].getInteger(counter[1])[0]
+                    new_count = counter()[0]
                     moved = new_count != count
-                    t_event = event_time[0].getReal(event_time[1])[0] if moved else t_next
+                    t_event = event_time()[0] if moved else t_next
                     if moved and t < t_event < t_next:
-                        for s, state in zip(slaves, states):
-                            s.setFMUstate(state)
+                        for inst, state in zip(trial, states):
+                            inst.set_state(state)
                         self._step_all(t, t_event - t)
-                        count = counter[0].getInteger(counter[1])[0]
+                        count = counter()[0]
                         steps += 1
                         rollbacks += 1
-                        for s, state in zip(slaves, states):
-                            s.freeFMUstate(state)
+                        for inst, state in zip(trial, states):
+                            inst.free_state(state)
                         self.exchange()
                         sample(t_event)
                         t = t_event
                         continue
                     count = new_count
-                    for s, state in zip(slaves, states):
-                        s.freeFMUstate(state)
+                    for inst, state in zip(trial, states):
+                        inst.free_state(state)
                     for inst in others:  # stepped only once the step is accepted
                         inst.do_step(t, t_next - t)
                     steps += 1
@@ -186,7 +179,7 @@ class FixedStepMaster:
             sample(t_next)
         wall = _time.perf_counter() - wall
         data = np.array(rows, dtype=float).reshape(len(rows_t), -1)
-        keys = [key for _get, _vrs, ks in readers for key in ks]
+        keys = [key for _read, ks in readers for key in ks]
         values = {key: data[:, i] for i, key in enumerate(keys)}
         return CosimResult(time=np.array(rows_t), values=values, step_size=step_size, wall_time=wall,
                            steps=steps, rollbacks=rollbacks,

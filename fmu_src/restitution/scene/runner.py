@@ -3,8 +3,9 @@
 Each drop (ball, plate, drop height) is a bouncing-ball simulation: free flight in closed
 form, impact instants located exactly, and the FMU asked for the rebound **only at impact
 events** (``v_approach`` is set at the impact; the first impact's speed is already set in
-initialization mode, so the evaluation at fmi2ExitInitializationMode is the first impact's;
-the fmi2DoStep calls that carry the FMU across each flight reuse the cached result).
+initialization mode, so the evaluation at the exit from initialization mode is the first impact's;
+the steps that carry the FMU across each flight reuse the cached result). FMI 2.0 and FMI 3.0
+FMUs alike (through :class:`~restitution.cosim.FmuInstance`).
 
 Only the outputs the scene requested are read, plus ``v_rebound`` (the master needs it to
 fly on) and the two Boolean outputs ``effects.plasticity`` / ``effects.plate_waves`` (to
@@ -90,21 +91,16 @@ def _run_drop(instance, scene: Scene, drop: Drop, params: dict, read_names, read
               interrupt: DeferredInterrupt | None = None) -> DropResult:
     sim = scene.simulation
     g, v_min = sim.gravity, sim.v_min
-    slave = instance.slave
     # Reset, then set the parameters and the first impact's speed in initialization mode: the
-    # evaluation at fmi2ExitInitializationMode is then the first impact's, not a wasted one.
+    # evaluation at the exit from initialization mode is then the first impact's, not a wasted one.
     v_first = math.sqrt(2.0 * g * drop.drop_height)
-    slave.reset()
     seen = len(instance.messages)
-    slave.setupExperiment(startTime=0.0)
-    slave.enterInitializationMode()
     try:
-        instance.set(**params, v_approach=v_first)
-        slave.exitInitializationMode()
+        instance.reset(parameters={**params, "v_approach": v_first})
         failure = None
-    except Exception as exc:  # noqa: BLE001 - fmpy raises on fmi2Error; the FMU's log says which value
+    except Exception as exc:  # noqa: BLE001 - a refused value (Error); the FMU's log says which
         failure = exc
-    rejected = [text for status, text in instance.messages[seen:] if status >= _FMI2_ERROR]
+    rejected = [text for status, text in instance.messages[seen:] if status >= _FMI_ERROR]
     if rejected or failure is not None:
         try:  # reset and back in step mode (out of initialization and any error mode): it can be reused or freed
             instance.reset()
@@ -115,23 +111,21 @@ def _run_drop(instance, scene: Scene, drop: Drop, params: dict, read_names, read
     if failure is not None:
         raise failure
 
-    vr_in = [instance.vr("v_approach")]
     real_names = ("v_rebound", *read_names)
-    vr_real = [instance.vr(n) for n in real_names]
-    vr_bool = [instance.vr(name) for name in READ_FLAGS]
-    get_real, get_bool, set_real, do_step = slave.getReal, slave.getBoolean, slave.setReal, slave.doStep
+    set_speed = instance.writer("v_approach")
+    get_real, get_bool = instance.reader(*real_names), instance.reader(*READ_FLAGS)
 
     def rebound(v):  # only the requested outputs, and the effects used
-        set_real(vr_in, [v])
-        out = dict(zip(real_names, get_real(vr_real)))  # floats: checked for NaN by impact_sequence
-        out["flags"] = get_bool(vr_bool)
+        set_speed([v])
+        out = dict(zip(real_names, get_real()))  # floats: checked for NaN by impact_sequence
+        out["flags"] = get_bool()
         if interrupt is not None:
             interrupt.check()  # here, between FMU calls, never inside one
         return out
 
     try:
         events, stop = impact_sequence(rebound, drop.drop_height, g, v_min, sim.max_bounces,
-                                       advance=do_step)  # flights need no evaluation (inputs unchanged)
+                                       advance=instance.do_step)  # flights need no evaluation (inputs unchanged)
     except ValueError as exc:
         raise RuntimeError(f"{drop.label}: {exc}; FMU log: {instance.last_message()}") from exc
     times = [t for t, _, _ in events]
@@ -151,8 +145,8 @@ def _run_drop(instance, scene: Scene, drop: Drop, params: dict, read_names, read
                       gravity=g, validity={name: flags[:, 2 + k] for k, name in enumerate(VALIDITY)})
 
 
-#: fmi2Status of a rejected value (fmi2Error; fmi2Fatal is 4).
-_FMI2_ERROR = 3
+#: Status of a rejected value (Error, 3 in FMI 2.0 and 3.0; Fatal is 4).
+_FMI_ERROR = 3
 
 
 def _rejected(scene: Scene, drop: Drop, message: str) -> SceneError:

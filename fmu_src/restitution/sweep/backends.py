@@ -4,9 +4,10 @@ Both take the case columns of :meth:`SweepSpec.cases` and return the FMU's outpu
 (plus ``ok``: inputs in range and the evaluation succeeded). Invalid inputs give NaN reals
 and false flags in both, as the FMU reads them.
 
-:class:`FmuBackend` runs ``SpherePlateImpact.fmu`` through fmpy's ``FMU2Slave``: one
-instance per worker process (per thread, where a worker runs several), loaded on first use
-and reused across chunks with ``fmi2Reset``, as fmpy's parameter-variation example does.
+:class:`FmuBackend` runs ``SpherePlateImpact.fmu`` (FMI 2.0 or FMI 3.0) through fmpy, by a
+:class:`restitution.cosim.FmuInstance`: one instance per worker process (per thread, where a
+worker runs several), loaded on first use and reused across chunks with a reset, as fmpy's
+parameter-variation example does.
 The FMU file travels with the sweep (as bytes, once per worker), so workers on other
 machines need no shared file system.
 
@@ -31,6 +32,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..cosim.fmu import FmiStatusError, quiet_instantiate
 from ..fmu.models.sphere_plate_impact.variables import TABLE
 from ..model import PARAMETERS
 from .spec import CODES, INPUTS, INTEGER_INPUTS, OUTPUTS, SETTABLE
@@ -165,13 +167,10 @@ class _LoadedFmu:
 
     def __init__(self, unzip_dir: str):
         from ..cosim.fmu import FmuInstance
-
-        global _FMI_CALL_ERRORS
-        _FMI_CALL_ERRORS = _fmi_call_errors()
         self.unzip_dir = unzip_dir
         self.instance = FmuInstance(unzip_dir, instance_name=f"sweep-{os.getpid()}-{threading.get_ident()}",
                                     unzip_dir=unzip_dir, instantiate=self._instantiate)
-        self.slave = self.instance.slave
+        self.slave = self.instance.slave  # None once closed
         variables = self.instance.variables
         self.vr = {name: variables[name].valueReference for name in variables}
         missing = [name for name, _kw, _t, _s in INPUTS if name not in variables]
@@ -187,16 +186,12 @@ class _LoadedFmu:
             self.code_file = _instantiate_with_bundled_code(slave, self.unzip_dir)
             self.code = code_fingerprint(Path(self.code_file).parent)
         else:  # a native FMU (C only): its binary is the code that runs
-            slave.instantiate(loggingOn=False, callbacks=_quiet_callbacks())
+            quiet_instantiate(slave)
             self.code_file = slave.dll._name
             self.code = hashlib.sha256(Path(self.code_file).read_bytes()).hexdigest()[:12]
 
     def reset(self):
-        s = self.slave
-        s.reset()
-        s.setupExperiment(startTime=0.0)
-        s.enterInitializationMode()
-        s.exitInitializationMode()
+        self.instance.reset()
 
     def evaluate(self, cases: dict, outputs=None) -> dict:
         """Set every input of every case (the varying ones case by case), read the outputs
@@ -221,35 +216,32 @@ class _LoadedFmu:
         self.reset()
         reals = [name for name, _kw, t, _s in INPUTS if t == "Real"]
         columns = {name: np.asarray(cases[name], dtype=float) for name, _kw, _t, _s in INPUTS}
-        for name in INTEGER_INPUTS:  # fmi2Integer is 32 bits: a code beyond would wrap, not fail
+        for name in INTEGER_INPUTS:  # an FMI 2.0 Integer is 32 bits: a code beyond would wrap, not fail
             bad = columns[name][~np.isin(columns[name], list(CODES[name].values()))]
             if bad.size:
                 raise ValueError(f"{name} = {float(bad[0])!r} is out of range: codes {sorted(CODES[name].values())}")
         varying = {name for name, col in columns.items() if n and not np.all(col == col[0])}
-        s = self.slave
+        fmu = self.instance
         real_names = [k for k in _REAL_OUT if outputs is None or k in outputs or k == "e"]
         bool_names = [k for k in _BOOL_OUT if outputs is None or k in outputs]
         if n:
             # The constant columns once; the varying ones case by case.
             try:
-                s.setReal([self.vr[k] for k in reals if k not in varying],
-                          [float(columns[k][0]) for k in reals if k not in varying])
-                s.setInteger([self.vr[k] for k in INTEGER_INPUTS if k not in varying],
-                             [int(columns[k][0]) for k in INTEGER_INPUTS if k not in varying])
-            except _FMI_CALL_ERRORS:  # a value every case shares is refused: no case can be evaluated
+                fmu.writer(*(k for k in reals if k not in varying))(
+                    [float(columns[k][0]) for k in reals if k not in varying])
+                fmu.writer(*(k for k in INTEGER_INPUTS if k not in varying))(
+                    [int(columns[k][0]) for k in INTEGER_INPUTS if k not in varying])
+            except FmiStatusError:  # a value every case shares is refused: no case can be evaluated
                 out = _empty_outputs(n)
                 return {k: v for k, v in out.items() if k in real_names or k in bool_names or k == "ok"}
         var_real = [k for k in reals if k in varying]
         var_int = [k for k in INTEGER_INPUTS if k in varying]
-        vr_real = [self.vr[k] for k in var_real]
-        vr_int = [self.vr[k] for k in var_int]
         real_rows = np.stack([columns[k] for k in var_real], axis=1).tolist() if var_real else None
         int_rows = np.stack([columns[k] for k in var_int], axis=1).astype(int).tolist() if var_int else None
-        real_vrs = [self.vr[k] for k in real_names]
-        bool_vrs = [self.vr[k] for k in bool_names]
-        real_out = np.empty((n, len(real_vrs)))
-        bool_out = np.empty((n, len(bool_vrs)), dtype=bool)
-        get_real, get_bool, set_real, set_int = s.getReal, s.getBoolean, s.setReal, s.setInteger
+        real_out = np.empty((n, len(real_names)))
+        bool_out = np.empty((n, len(bool_names)), dtype=bool)
+        get_real, get_bool = fmu.reader(*real_names), fmu.reader(*bool_names)
+        set_real, set_int = fmu.writer(*var_real), fmu.writer(*var_int)
         check = _INTERRUPT_CHECK  # serial runs: Ctrl-C taken between FMU calls, not at the chunk's end
         for i in range(n):
             if check is not None:
@@ -258,19 +250,19 @@ class _LoadedFmu:
                 raise RuntimeError("the sweep was cancelled: FMU instance released")
             try:
                 if real_rows is not None:
-                    set_real(vr_real, real_rows[i])
+                    set_real(real_rows[i])
                 if int_rows is not None:
-                    set_int(vr_int, int_rows[i])
-            except _FMI_CALL_ERRORS:
-                # The FMU refused a value of this case (fmi2Error, logged): the case is out of range,
+                    set_int(int_rows[i])
+            except FmiStatusError:
+                # The FMU refused a value of this case (Error, logged): the case is out of range,
                 # as an FMU that keeps the value and reads NaN reports it. The next case sets every
                 # varying input again.
                 real_out[i] = np.nan
                 bool_out[i] = False
                 continue
-            real_out[i] = get_real(real_vrs)
-            if bool_vrs:
-                bool_out[i] = get_bool(bool_vrs)
+            real_out[i] = get_real()
+            if bool_names:
+                bool_out[i] = get_bool()
         out = {name: real_out[:, j] for j, name in enumerate(real_names)}
         out.update({name: bool_out[:, j] for j, name in enumerate(bool_names)})
         out["ok"] = ~np.isnan(out["e"])
@@ -285,38 +277,9 @@ class _LoadedFmu:
             self.slave = None
 
 
-def _fmi_call_errors() -> tuple:
-    try:
-        from fmpy.fmi1 import FMICallException
-    except ImportError:  # fmpy without it: only our own errors are caught
-        return ()
-    return (FMICallException,)
-
-
-#: What fmpy raises when an FMI call returns fmi2Error (a refused value).
-_FMI_CALL_ERRORS = ()
-
-_CALLBACKS = None
-
-
-def _quiet_callbacks():
-    """FMI callbacks whose logger drops messages: a bad case shows as NaN outputs and ok = False."""
-    global _CALLBACKS
-    if _CALLBACKS is None:
-        from fmpy.fmi2 import (calloc, fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE,
-                               fmi2CallbackFunctions, fmi2CallbackLoggerTYPE, free)
-
-        callbacks = fmi2CallbackFunctions()
-        callbacks.logger = fmi2CallbackLoggerTYPE(lambda *args: None)
-        callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
-        callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
-        _CALLBACKS = callbacks
-    return _CALLBACKS
-
-
 def _instantiate_with_bundled_code(slave, unzip_dir: str) -> str:
-    """fmi2Instantiate with the host's ``restitution`` (and slave) modules set aside, so the FMU
-    imports its bundled copy; the file of the ``impact`` the FMU runs, checked to be inside the FMU."""
+    """Instantiate a pythonfmu FMU (FMI 2.0) with the host's ``restitution`` (and slave) modules set
+    aside, so the FMU imports its bundled copy; the file of the ``impact`` the FMU runs, checked to be inside the FMU."""
     resources = os.path.join(unzip_dir, "resources")
     module_file = os.path.join(resources, "slavemodule.txt")
     slave_module = Path(module_file).read_text().strip() if os.path.isfile(module_file) else None
@@ -325,7 +288,7 @@ def _instantiate_with_bundled_code(slave, unzip_dir: str) -> str:
         saved = {k: sys.modules.pop(k) for k in list(sys.modules) if shadowed(k)}
         path_before = list(sys.path)
         try:
-            slave.instantiate(loggingOn=False, callbacks=_quiet_callbacks())
+            quiet_instantiate(slave)
             fmu_module = sys.modules.get(slave_module) if slave_module else None
             impact_fn = getattr(fmu_module, "impact", None)
             impact_fn = inspect.unwrap(impact_fn) if impact_fn is not None else None  # past the unit layer
