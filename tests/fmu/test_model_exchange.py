@@ -11,6 +11,7 @@ import pytest
 from fmpy import extract, read_model_description, simulate_fmu
 
 from fmi_child import run_child
+from script_host import free_fall_contacts
 
 H0, G = 0.3, 9.80665
 E, V_MIN = 0.8, 0.5
@@ -29,18 +30,8 @@ def me_impact(request, native_impact_fmu, fmi3_impact_fmu):
 
 
 def analytic_contacts(h0=H0, g=G, e=E, v_min=V_MIN):
-    """Times [s] and approach speeds [m/s] of the contacts of a ball dropped from rest at h0 that rebounds
-    with a constant COR e until it would leave slower than v_min (closed form: free fall, then flights
-    of 2 v/g from the plate)."""
-    v = math.sqrt(2.0 * g * h0)
-    t = v / g
-    times, speeds = [t], [v]
-    while e * v >= v_min:
-        v *= e
-        t += 2.0 * v / g
-        times.append(t)
-        speeds.append(v)
-    return np.array(times), np.array(speeds)
+    """Times [s] and approach speeds [m/s] of the contacts, in closed form (script_host.free_fall_contacts)."""
+    return tuple(np.array(x) for x in free_fall_contacts(h0, g, e, v_min))
 
 
 def test_both_interfaces_are_declared_in_one_archive(me_ball, me_impact):
