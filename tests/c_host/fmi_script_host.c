@@ -1,9 +1,10 @@
 /*
- * Scriptable FMI co-simulation host in plain C, for FMI 2.0 and FMI 3.0: drives several instances of
- * one FMU through a script read from stdin, the way C/C++ simulation tools call an FMU. One program,
- * one script language, for both versions: -DFMI_VERSION=3 selects the FMI 3.0 calls (default 2), and
- * only the thin wrappers of the calls that differ between the versions (instantiation, the experiment,
- * get/set by type, fmi3DoStep's out-arguments, FMU states, String calls, the logger) are written twice.
+ * Scriptable FMI host in plain C, for FMI 2.0 and FMI 3.0, co-simulation and model exchange: drives
+ * several instances of one FMU through a script read from stdin, the way C/C++ simulation tools call an
+ * FMU. One program, one script language, for both versions: -DFMI_VERSION=3 selects the FMI 3.0 calls
+ * (default 2), and only the thin wrappers of the calls that differ between the versions (instantiation,
+ * the experiment, get/set by type, fmi3DoStep's out-arguments, FMU states, String calls, the logger,
+ * the discrete-state update and the completed integrator step) are written twice.
  * It builds for Linux (gcc; dlopen(RTLD_LAZY | RTLD_LOCAL) of binaries/linux64/<id>.so, FMI 3.0:
  * binaries/x86_64-linux/<id>.so) and for Windows (x86_64-w64-mingw32-gcc; LoadLibrary of
  * binaries/win64/<id>.dll, FMI 3.0: binaries/x86_64-windows/<id>.dll); the process knows nothing
@@ -43,6 +44,31 @@
  *                             model_exchange, scheduled_execution. A kind of the other version is a
  *                             script error.
  *   get_string S VR | set_string S VR      String calls (these FMUs have no String variable)
+ * Model exchange (each is one FMI call, STATUS as above, but integrate):
+ *   instantiate_me NAME       fmi2Instantiate(fmi2ModelExchange, loggingOn) | fmi3InstantiateModelExchange
+ *   set_time S T              fmi2SetTime | fmi3SetTime
+ *   set_states S N X1..XN     fmi2SetContinuousStates | fmi3SetContinuousStates with an array of exactly N
+ *                             elements (values not given are 0); "set_states S N null" passes NULL
+ *   get_states S N | get_derivatives S N | get_indicators S N | get_nominals S N   [null]
+ *                             fmi2GetContinuousStates | fmi3GetContinuousStates, fmi2GetDerivatives |
+ *                             fmi3GetContinuousStateDerivatives, fmi2/3GetEventIndicators,
+ *                             fmi2/3GetNominalsOfContinuousStates into an array of exactly N elements (or
+ *                             NULL); prints STATES | DERIVATIVES | INDICATORS | NOMINALS <slot> <N values>
+ *   enter_event S | enter_ct S   fmi2/3EnterEventMode | fmi2/3EnterContinuousTimeMode
+ *   update_discrete S [null]  fmi2NewDiscreteStates | fmi3UpdateDiscreteStates (null: NULL eventInfo / every
+ *                             out-argument NULL); prints DISCRETE (below)
+ *   completed_step S [null]   fmi2/3CompletedIntegratorStep(noSetFMUStatePriorToCurrentPoint = true) (null: NULL
+ *                             out-arguments); prints COMPLETED <slot> <enterEventMode> <terminateSimulation>
+ *   integrate S NX NZ T0 T_END DT TOL
+ *                             the host's own solver, from continuous-time mode at T0 to T_END: Heun's method
+ *                             (explicit trapezoidal rule; exact to rounding where the states' second
+ *                             derivative is constant) in steps of DT, the last one shortened to end on T_END,
+ *                             with NX states and NZ event indicators; an event where an indicator's domain
+ *                             z > 0 changes either way (FMI's rule), located by bisecting the step to TOL
+ *                             (TOL <= 0: the step) and handled at the first point found past the crossing:
+ *                             event mode, discrete-state updates until none is needed, continuous-time mode;
+ *                             completed_step after every step. Prints EVENT per event, INTEGRATED at the end,
+ *                             and one STATUS: the worst of all its calls (it stops at the first Error)
  *
  * Output (stdout, flushed after every command and every log message):
  *   INFO <fmi2GetVersion> <fmi2GetTypesPlatform>  |  INFO <fmi3GetVersion> -    first, once loaded
@@ -52,6 +78,10 @@
  *   REAL <slot> <vr> <%.17g>, INTEGER <slot> <vr> <integer> (Integer, Int32 and Enumeration),
  *   BOOLEAN <slot> <vr> <0|1>
  *   STEPPED <slot> <eventHandlingNeeded> <terminateSimulation> <earlyReturn> <%.17g lastSuccessfulTime>
+ *   DISCRETE <slot> <discreteStatesNeedUpdate> <terminateSimulation> <nominalsChanged> <valuesChanged>
+ *            <nextEventTimeDefined> <%.17g nextEventTime>
+ *   EVENT <slot> <%.17g time> <valuesOfContinuousStatesChanged by some update> <terminateSimulation>
+ *   INTEGRATED <slot> <%.17g time reached> <steps> <events>
  *   RECORDED setup <slot> <T0>  (FMI 3.0)
  *   SERIALIZED <slot> <bytes>
  *   INSTANCE <slot> <name>    or INSTANTIATE_FAILED (then exit code 3)
@@ -201,6 +231,27 @@ static const char *token;                         /* the GUID or instantiation t
 /* The calls every version makes through the same signature. */
 static FreeInstanceT free_instance;
 static InstanceOnlyT exit_init, terminate, reset;
+
+/* Model exchange: these calls have the same shape in FMI 2.0 and FMI 3.0 (fmi2Real = fmi3Float64 =
+ * double), so one pointer each; they are looked up only when a model-exchange command needs them
+ * (me_sym), so a co-simulation-only binary still loads. */
+typedef Status (*SetTimeT)(Instance, double);
+typedef Status (*SetVectorT)(Instance, const double[], size_t);
+typedef Status (*GetVectorT)(Instance, double[], size_t);
+enum { VEC_STATES, VEC_DERIVATIVES, VEC_INDICATORS, VEC_NOMINALS, N_VECTORS };
+static const char *const vector_label[N_VECTORS] = {"STATES", "DERIVATIVES", "INDICATORS", "NOMINALS"};
+static InstanceOnlyT enter_event_mode, enter_continuous_time_mode;
+static SetTimeT set_time;
+static SetVectorT set_states;
+static GetVectorT get_vector[N_VECTORS];
+/* what fmi2NewDiscreteStates' fmi2EventInfo / fmi3UpdateDiscreteStates' out-arguments say */
+typedef struct {
+    int need_update, terminate, nominals_changed, values_changed, next_time_defined;
+    double next_time;
+} EventUpdate;
+static void me_functions(void); /* each version's: looks up the model-exchange calls */
+static int me_loaded;
+static void *me_sym(const char *name);
 
 #if FMI_VERSION == 3
 /* ================================ FMI 3.0 ========================================================= */
@@ -368,6 +419,43 @@ static Status string_call(Instance c, int get, VR vr)
 {
     const char *text[1] = {"text"};
     return (get ? get_string3 : set_string3)(c, &vr, 1, text, 1);
+}
+
+typedef Status (*UpdateDiscrete3T)(Instance, bool *, bool *, bool *, bool *, bool *, double *);
+typedef Status (*CompletedStep3T)(Instance, bool, bool *, bool *);
+static UpdateDiscrete3T update_discrete3;
+static CompletedStep3T completed_step3;
+static void me_functions(void)
+{
+    enter_event_mode = (InstanceOnlyT)me_sym("fmi3EnterEventMode");
+    enter_continuous_time_mode = (InstanceOnlyT)me_sym("fmi3EnterContinuousTimeMode");
+    set_time = (SetTimeT)me_sym("fmi3SetTime");
+    set_states = (SetVectorT)me_sym("fmi3SetContinuousStates");
+    get_vector[VEC_STATES] = (GetVectorT)me_sym("fmi3GetContinuousStates");
+    get_vector[VEC_DERIVATIVES] = (GetVectorT)me_sym("fmi3GetContinuousStateDerivatives");
+    get_vector[VEC_INDICATORS] = (GetVectorT)me_sym("fmi3GetEventIndicators");
+    get_vector[VEC_NOMINALS] = (GetVectorT)me_sym("fmi3GetNominalsOfContinuousStates");
+    update_discrete3 = (UpdateDiscrete3T)me_sym("fmi3UpdateDiscreteStates");
+    completed_step3 = (CompletedStep3T)me_sym("fmi3CompletedIntegratorStep");
+}
+/* fmi3UpdateDiscreteStates; null_args: every out-argument NULL */
+static Status update_discrete(Instance c, int null_args, EventUpdate *u)
+{
+    bool need = true, stop = true, nominals = true, values = true, defined = true;
+    double next = -1.0;
+    Status st = null_args ? update_discrete3(c, NULL, NULL, NULL, NULL, NULL, NULL)
+                          : update_discrete3(c, &need, &stop, &nominals, &values, &defined, &next);
+    u->need_update = need, u->terminate = stop, u->nominals_changed = nominals, u->values_changed = values;
+    u->next_time_defined = defined, u->next_time = next;
+    return st;
+}
+/* fmi3CompletedIntegratorStep(noSetFMUStatePriorToCurrentPoint = true); null_args: NULL out-arguments */
+static Status completed_step(Instance c, int null_args, int *enter_event, int *stop)
+{
+    bool enter = true, terminate_now = true;
+    Status st = null_args ? completed_step3(c, true, NULL, NULL) : completed_step3(c, true, &enter, &terminate_now);
+    *enter_event = enter, *stop = terminate_now;
+    return st;
 }
 
 #else
@@ -541,6 +629,48 @@ static Status string_call(Instance c, int get, VR vr)
     const char *text[1] = {"text"};
     return (get ? get_string2 : set_string2)(c, &vr, 1, text);
 }
+
+typedef struct {
+    fmi2Boolean newDiscreteStatesNeeded, terminateSimulation, nominalsOfContinuousStatesChanged,
+        valuesOfContinuousStatesChanged, nextEventTimeDefined;
+    double nextEventTime;
+} fmi2EventInfo;
+typedef Status (*NewDiscreteStatesT)(Instance, fmi2EventInfo *);
+typedef Status (*CompletedStep2T)(Instance, fmi2Boolean, fmi2Boolean *, fmi2Boolean *);
+static NewDiscreteStatesT new_discrete_states2;
+static CompletedStep2T completed_step2;
+static void me_functions(void)
+{
+    enter_event_mode = (InstanceOnlyT)me_sym("fmi2EnterEventMode");
+    enter_continuous_time_mode = (InstanceOnlyT)me_sym("fmi2EnterContinuousTimeMode");
+    set_time = (SetTimeT)me_sym("fmi2SetTime");
+    set_states = (SetVectorT)me_sym("fmi2SetContinuousStates");
+    get_vector[VEC_STATES] = (GetVectorT)me_sym("fmi2GetContinuousStates");
+    get_vector[VEC_DERIVATIVES] = (GetVectorT)me_sym("fmi2GetDerivatives");
+    get_vector[VEC_INDICATORS] = (GetVectorT)me_sym("fmi2GetEventIndicators");
+    get_vector[VEC_NOMINALS] = (GetVectorT)me_sym("fmi2GetNominalsOfContinuousStates");
+    new_discrete_states2 = (NewDiscreteStatesT)me_sym("fmi2NewDiscreteStates");
+    completed_step2 = (CompletedStep2T)me_sym("fmi2CompletedIntegratorStep");
+}
+/* fmi2NewDiscreteStates; null_args: a NULL fmi2EventInfo */
+static Status update_discrete(Instance c, int null_args, EventUpdate *u)
+{
+    fmi2EventInfo info = {1, 1, 1, 1, 1, -1.0};
+    Status st = new_discrete_states2(c, null_args ? NULL : &info);
+    u->need_update = info.newDiscreteStatesNeeded, u->terminate = info.terminateSimulation;
+    u->nominals_changed = info.nominalsOfContinuousStatesChanged;
+    u->values_changed = info.valuesOfContinuousStatesChanged;
+    u->next_time_defined = info.nextEventTimeDefined, u->next_time = info.nextEventTime;
+    return st;
+}
+/* fmi2CompletedIntegratorStep(noSetFMUStatePriorToCurrentPoint = true); null_args: NULL out-arguments */
+static Status completed_step(Instance c, int null_args, int *enter_event, int *stop)
+{
+    fmi2Boolean enter = 1, terminate_now = 1;
+    Status st = null_args ? completed_step2(c, 1, NULL, NULL) : completed_step2(c, 1, &enter, &terminate_now);
+    *enter_event = enter, *stop = terminate_now;
+    return st;
+}
 #endif
 
 /* ================================ the script: one copy for both versions ========================== */
@@ -564,6 +694,142 @@ static int split(char *line, char **tokens, int max)
     return n;
 }
 
+/* --- model exchange ------------------------------------------------------------------------------ */
+static void *me_sym(const char *name)
+{
+    return sym(name); /* exits (code 2) naming a missing symbol */
+}
+static void need_me_functions(void)
+{
+    if (!me_loaded) me_functions();
+    me_loaded = 1;
+}
+
+/* A vector of exactly n doubles (so the sanitizers see any access past what the host passed), or one
+ * double for n = 0. */
+static double *vector_of(size_t n)
+{
+    double *v = calloc(n ? n : 1, sizeof *v);
+    if (!v) {
+        fprintf(stderr, "fmi_script_host: out of memory\n");
+        exit(1);
+    }
+    return v;
+}
+
+static void print_vector(const char *label, int slot, const double *v, size_t n)
+{
+    printf("%s %d", label, slot);
+    for (size_t i = 0; i < n; i++) printf(" %.17g", v[i]);
+    printf("\n");
+}
+
+/* The host's solver for "integrate": Heun's method (explicit trapezoidal rule, 2 derivative evaluations
+ * a step; exact, to rounding, where the second derivative of the states is constant, as in free flight)
+ * with the FMI state-event rule: an event where an indicator's domain z > 0 changes (either way), located
+ * by bisection of the step to `tol`, and handled at the first point found past the crossing. */
+typedef struct {
+    Instance c;
+    size_t nx, nz;
+    double *k2;   /* scratch: the derivatives at the predictor */
+    Status worst; /* the worst status of every call made */
+} Solver;
+
+static int solver_ok(Solver *sv, Status st)
+{
+    if (st > sv->worst) sv->worst = st;
+    return st <= ST_WARNING;
+}
+
+/* Sets the FMU to time t + h and the states of one Heun step from (t, x) whose derivatives are dx;
+ * the new states in x1, the indicators there in z1. */
+static int heun_step(Solver *sv, double t, const double *x, const double *dx, double h, double *x1, double *z1)
+{
+    for (size_t i = 0; i < sv->nx; i++) x1[i] = x[i] + h * dx[i];
+    if (!solver_ok(sv, set_time(sv->c, t + h)) || !solver_ok(sv, set_states(sv->c, x1, sv->nx)) ||
+        !solver_ok(sv, get_vector[VEC_DERIVATIVES](sv->c, sv->k2, sv->nx)))
+        return 0;
+    for (size_t i = 0; i < sv->nx; i++) x1[i] = x[i] + 0.5 * h * (dx[i] + sv->k2[i]);
+    return solver_ok(sv, set_states(sv->c, x1, sv->nx)) && solver_ok(sv, get_vector[VEC_INDICATORS](sv->c, z1, sv->nz));
+}
+
+static int crossed(const double *z0, const double *z1, size_t nz)
+{
+    for (size_t i = 0; i < nz; i++)
+        if ((z0[i] > 0.0) != (z1[i] > 0.0)) return 1;
+    return 0;
+}
+
+/* The event iteration: event mode, discrete-state updates until none is needed (at most 100), back to
+ * continuous-time mode. *changed: some update changed the continuous states; *stop: terminate asked. */
+static int handle_event(Solver *sv, int *changed, int *stop)
+{
+    EventUpdate u = {1, 0, 0, 0, 0, 0.0};
+    *changed = *stop = 0;
+    if (!solver_ok(sv, enter_event_mode(sv->c))) return 0;
+    for (int i = 0; i < 100 && u.need_update && !u.terminate; i++) {
+        if (!solver_ok(sv, update_discrete(sv->c, 0, &u))) return 0;
+        *changed |= u.values_changed;
+    }
+    *stop = u.terminate;
+    if (u.need_update && !u.terminate) {
+        fprintf(stderr, "fmi_script_host: discrete states still need an update after 100 iterations\n");
+        return 0;
+    }
+    return *stop || solver_ok(sv, enter_continuous_time_mode(sv->c));
+}
+
+/* integrate S NX NZ T0 T_END DT TOL: from continuous-time mode at time T0 to T_END in steps of DT (the last
+ * one shortened to land on T_END), events located to TOL (TOL <= 0: to the step). Prints EVENT per event
+ * and INTEGRATED at the end; returns the worst status of its calls. */
+static Status integrate(int slot, Instance c, size_t nx, size_t nz, double t0, double t_end, double dt, double tol)
+{
+    Solver sv = {c, nx, nz, vector_of(nx), ST_OK};
+    double *x = vector_of(nx), *dx = vector_of(nx), *x1 = vector_of(nx), *z0 = vector_of(nz), *z1 = vector_of(nz);
+    double t = t0;
+    long steps = 0, events = 0;
+    int alive = solver_ok(&sv, get_vector[VEC_STATES](c, x, nx)) && solver_ok(&sv, get_vector[VEC_INDICATORS](c, z0, nz)) &&
+                solver_ok(&sv, get_vector[VEC_DERIVATIVES](c, dx, nx));
+    while (alive && t < t_end) {
+        double h = t_end - t <= dt * (1.0 + 1e-9) ? t_end - t : dt;
+        int event = 0, enter = 0, stop = 0, changed = 0;
+        if (!heun_step(&sv, t, x, dx, h, x1, z1)) break;
+        if (crossed(z0, z1, nz)) {
+            double lo = 0.0, hi = h;
+            event = 1;
+            while (tol > 0.0 && hi - lo > tol) {
+                double mid = lo + 0.5 * (hi - lo);
+                if (mid <= lo || mid >= hi) break;
+                if (!heun_step(&sv, t, x, dx, mid, x1, z1)) goto failed;
+                if (crossed(z0, z1, nz)) hi = mid;
+                else lo = mid;
+            }
+            if (hi < h && !heun_step(&sv, t, x, dx, hi, x1, z1)) break; /* the FMU at the point past it */
+            h = hi;
+        }
+        if (!solver_ok(&sv, completed_step(c, 0, &enter, &stop))) break;
+        t += h;
+        steps++;
+        memcpy(x, x1, nx * sizeof *x);
+        memcpy(z0, z1, nz * sizeof *z0);
+        if (event || enter) {
+            if (!handle_event(&sv, &changed, &stop)) break;
+            events++;
+            printf("EVENT %d %.17g %d %d\n", slot, t, changed, stop);
+            if (stop) break;
+            if (!solver_ok(&sv, get_vector[VEC_STATES](c, x, nx)) || !solver_ok(&sv, get_vector[VEC_INDICATORS](c, z0, nz)))
+                break;
+        } else if (stop) {
+            break;
+        }
+        alive = solver_ok(&sv, get_vector[VEC_DERIVATIVES](c, dx, nx));
+    }
+failed:
+    printf("INTEGRATED %d %.17g %ld %ld\n", slot, t, steps, events);
+    free(sv.k2), free(x), free(dx), free(x1), free(z0), free(z1);
+    return sv.worst;
+}
+
 /* "integer", "enumeration" or "boolean" after "set_"/"get_", or -1 */
 static int whole_kind(const char *cmd)
 {
@@ -571,6 +837,15 @@ static int whole_kind(const char *cmd)
     if (strncmp(cmd, "set_", 4) && strncmp(cmd, "get_", 4)) return -1;
     return !strcmp(kind, "integer") ? AS_INTEGER : !strcmp(kind, "enumeration") ? AS_ENUMERATION
            : !strcmp(kind, "boolean") ? AS_BOOLEAN : -1;
+}
+
+/* the vector a "get_<name>" model-exchange command reads, or -1 */
+static int vector_kind(const char *cmd)
+{
+    static const char *const names[N_VECTORS] = {"get_states", "get_derivatives", "get_indicators", "get_nominals"};
+    for (int i = 0; i < N_VECTORS; i++)
+        if (!strcmp(cmd, names[i])) return i;
+    return -1;
 }
 
 int main(int argc, char **argv)
@@ -609,10 +884,10 @@ int main(int argc, char **argv)
         int n = split(line, tok, MAX_TOKENS), known = 1;
         if (n == 0 || tok[0][0] == '#') continue;
         const char *cmd = tok[0];
-        if (!strcmp(cmd, "instantiate")) {
+        if (!strcmp(cmd, "instantiate") || !strcmp(cmd, "instantiate_me")) {
             if (n < 2 || nslots == MAX_SLOTS) return 1;
             snprintf(slot_name[nslots], MAX_NAME, "%s", tok[1]);
-            inst[nslots] = instantiate_kind("", nslots, &known);
+            inst[nslots] = instantiate_kind(cmd[11] == '_' ? "model_exchange" : "", nslots, &known);
             if (!inst[nslots]) {
                 printf("INSTANTIATE_FAILED\n");
                 return 3;
@@ -707,6 +982,54 @@ int main(int argc, char **argv)
             report(cmd, s, set_state(c, (State)not_a_state));
         } else if ((!strcmp(cmd, "get_string") || !strcmp(cmd, "set_string")) && a) {
             report(cmd, s, string_call(c, cmd[0] == 'g', (VR)strtoul(a, NULL, 10)));
+        } else if (!strcmp(cmd, "set_time") && a) {
+            need_me_functions();
+            report(cmd, s, set_time(c, strtod(a, NULL)));
+        } else if (!strcmp(cmd, "enter_event") || !strcmp(cmd, "enter_ct")) {
+            need_me_functions();
+            report(cmd, s, (cmd[6] == 'e' ? enter_event_mode : enter_continuous_time_mode)(c));
+        } else if ((!strcmp(cmd, "set_states") || vector_kind(cmd) >= 0) && a) {
+            /* N values or "null" (a NULL array); the array has exactly N elements */
+            size_t nv = strtoul(a, NULL, 10);
+            int null_array = b && !strcmp(b, "null"), kind = vector_kind(cmd);
+            if (nv > MAX_VRS) return 1;
+            double *v = vector_of(nv);
+            need_me_functions();
+            if (kind < 0) {
+                for (size_t i = 0; i < nv && (int)i + 3 < n && !null_array; i++) v[i] = strtod(tok[i + 3], NULL);
+                report(cmd, s, set_states(c, null_array ? NULL : v, nv));
+            } else {
+                Status st = get_vector[kind](c, null_array ? NULL : v, nv);
+                report(cmd, s, st);
+                if (st <= ST_WARNING && !null_array) print_vector(vector_label[kind], s, v, nv);
+            }
+            free(v);
+        } else if (!strcmp(cmd, "update_discrete") || !strcmp(cmd, "completed_step")) {
+            int null_args = a && !strcmp(a, "null");
+            need_me_functions();
+            if (cmd[0] == 'u') {
+                EventUpdate u;
+                Status st = update_discrete(c, null_args, &u);
+                report(cmd, s, st);
+                if (st <= ST_WARNING && !null_args)
+                    printf("DISCRETE %d %d %d %d %d %d %.17g\n", s, u.need_update, u.terminate, u.nominals_changed,
+                           u.values_changed, u.next_time_defined, u.next_time);
+            } else {
+                int enter = 0, stop = 0;
+                Status st = completed_step(c, null_args, &enter, &stop);
+                report(cmd, s, st);
+                if (st <= ST_WARNING && !null_args) printf("COMPLETED %d %d %d\n", s, enter, stop);
+            }
+        } else if (!strcmp(cmd, "integrate") && n == 8) {
+            size_t nx = strtoul(tok[2], NULL, 10), nz = strtoul(tok[3], NULL, 10);
+            double t0 = strtod(tok[4], NULL), t_end = strtod(tok[5], NULL), dt = strtod(tok[6], NULL);
+            if (nx > MAX_VRS || nz > MAX_VRS || !(dt > 0.0) || !(t_end - t0 < 1e9 * dt)) {
+                fprintf(stderr, "fmi_script_host: integrate needs sizes <= %d and 0 < DT, (T_END - T0) / DT < 1e9\n",
+                        MAX_VRS);
+                return 1;
+            }
+            need_me_functions();
+            report(cmd, s, integrate(s, c, nx, nz, t0, t_end, dt, strtod(tok[7], NULL)));
         } else if (!strcmp(cmd, "deserialize")) {
             int from = a ? atoi(a) : s;
             if (from < 0 || from >= nslots || !blob[from]) return 1;

@@ -8,7 +8,9 @@ hostile calls generated from
 the interface table: every variable set to NaN, infinities, values just outside its range and the
 wrong type; unknown value references; String calls; calls in the wrong mode; bad step sizes and
 times; garbage, truncated, flipped and foreign serialized states; a pointer that is no state;
-instantiation with each bad argument (each version's own); instances freed with states still allocated. Any memory
+instantiation with each bad argument (each version's own); instances freed with states still allocated;
+and for model exchange (both models, both versions) the hostile calls of _hostile_me_script followed by a
+legitimate integration by the host's own solver across BouncingBall's first contacts. Any memory
 error, undefined behaviour or leak (native FMUs: the process ends with every instance freed)
 makes the sanitizer exit non-zero with a report, which the test shows.
 """
@@ -25,7 +27,7 @@ import pytest
 
 from restitution.fmu.interface import variables
 
-from script_host import build_host, interface
+from script_host import BALL_ME, build_host, interface
 
 ROOT = Path(__file__).resolve().parents[2]
 SANITIZE = ["-g", "-O1", "-fno-omit-frame-pointer", "-fsanitize=address,undefined", "-fno-sanitize-recover=all"]
@@ -148,6 +150,60 @@ def _hostile_script(model, state_files, other_model_state, fmi):
     return lines
 
 
+#: the legitimate model-exchange run at the end of the hostile one: BouncingBall across its first 3 contacts
+ME_RUN = {"t_end": 1.0, "dt": 1e-3, "tol": 1e-9}
+
+
+def _hostile_me_script(model, fmi):
+    """Hostile model-exchange calls, from the interface table and the modelDescription's vector sizes:
+    every model-exchange call before initialization and in each wrong mode; vectors one too long, one too
+    short, empty and huge; NULL arrays and out-arguments; NaN and infinite states and time; doStep on the
+    model-exchange instance and every model-exchange call on a co-simulation one; FMU states taken in
+    model exchange, restored there, and refused by a co-simulation instance (and the reverse); terminate,
+    reset; then a legitimate run (BouncingBall: Heun integration across its first contacts, an FMU state
+    taken mid-run and restored to integrate the same stretch again). Slots 2 (ME), 3 (CS) and 4 (ME)."""
+    n, z = fmi.n_states, fmi.n_indicators
+    tunable = [v for v in variables(model) if v.causality == "parameter" and v.variability == "tunable"]
+    every_me_call = [f"set_time {{s}} 0.0", f"set_states {{s}} {n} " + " ".join(["0.25"] * n),
+                     f"get_states {{s}} {n}", f"get_derivatives {{s}} {n}", f"get_indicators {{s}} {z}",
+                     f"get_nominals {{s}} {n}", "enter_event {s}", "enter_ct {s}", "update_discrete {s}",
+                     "completed_step {s}"]
+    sizes = sorted({n + 1, n + 2, 256} | ({n - 1, 0} if n > 0 else set()))
+    lines = ["instantiate_me me_hostile", "instantiate cs_target"]
+    lines += [c.format(s=2) for c in every_me_call] + ["step 2 0.0 0.1", "get_state 2"]  # before initialization
+    lines += ["setup 2 0.0", "enter_init 2"] + [c.format(s=2) for c in every_me_call] + ["exit_init 2"]
+    lines += ["step 2 0.0 0.1", "completed_step 2", "enter_event 2", "update_discrete 2 null", "update_discrete 2"]
+    for k in sizes:
+        lines += [f"get_states 2 {k}", f"get_derivatives 2 {k}", f"get_nominals 2 {k}",
+                  f"set_states 2 {k} " + " ".join(["0.5"] * min(k, 8))]
+    lines += [f"get_indicators 2 {k}" for k in sorted({z + 1, 256} | ({z - 1, 0} if z > 0 else set()))]
+    lines += [f"get_states 2 {n} null", f"get_derivatives 2 {n} null", f"get_indicators 2 {z} null",
+              f"get_nominals 2 {n} null", f"set_states 2 {n} null"]
+    for bad in ("nan", "inf", "-inf", "1e308"):
+        lines += [f"set_time 2 {bad}"]
+        lines += [f"set_states 2 {n} " + " ".join([bad] + ["0.1"] * (n - 1))] if n else []
+    lines += [f"get_states 2 {n}", "enter_ct 2", "update_discrete 2", "enter_ct 2", "completed_step 2 null",
+              "completed_step 2", "step 2 0.0 0.1", "set_time 2 -1e300"]
+    lines += [f"set_real 2 {v.vr} {v.start!r}" for v in tunable[:3] if fmi.kind[v.name] == "real"]  # wrong mode
+    # FMU states: taken in model exchange, restored there, refused by co-simulation (and the reverse)
+    lines += ["set_time 2 0.5", "get_state 2", "serialize 2", f"set_states 2 {n} " + " ".join(["0.125"] * n),
+              "set_time 2 0.75", "set_state 2", f"get_states 2 {n}", "deserialize 2 2", "set_state 2",
+              "setup 3 0.0", "enter_init 3", "exit_init 3"] + [c.format(s=3) for c in every_me_call]
+    lines += ["deserialize 3 2", "set_state 3", "get_state 3", "serialize 3", "deserialize 2 3", "set_state 2",
+              "step 3 0.0 0.1", "terminate 2", f"get_states 2 {n}", f"set_states 2 {n} " + " ".join(["0.5"] * n),
+              "set_time 2 1.0", "reset 2", "enter_event 2", "setup 2 0.0", "enter_init 2", "exit_init 2",
+              "enter_ct 2", "get_state 2", "free_state 2", "get_state 2", "terminate 3"]
+    # the legitimate run (free 2 with its state still allocated)
+    settings = {k: v for k, v in BALL_ME.items()} if model == "BouncingBall" else {}
+    half = ME_RUN["t_end"] / 2
+    lines += fmi.me_start(4, "me_run", settings)
+    lines += [fmi.integrate(4, 0.0, half, ME_RUN["dt"], ME_RUN["tol"]), "get_state 4",
+              fmi.integrate(4, half, ME_RUN["t_end"], ME_RUN["dt"], ME_RUN["tol"]), "set_state 4",
+              fmi.integrate(4, half, ME_RUN["t_end"], ME_RUN["dt"], ME_RUN["tol"]), f"get_states 4 {n}",
+              "terminate 4", "free 4", "free 2", "free 3"]
+    return lines
+
+
 def _state_files(directory, blob_source):
     """Hostile serialized states: garbage, empty, truncated and flipped versions of a real one."""
     directory.mkdir()
@@ -233,13 +289,59 @@ def test_native_fmu_hostile_calls_under_sanitizers(built_fmus, hosts, genuine_st
     unpacked = _sanitized_native(fmu, model, tmp_path / "fmu")
     other = genuine_states["BouncingBall" if model == "SpherePlateImpact" else "SpherePlateImpact"]
     script = _hostile_script(model, _state_files(tmp_path / "states", genuine_states[model]), other, fmi)
+    me_script = _hostile_me_script(model, fmi)
+    script += me_script
     proc = _run(hosts[fmi.version], unpacked, model, script, leaks=True, guid=fmi.token)
     _assert_clean(proc, script, BAD_INSTANTIATIONS[fmi.version], model_exchange=True)
     assert proc.stdout.startswith(f"INFO {fmi.version}.0 "), proc.stdout[:200]
     # the genuine state (serialized by another instance) restores; a damaged one never does
     statuses = [line.split() for line in proc.stdout.splitlines() if line.startswith("STATUS deserialize")]
-    assert [s[3] for s in statuses if s[1] == "deserialize"] == ["OK", "OK"], statuses
+    assert [s[3] for s in statuses if s[1] == "deserialize" and s[2] in ("0", "1")] == ["OK", "OK"], statuses
     assert all(s[3] == "Error" for s in statuses if s[1] == "deserialize_file"), statuses
+    _assert_model_exchange(proc.stdout, me_script, model, fmi)
+
+
+def _assert_model_exchange(stdout, script, model, fmi):
+    """What the hostile model-exchange part (``script``, the run's last lines) must show beyond a clean run,
+    call by call (each of its lines but instantiate, free and FMI 3.0's setup prints one STATUS): doStep on the model-exchange instance,
+    every model-exchange call on the co-simulation one, wrong vector sizes, NULL arrays, non-finite states
+    and time, a state of one interface into the other: Error; the legitimate run: every call OK, and
+    BouncingBall's contacts before the FMU state was taken at the closed-form times. (After that state is
+    restored, the stretch is integrated again: statuses only; see test_model_exchange.py's repro of the
+    stale derivatives after a restore.)"""
+    silent = {"instantiate", "instantiate_me", "free"} | ({"setup"} if fmi.version == 3 else set())
+    commands = [line for line in script if line.split()[0] not in silent]
+    statuses = [line.split() for line in stdout.splitlines() if line.startswith("STATUS ")][-len(commands):]
+    calls = [(line.split(), st[3]) for line, st in zip(commands, statuses)]
+    assert all(words[0] == st_cmd[1] for (words, _), st_cmd in zip(calls, statuses))
+    me = [(words, st) for words, st in calls if words[1] in ("2", "3", "4")]
+    n, z = fmi.n_states, fmi.n_indicators
+    size = {"get_states": n, "get_derivatives": n, "get_nominals": n, "set_states": n, "get_indicators": z}
+    for words, st in me:
+        cmd, slot = words[0], words[1]
+        must_fail = (
+            (cmd == "step" and slot == "2")
+            or (slot == "3" and cmd in ("set_time", "enter_event", "enter_ct", "update_discrete", "completed_step",
+                                         *size))
+            or (cmd in size and (int(words[2]) != size[cmd] or "null" in words[3:4]) and not (
+                "null" in words[3:4] and size[cmd] == 0 and int(words[2]) == 0))
+            or (cmd in ("set_time", "set_states") and any(w in ("nan", "inf", "-inf") for w in words[2:]))
+            or (cmd == "deserialize" and words[1] != words[2]))  # a state of the other interface
+        if must_fail:
+            assert st == "Error", (words, st)
+        if slot == "4":
+            assert st == "OK", (words, st)
+    if model == "BouncingBall":
+        from script_host import events, free_fall_contacts, located_contact_bounds
+
+        half = ME_RUN["t_end"] / 2
+        contacts = [t for t, changed in events(stdout, 4) if changed]
+        times, _ = free_fall_contacts(**BALL_ME)
+        first = [t for t in times if t <= ME_RUN["t_end"]]
+        late, _ = located_contact_bounds(len(first), BALL_ME["g"], BALL_ME["e"], ME_RUN["tol"])
+        assert len(first) == 3 and len(contacts) == 3 + sum(t > half for t in first), contacts
+        for got, want, bound in zip(contacts[:3], first, late):
+            assert -1e-12 <= got - want <= bound + 1e-12, (got, want, bound)
 
 
 @pytest.mark.slow

@@ -10,7 +10,11 @@ conditioning, never bit identity).
   tests (tests/c_host/fmi_script_host.c, built for the FMU's version) cross-compiled with mingw-w64,
   and the same host built with gcc on the FMU's Linux binary: the same script of FMI calls on both,
   every output compared; one refused value (NaN) is an error status with a log message, not a crash;
-  no Python in either process.
+  no Python in either process. Co-simulation and model exchange (the same outputs after set_time, the
+  parameters set in event mode).
+* BouncingBall as model exchange, FMI 2.0 and FMI 3.0: integrated by the host's own solver (Heun steps,
+  contacts as bisected state events) under Wine and on Linux, each against the closed-form free-fall
+  contact times, and the two against each other within the event location's conditioning.
 
 Needs Debian's gcc-mingw-w64-x86-64 and wine64 (+ wine for the ``wine`` command; bash
 build_scripts/system_packages.sh installs them); skips saying which is missing. Marked slow: the first
@@ -35,7 +39,7 @@ from restitution.agreement import disagreements, tolerances
 from restitution.fmu.compile import CFLAGS, prepare_sources
 
 from cases import FMU_FLAGS, FMU_REALS, NAMES, params_for, random_cases
-from script_host import build_host, interface
+from script_host import ball_me_script, ball_run, build_host, check_ball_run, interface
 
 MINGW = "x86_64-w64-mingw32-gcc"
 WINE = shutil.which("wine64") or shutil.which("wine") or (
@@ -137,22 +141,27 @@ def _fmu_cases():
     return cases
 
 
-def _fmu_script(fmu, cases):
+def _fmu_script(fmu, cases, me=False):
     """The FMI calls both hosts make: parameters, then v_approach / doStep / every output, case by
-    case; at the end one refused value (plate.t = NaN), a read, a step, terminate and free."""
+    case; at the end one refused value (plate.t = NaN), a read, a step, terminate and free. As model
+    exchange (``me``): the instance starts in continuous-time mode, each case's parameters are set in
+    event mode (enter_event, set, update_discrete, enter_ct), and set_time takes the place of doStep."""
     vr = fmu.vr
-    script = ["instantiate impact", "setup 0 0.0", "enter_init 0", "exit_init 0"]
+    script = fmu.me_start(0, "impact") if me else ["instantiate impact", "setup 0 0.0", "enter_init 0", "exit_init 0"]
     t = 0.0
     reals, flags = " ".join(str(vr[n]) for n in FMU_REALS), " ".join(str(vr[n]) for n in FMU_FLAGS)
     for _label, _params, settings, _options in cases:
+        script += ["enter_event 0"] if me else []
         for name, value in settings.items():
             script.append(fmu.set(0, name, value))
+        script += ["update_discrete 0", "enter_ct 0"] if me else []
         for v in FMU_SPEEDS:
-            script += [f"set_real 0 {vr['v_approach']} {v!r}", f"step 0 {t!r} {STEP!r}",
+            script += [f"set_real 0 {vr['v_approach']} {v!r}", f"set_time 0 {t + STEP!r}" if me else f"step 0 {t!r} {STEP!r}",
                        f"get_real 0 {reals}", f"get_boolean 0 {flags}"]
             t += STEP
+    script += ["enter_event 0"] if me else []
     script += [f"set_real 0 {vr['plate.t']} nan", f"get_real 0 {reals}", f"get_boolean 0 {flags}",
-               f"step 0 {t!r} {STEP!r}", "terminate 0", "free 0"]
+               f"set_time 0 {t + STEP!r}" if me else f"step 0 {t!r} {STEP!r}", "terminate 0", "free 0"]
     return script
 
 
@@ -190,11 +199,14 @@ def _groups(values, n_groups):
     return records
 
 
+@pytest.mark.parametrize("interface_type", ["cs", "me"])
 @pytest.mark.parametrize("folder", ["native", "fmi3"])
-def test_win64_fmu_dll_under_wine_equals_the_linux_fmu(built_fmus, folder, script_hosts, wine_env, tmp_path):
+def test_win64_fmu_dll_under_wine_equals_the_linux_fmu(built_fmus, folder, interface_type, script_hosts, wine_env,
+                                                       tmp_path):
     """The Windows DLL of the native FMU (FMI 2.0: binaries/win64/, FMI 3.0: binaries/x86_64-windows/) in a
     mingw-built C host under Wine and its Linux binary in the same host built with gcc, driven by the same
-    script: every call OK but the refused NaN (an error status, logged, nothing crashes, the previous value
+    script, as co-simulation (``cs``) and as model exchange (``me``: parameters set in event mode, the
+    outputs read in continuous-time mode after set_time): every call OK but the refused NaN (an error status, logged, nothing crashes, the previous value
     kept); all 17 outputs of 504 evaluations agree within restitution.agreement's tolerances; Green
     (2022)'s checkpoint (V_c = 0.0265 m/s, V* = 86.9 at 2.3 m/s) on Windows.
 
@@ -219,7 +231,7 @@ def test_win64_fmu_dll_under_wine_equals_the_linux_fmu(built_fmus, folder, scrip
     assert (unpacked / "binaries" / linux_dir / f"{MODEL}.so").is_file()
     guid = fmu.token
     cases = _fmu_cases()
-    script = _fmu_script(fmu, cases)
+    script = _fmu_script(fmu, cases, me=interface_type == "me")
 
     # each host loads binaries/<platform>/SpherePlateImpact.<so|dll> of the unpacked FMU and passes it the
     # percent-encoded file: URI of its resources (under Wine: file:///Z:/...)
@@ -255,5 +267,56 @@ def test_win64_fmu_dll_under_wine_equals_the_linux_fmu(built_fmus, folder, scrip
             checkpoint_seen = True
     assert checkpoint_seen
     total = len(cases) * len(FMU_SPEEDS) * len(FMU_REALS)
-    print(f"{folder}: {windows_dir} vs {linux_dir}: {differing} of {total} real outputs differ in some bit, all within "
+    print(f"{folder} {interface_type}: {windows_dir} vs {linux_dir}: {differing} of {total} real outputs differ in some bit, all within "
           "tolerance")
+
+
+@pytest.mark.parametrize("dt, tol", [(1e-3, 1e-10), (1e-4, 0.0)], ids=["bisected", "step"])
+@pytest.mark.parametrize("folder", ["native", "fmi3"])
+def test_win64_ball_model_exchange_under_wine_equals_the_linux_fmu(built_fmus, folder, dt, tol, script_hosts,
+                                                                   wine_env, tmp_path):
+    """BouncingBall's Windows DLL as model exchange, integrated by the host's own solver (fmi_script_host.c:
+    integrate, Heun steps of ``dt``, each contact a state event bisected to ``tol``, or located to the step
+    without bisection) in the mingw-built host under Wine, and its Linux binary in the gcc-built host.
+    Each run on its own: every call OK, the 8 contacts at the closed-form free-fall times
+    (script_host.check_ball_run: no earlier than the exact crossing, no later than the resolution carried
+    through the flights), the ball at rest with the indicator held. Then the two against each other.
+
+    The tolerance between them, and why: both hosts do the same IEEE double arithmetic on the same script
+    (Heun's combinations, the bisection's midpoints), and the ball's model-exchange path in the FMU
+    (der(h) = v, der(v) = -g, the indicator h, the rebound v -> e v and the rest test) calls no function of
+    the C runtime's maths library, so the runs will usually agree to the bit; but the DLL and the .so are
+    different binaries with different C runtimes, and nothing here relies on bit identity. Where a
+    last-bit difference matters is the event location: h at a bisection midpoint within rounding of 0 may
+    take the other branch, which moves that contact by up to the resolution and every later one by what
+    that adds to the flights. That is exactly the conditioning located_contact_bounds gives, so the
+    contact times may differ by the bound of each contact (and the last approach speed by its excess
+    bound), no more; the states at rest are 0 and the indicator 1 m exactly on both."""
+    fmu_path = built_fmus / folder / "BouncingBall.fmu"
+    if not fmu_path.is_file():
+        pytest.skip(f"{folder}/BouncingBall.fmu not built here (needs gcc)")
+    fmu = interface(fmu_path)
+    linux_host, win_host = script_hosts[fmu.version]
+    linux_dir, windows_dir = fmu.binary_dirs
+    unpacked = tmp_path / "fmu"
+    with zipfile.ZipFile(fmu_path) as z:
+        z.extractall(unpacked)
+    if not (unpacked / "binaries" / windows_dir / "BouncingBall.dll").is_file():
+        pytest.skip(f"the {folder} FMU has no {windows_dir} binary ({MINGW} missing when it was built)")
+    script = ball_me_script(fmu, dt, tol)
+    linux = _run_script_host([str(linux_host), str(unpacked), "BouncingBall", fmu.token], script)
+    win = _run_script_host([WINE, str(win_host), _windows_path(unpacked), "BouncingBall", fmu.token], script,
+                           env=wine_env)
+    runs = {}
+    for name, run in (("linux", linux), ("win64 under Wine", win)):
+        assert run.returncode == 0, f"{name}: exit {run.returncode}\n{run.stdout[-2000:]}\n{run.stderr[-2000:]}"
+        assert run.libpython is False, name
+        runs[name] = ball_run(run.stdout)
+        delays, excess = check_ball_run(runs[name], dt, tol)
+    lin, w = runs["linux"], runs["win64 under Wine"]
+    for k, (a, b, late) in enumerate(zip(w.contacts, lin.contacts, delays)):
+        assert abs(a - b) <= late, (k, a, b, late)
+    assert abs(w.v_impact - lin.v_impact) <= excess[-1]
+    assert w.vectors == lin.vectors and w.impacts == lin.impacts and w.at_rest == lin.at_rest
+    differing = sum(a != b for a, b in zip(w.contacts, lin.contacts))
+    print(f"{folder} ME dt={dt} tol={tol}: {differing} of {len(lin.contacts)} contact times differ in some bit")
