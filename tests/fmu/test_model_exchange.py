@@ -159,9 +159,6 @@ def test_hostile_model_exchange_calls_are_refused_and_keep_the_states(native_bal
         assert needed in text, needed
 
 
-@pytest.mark.xfail(strict=True, reason="FMU bug (reported, fmu_src not edited here): after fmi2SetFMUstate / "
-                   "fmi3SetFMUState in model exchange the states are restored but der(h), der(v) and "
-                   "contact_indicator keep the values of before the restore until the host sets the states")
 def test_derivatives_and_indicator_follow_a_restored_fmu_state(me_ball):
     """Repro: the derivatives and the event indicator after an FMU state is restored must be those of the
     restored states (a solver that restores a state and asks for the derivatives integrates from there)."""

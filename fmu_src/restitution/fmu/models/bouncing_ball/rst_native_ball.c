@@ -50,7 +50,7 @@ static double flight_duration(double h_start, double v_start, double g)
 
 /* _update_derivatives: der(h), der(v) and the contact indicator from the state (flight under
  * gravity; nothing moves at the plate; at rest the indicator stays at 1 m: no more contacts). */
-static void update_derivatives(double *values)
+void rst_ball_update_derivatives(double *values)
 {
     int still = AT(AT_REST) != 0.0 || AT(IN_CONTACT) != 0.0;
     AT(DER_H) = still ? 0.0 : AT(V);
@@ -79,7 +79,7 @@ static void update_outputs(double *values, double t)
         AT(V) = AT(FLIGHT_V_START) - g * dt;
         AT(V_APPROACH) = -AT(V) >= 0.0 ? -AT(V) : 0.0;
     }
-    update_derivatives(values);
+    rst_ball_update_derivatives(values);
 }
 
 /* _impact: the last of `count` contacts, at time t [s] with approach speed v [m/s]. */
@@ -202,7 +202,7 @@ void rst_ball_states_changed(double *values)
         AT(H) = AT(V) = 0.0;
     }
     AT(V_APPROACH) = -AT(V) >= 0.0 ? -AT(V) : 0.0;
-    update_derivatives(values);
+    rst_ball_update_derivatives(values);
 }
 
 int rst_ball_contact_event(double *values, double t)

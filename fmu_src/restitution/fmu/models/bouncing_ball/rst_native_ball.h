@@ -14,6 +14,7 @@
 #define rst_ball_initialize RST_PREFIXED(rst_ball_initialize)
 #define rst_ball_do_step RST_PREFIXED(rst_ball_do_step)
 #define rst_ball_states_changed RST_PREFIXED(rst_ball_states_changed)
+#define rst_ball_update_derivatives RST_PREFIXED(rst_ball_update_derivatives)
 #define rst_ball_contact_event RST_PREFIXED(rst_ball_contact_event)
 #endif
 
@@ -27,6 +28,10 @@ void rst_ball_initialize(double *values, double start_time);
 
 /* fmi2DoStep from `current_time` [s] over `step_size` [s]: locates every contact inside the step. */
 void rst_ball_do_step(double *values, double current_time, double step_size);
+
+/* der(h), der(v) and the contact indicator from the state in the store (they are not part of the FMU
+ * state: recomputed after a state is restored). */
+void rst_ball_update_derivatives(double *values);
 
 /* Model exchange: the host set h and v (or an input or parameter): the approach speed, der(h), der(v)
  * and the contact indicator follow from them. */

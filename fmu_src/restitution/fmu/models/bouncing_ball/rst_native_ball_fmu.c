@@ -44,6 +44,17 @@ static rst_status set(rst_instance *inst, rst_type type, const rst_vr vr[], size
     return RST_OK;
 }
 
+/* fmi2SetFMUstate: the store holds the restored state; what is recomputed from it follows (model
+ * exchange: also the approach speed from the restored v). */
+static rst_status restore_state(rst_instance *inst)
+{
+    if (rst_is_model_exchange(inst))
+        rst_ball_states_changed(rst_store(inst));
+    else
+        rst_ball_update_derivatives(rst_store(inst));
+    return RST_OK;
+}
+
 /* Model exchange: the contact located by the host's solver (contact_indicator crossed zero). */
 static rst_status update_discrete_states(rst_instance *inst, rst_event_update *result)
 {
@@ -55,4 +66,5 @@ const rst_model RST_MODEL = {
     .identifier = RST_MODEL_IDENTIFIER, .guid = RST_MODEL_GUID,
     .variables = RST_MODEL_VARIABLES, .n_variables = RST_MODEL_N_VARIABLES, .backend_size = 0,
     .instantiate = instantiate, .exit_initialization = exit_initialization, .do_step = do_step, .reset = reset,
-    .set = set, .update_discrete_states = update_discrete_states, .model_exchange = 1, RST_MODEL_EXCHANGE_VECTORS};
+    .set = set, .restore_state = restore_state, .update_discrete_states = update_discrete_states, .model_exchange = 1,
+    RST_MODEL_EXCHANGE_VECTORS};
