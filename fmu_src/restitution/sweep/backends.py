@@ -72,6 +72,12 @@ def _own_fingerprint() -> str:
     return _FINGERPRINT
 
 
+def _column(values, n: int, vtype: str) -> np.ndarray:
+    """An output of one vectorized call as a table column of ``n`` cases (no copy where it already is one)."""
+    column = np.asarray(values, dtype=bool if vtype == "Boolean" else float)
+    return column if column.shape == (n,) else np.array(np.broadcast_to(column, (n,)))
+
+
 def _empty_outputs(n: int) -> dict:
     out = {name: np.full(n, np.nan) for name in _REAL_OUT}
     out.update({name: np.zeros(n, dtype=bool) for name in _BOOL_OUT})
@@ -124,13 +130,18 @@ class PackageBackend(Backend):
         from ..model import impact, published
 
         n = np.size(cases["v_approach"])
-        out = _empty_outputs(n)
+        out = None
         for sel, inputs, options in impact_groups(cases, np.flatnonzero(inputs_ok(cases))):
             values = published(impact(**inputs, **options, validate=False).as_dict())
+            if out is None and np.size(sel) == n:  # the usual chunk, every case in one call: its arrays are the columns
+                out = {name: _column(values[field_name], n, vtype) for name, field_name, vtype in OUTPUTS}
+                out["ok"] = np.ones(n, dtype=bool)
+                continue
+            out = _empty_outputs(n) if out is None else out
             for name, field_name, _t in OUTPUTS:
                 out[name][sel] = values[field_name]
             out["ok"][sel] = True
-        return out, {"code": _own_fingerprint(), "pid": os.getpid()}
+        return (_empty_outputs(n) if out is None else out), {"code": _own_fingerprint(), "pid": os.getpid()}
 
 
 def impact_groups(cases: dict, rows):
