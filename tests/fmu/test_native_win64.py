@@ -69,6 +69,22 @@ def wine_env(tmp_path_factory):
         subprocess.run([server, "-k"], env=env, capture_output=True, timeout=60)
 
 
+
+def _unpacked_with_dll(built_fmus, folder, model, tmp_path):
+    """(script_host.Interface, unpacked directory) of the native ``folder``/``model``.fmu, skipping where
+    it or its Windows binary was not built here."""
+    fmu_path = built_fmus / folder / f"{model}.fmu"
+    if not fmu_path.is_file():
+        pytest.skip(f"{folder}/{model}.fmu not built here (needs gcc)")
+    fmu = interface(fmu_path)
+    windows_dir = fmu.binary_dirs[1]
+    unpacked = tmp_path / "fmu"
+    with zipfile.ZipFile(fmu_path) as z:
+        z.extractall(unpacked)
+    if not (unpacked / "binaries" / windows_dir / f"{model}.dll").is_file():
+        pytest.skip(f"the {folder} FMU has no {windows_dir} binary ({MINGW} missing when it was built)")
+    return fmu, unpacked
+
 def test_win64_physics_under_wine_equals_the_package(tmp_path, wine_env):
     src = prepare_sources(tmp_path / "src")
     shutil.copyfile(PHYSICS_DRIVER, src / "driver.c")
@@ -216,18 +232,10 @@ def test_win64_fmu_dll_under_wine_equals_the_linux_fmu(built_fmus, folder, inter
     amplified by each output's conditioning. The tolerance is therefore the per-case bound of
     restitution.agreement (32 ulps x (1 + the output's summed log-sensitivity to the inputs)), the same
     one every comparison between two correct evaluations of the model uses."""
-    fmu_path = built_fmus / folder / f"{MODEL}.fmu"
-    if not fmu_path.is_file():
-        pytest.skip(f"{folder}/{MODEL}.fmu not built here (needs gcc)")
-    fmu = interface(fmu_path)
+    fmu, unpacked = _unpacked_with_dll(built_fmus, folder, MODEL, tmp_path)
     linux_host, win_host = script_hosts[fmu.version]
     linux_dir, windows_dir = fmu.binary_dirs
-    unpacked = tmp_path / "fmu"
-    with zipfile.ZipFile(fmu_path) as z:
-        z.extractall(unpacked)
     dll = unpacked / "binaries" / windows_dir / f"{MODEL}.dll"
-    if not dll.is_file():
-        pytest.skip(f"the {folder} FMU has no {windows_dir} binary ({MINGW} missing when it was built)")
     assert (unpacked / "binaries" / linux_dir / f"{MODEL}.so").is_file()
     guid = fmu.token
     cases = _fmu_cases()
@@ -292,17 +300,9 @@ def test_win64_ball_model_exchange_under_wine_equals_the_linux_fmu(built_fmus, f
     that adds to the flights. That is exactly the conditioning located_contact_bounds gives, so the
     contact times may differ by the bound of each contact (and the last approach speed by its excess
     bound), no more; the states at rest are 0 and the indicator 1 m exactly on both."""
-    fmu_path = built_fmus / folder / "BouncingBall.fmu"
-    if not fmu_path.is_file():
-        pytest.skip(f"{folder}/BouncingBall.fmu not built here (needs gcc)")
-    fmu = interface(fmu_path)
+    fmu, unpacked = _unpacked_with_dll(built_fmus, folder, "BouncingBall", tmp_path)
     linux_host, win_host = script_hosts[fmu.version]
     linux_dir, windows_dir = fmu.binary_dirs
-    unpacked = tmp_path / "fmu"
-    with zipfile.ZipFile(fmu_path) as z:
-        z.extractall(unpacked)
-    if not (unpacked / "binaries" / windows_dir / "BouncingBall.dll").is_file():
-        pytest.skip(f"the {folder} FMU has no {windows_dir} binary ({MINGW} missing when it was built)")
     script = ball_me_script(fmu, dt, tol)
     linux = _run_script_host([str(linux_host), str(unpacked), "BouncingBall", fmu.token], script)
     win = _run_script_host([WINE, str(win_host), _windows_path(unpacked), "BouncingBall", fmu.token], script,

@@ -140,22 +140,19 @@ class SpherePlateImpact(Fmi2Slave):
     # A host asks for the same list step after step: the reader of the last list is kept, so a
     # repeated request costs one list comparison instead of a lookup per value reference.
     def get_real(self, vrs):
-        last_vrs, read = self._last_read["Real"]
-        if vrs != last_vrs:
-            read = self._remember_reader("Real", vrs)
-        if read is None:
-            return super().get_real(vrs)
-        outputs = self._evaluate()
-        return read(outputs) if outputs is not None else [math.nan] * len(vrs)
+        return self._get_outputs("Real", vrs, math.nan, super().get_real)
 
     def get_boolean(self, vrs):
-        last_vrs, read = self._last_read["Boolean"]
+        return self._get_outputs("Boolean", vrs, False, super().get_boolean)
+
+    def _get_outputs(self, vtype, vrs, invalid_value, general_get):
+        last_vrs, read = self._last_read[vtype]
         if vrs != last_vrs:
-            read = self._remember_reader("Boolean", vrs)
+            read = self._remember_reader(vtype, vrs)
         if read is None:
-            return super().get_boolean(vrs)
+            return general_get(vrs)
         outputs = self._evaluate()
-        return read(outputs) if outputs is not None else [False] * len(vrs)
+        return read(outputs) if outputs is not None else [invalid_value] * len(vrs)
 
     def _remember_reader(self, vtype, vrs):
         """outputs -> the list of values of ``vrs``, or None when ``vrs`` names anything but outputs
