@@ -306,3 +306,36 @@ def test_fmi3_bouncing_ball_meets_the_plate_at_the_free_fall_time(fmi3_ball):
     assert math.isclose(first["v_impact"][0], g * t1, rel_tol=1e-12)
     apex = result["h"][abs(result["time"] - 2 * t1) < 1e-3]
     assert apex.size and max(apex) == pytest.approx(h0, rel=1e-5)
+
+
+def test_fmi3_source_fmus_link_into_one_library_with_prefixes(fmi3_impact_fmu, fmi3_ball_fmu, tmp_path):
+    """Compiled from their sources/ with FMI3_FUNCTION_PREFIX (the FMI 3.0 headers prefix the fmi3
+    functions, the project's rst_prefix.h every other external name), both FMI 3.0 FMUs link into one
+    shared library: every external symbol carries its FMU's prefix, none clashes."""
+    import shutil
+    import subprocess
+
+    from restitution.fmu.build_native import fmi_include_dir
+
+    if shutil.which("gcc") is None or shutil.which("nm") is None:
+        pytest.skip("gcc and nm are needed")
+    objects = []
+    for model, fmu in (("SpherePlateImpact", fmi3_impact_fmu), ("BouncingBall", fmi3_ball_fmu)):
+        with zipfile.ZipFile(fmu) as z:
+            z.extractall(tmp_path / model)
+        sources = tmp_path / model / "sources"
+        for c_file in sorted(sources.glob("*.c")):
+            obj = tmp_path / f"{model}_{c_file.stem}.o"
+            done = subprocess.run(["gcc", "-std=c99", "-O1", "-Wall", "-Wextra", "-Werror", "-fPIC", "-c",
+                                   f"-DFMI3_FUNCTION_PREFIX={model}_", f"-I{sources}", f"-I{fmi_include_dir('3.0')}",
+                                   "-o", str(obj), str(c_file)], capture_output=True, text=True)
+            assert done.returncode == 0, done.stderr[-3000:]
+            objects.append(obj)
+    defined = subprocess.run(["nm", "-g", "--defined-only", *map(str, objects)], capture_output=True,
+                             text=True).stdout
+    names = {line.split()[-1] for line in defined.splitlines() if len(line.split()) == 3}
+    assert names and not {n for n in names if not n.startswith(("SpherePlateImpact_", "BouncingBall_"))}
+    assert {"SpherePlateImpact_fmi3DoStep", "BouncingBall_fmi3InstantiateModelExchange"} <= names
+    linked = subprocess.run(["gcc", "-shared", "-o", str(tmp_path / "pair.so"), *map(str, objects), "-lm", "-pthread"],
+                            capture_output=True, text=True)
+    assert linked.returncode == 0, linked.stderr[-3000:]
