@@ -47,7 +47,10 @@ def open_client(scheduler=None, n_workers: int | None = None, threads_per_worker
     # with glibc's own allocation thresholds (see _workers_keep_glibc_thresholds)
     with _without_fmu_resources_on_sys_path(), _workers_ignore_sigint(), _workers_keep_glibc_thresholds():
         cluster = LocalCluster(**kwargs)
-    with cluster, Client(cluster) as client:
+    # direct_to_workers: this process takes each finished chunk from its worker. Through the scheduler
+    # (Dask's default for a client) every chunk crossed TCP twice and, the LocalCluster's scheduler
+    # living in this process, was received here twice, into fresh memory each time.
+    with cluster, Client(cluster, direct_to_workers=True) as client:
         yield client
 
 
