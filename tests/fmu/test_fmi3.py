@@ -5,81 +5,44 @@ FMI versions, and bounce a ball at the analytic free-fall times."""
 from __future__ import annotations
 
 import math
-import shutil
 import zipfile
-from pathlib import Path
+from types import SimpleNamespace
 from xml.etree import ElementTree as ET
 
 import pytest
 from fmpy import extract, read_model_description, simulate_fmu
-from fmpy.fmi2 import FMU2Slave
-from fmpy.fmi3 import FMU3Slave
 from fmpy.validation import validate_fmu
-
 from hypothesis import given, settings
 
 from cases import CASES, FMU_FLAGS, FMU_REALS, PAIRS, SPEEDS, T_OVER_D, params_for
 from fmi_child import run_child
+from restitution.agreement import disagreements, tolerances
+from restitution.cosim import FmuInstance
 from restitution.fmu.models import table
 
 IMPACT = table("SpherePlateImpact")
 FMU_NAME = {key: row.name for key, row in IMPACT.by_key().items()}  # package keyword -> FMU name
 
 
-@pytest.fixture(scope="module")
-def fmi3_impact(fmi3_impact_fmu):
-    return fmi3_impact_fmu
+def outputs(fmu: FmuInstance) -> SimpleNamespace:
+    """Every output of a SpherePlateImpact instance under the package's field names."""
+    reals = dict(zip(FMU_REALS.values(), fmu.get_reals(list(FMU_REALS))))
+    flags = dict(zip(FMU_FLAGS.values(), (bool(x) for x in fmu.get(*FMU_FLAGS))))
+    return SimpleNamespace(**reals, **flags)
 
 
-@pytest.fixture(scope="module")
-def fmi3_ball(fmi3_ball_fmu):
-    return fmi3_ball_fmu
+def assert_versions_agree(two: FmuInstance, three: FmuInstance, v, params: dict, context, **options):
+    """The FMI 3.0 and FMI 2.0 native FMUs' outputs agree within the outputs' conditioning
+    (restitution.agreement: last-bit differences of exp, log and pow amplified by each output's
+    sensitivity to its inputs), every flag equal unless an input perturbation flips it."""
+    problems = disagreements(outputs(three), outputs(two), *tolerances(v, params, **options))
+    assert not problems, (context, problems)
 
 
-class Loaded:
-    """An FMU unzipped once, instantiated as an FMI 2.0 or 3.0 slave, initialised at t = 0."""
-
-    def __init__(self, fmu: Path, name="t"):
-        self.md = read_model_description(str(fmu))
-        self.dir = extract(str(fmu))
-        self.vr = {v.name: v.valueReference for v in self.md.modelVariables}
-        self.fmi3 = self.md.fmiVersion.startswith("3")
-        cls = FMU3Slave if self.fmi3 else FMU2Slave
-        token = self.md.instantiationToken if self.fmi3 else self.md.guid
-        self.s = cls(guid=token, unzipDirectory=self.dir, modelIdentifier=self.md.coSimulation.modelIdentifier,
-                     instanceName=name)
-        self.s.instantiate()
-
-    def initialise(self, parameters: dict):
-        if self.fmi3:
-            self.s.enterInitializationMode(startTime=0.0)
-        else:
-            self.s.setupExperiment(startTime=0.0)
-            self.s.enterInitializationMode()
-        self.set_reals(parameters)
-        self.s.exitInitializationMode()
-
-    def set_reals(self, values: dict):
-        setter = self.s.setFloat64 if self.fmi3 else self.s.setReal
-        setter([self.vr[n] for n in values], list(values.values()))
-
-    def reals(self, names):
-        getter = self.s.getFloat64 if self.fmi3 else self.s.getReal
-        return list(getter([self.vr[n] for n in names]))
-
-    def flags(self, names):
-        return [bool(x) for x in self.s.getBoolean([self.vr[n] for n in names])]
-
-    def close(self):
-        self.s.terminate()
-        self.s.freeInstance()
-        shutil.rmtree(self.dir, ignore_errors=True)
-
-
-def test_fmi3_fmus_validate_and_declare_their_sources(fmi3_impact, fmi3_ball):
+def test_fmi3_fmus_validate_and_declare_their_sources(fmi3_impact_fmu, fmi3_ball_fmu):
     """fmpy's validation (FMI 3.0 schema and its checks) finds nothing; sources/buildDescription.xml names
     exactly the .c files in sources/, and the FMI 3.0 layer, not the FMI 2.0 one, is among them."""
-    for fmu in (fmi3_impact, fmi3_ball):
+    for fmu in (fmi3_impact_fmu, fmi3_ball_fmu):
         assert validate_fmu(str(fmu)) == []
         with zipfile.ZipFile(fmu) as z:
             names = z.namelist()
@@ -90,90 +53,57 @@ def test_fmi3_fmus_validate_and_declare_their_sources(fmi3_impact, fmi3_ball):
         assert any(n.startswith("binaries/x86_64-linux/") for n in names)
 
 
-def test_fmi3_impact_equals_the_fmi2_native_fmu_over_the_hard_cases(native_impact_fmu, fmi3_impact):
+def test_fmi3_impact_equals_the_fmi2_native_fmu_over_the_hard_cases(native_impact_fmu, fmi3_impact_fmu):
     """Over the hard-case matrix (8 material pairs x 10 speeds x 7 thickness ratios), every output of the
-    FMI 3.0 FMU equals the FMI 2.0 native FMU's. Both run the same C physics built with the same flags;
-    the version layers only copy doubles, so the tolerance is a few ulps (4e-16 relative), which a
-    layer that converted a value through another type (float, integer) or mixed up two value
-    references would exceed by orders of magnitude."""
-    reals, flags = list(FMU_REALS), list(FMU_FLAGS)
-    two, three = Loaded(native_impact_fmu), Loaded(fmi3_impact)
-    try:
+    FMI 3.0 FMU agrees with the FMI 2.0 native FMU's within its conditioning, every flag equal. Both run
+    the same C physics: a version layer that converted a value through another type (float, integer)
+    or mixed up two value references would exceed the bound by orders of magnitude."""
+    with FmuInstance(native_impact_fmu, "two") as two, FmuInstance(fmi3_impact_fmu, "three") as three:
         for pair in PAIRS:
             for t_over_d in T_OVER_D:
-                params = {FMU_NAME[k]: v for k, v in params_for(pair, t_over_d).items()}
-                for fmu in (two, three):
-                    fmu.s.reset()
-                    fmu.initialise(params)
+                params = params_for(pair, t_over_d)
                 for v in SPEEDS:
-                    outs = []
                     for fmu in (two, three):
-                        fmu.set_reals({"v_approach": v})
-                        outs.append((fmu.reals(reals), fmu.flags(flags)))
-                    (r2, f2), (r3, f3) = outs
-                    context = f"{pair}, t/d = {t_over_d}, v = {v}"
-                    assert f3 == f2, context
-                    for name, a, b in zip(reals, r2, r3):
-                        assert math.isclose(a, b, rel_tol=4e-16, abs_tol=0.0), f"{name}: {a} != {b} ({context})"
-    finally:
-        two.close()
-        three.close()
+                        fmu.set(**{FMU_NAME[k]: value for k, value in params.items()}, v_approach=v)
+                    assert_versions_agree(two, three, v, params, (pair, t_over_d, v))
 
 
 @pytest.fixture(scope="module")
 def both_versions(native_impact_fmu, fmi3_impact_fmu):
     """The native FMI 2.0 and FMI 3.0 SpherePlateImpact, initialised, for a search over the domain."""
-    pair = (Loaded(native_impact_fmu, "two"), Loaded(fmi3_impact_fmu, "three"))
-    for fmu in pair:
-        fmu.initialise({})
-    yield pair
-    for fmu in pair:
-        fmu.close()
+    with FmuInstance(native_impact_fmu, "two") as two, FmuInstance(fmi3_impact_fmu, "three") as three:
+        yield two, three
 
 
 @settings(max_examples=300, deadline=None)
 @given(CASES)
 def test_fmi3_impact_equals_the_fmi2_native_fmu_over_the_declared_domain(both_versions, case):
     """A hypothesis search of the declared domain (every parameter log-uniform over its range, every
-    choice): the FMI 3.0 FMU's outputs equal the FMI 2.0 native FMU's to a few ulps (the same C
-    evaluation; see the hard-case test), flags exactly, and the choices read back as set."""
-    reals = {FMU_NAME[k]: float(v) for k, v in case.items() if IMPACT[FMU_NAME[k]].type == "Real"}
-    codes = {FMU_NAME[k]: IMPACT[FMU_NAME[k]].codes[v] for k, v in case.items() if IMPACT[FMU_NAME[k]].choices}
-    outs = []
+    choice): the FMI 3.0 FMU's outputs agree with the FMI 2.0 native FMU's within their conditioning
+    (as over the hard cases), and the choices read back as set (Int64 in FMI 3.0, Integer in 2.0)."""
+    two, three = both_versions
+    options = {k: v for k, v in case.items() if IMPACT[FMU_NAME[k]].choices}
+    values = {FMU_NAME[k]: (IMPACT[FMU_NAME[k]].codes[v] if k in options else float(v)) for k, v in case.items()}
     for fmu in both_versions:
-        fmu.set_reals(reals)
-        set_codes = fmu.s.setInt64 if fmu.fmi3 else fmu.s.setInteger
-        set_codes([fmu.vr[n] for n in codes], list(codes.values()))
-        get_codes = fmu.s.getInt64 if fmu.fmi3 else fmu.s.getInteger
-        assert list(get_codes([fmu.vr[n] for n in codes])) == list(codes.values())
-        outs.append((fmu.reals(list(FMU_REALS)), fmu.flags(list(FMU_FLAGS))))
-    (r2, f2), (r3, f3) = outs
-    assert f3 == f2
-    for name, a, b in zip(FMU_REALS, r2, r3):
-        assert math.isclose(a, b, rel_tol=4e-16, abs_tol=0.0), f"{name}: {a} != {b} ({case})"
+        fmu.set(**values)
+        assert [int(x) for x in fmu.get(*(FMU_NAME[k] for k in options))] == [values[FMU_NAME[k]] for k in options]
+    params = {k: v for k, v in case.items() if k not in options and k != "v"}
+    assert_versions_agree(two, three, case["v"], params, case, **options)
 
 
-def test_fmi3_materials_are_enumerations_set_with_int64(fmi3_impact):
+def test_fmi3_materials_are_enumerations_set_with_int64(fmi3_impact_fmu):
     """plate.material is an Enumeration (got and set with fmi3Get/SetInt64): naming a preset makes the
-    calculated parameters plate.used.* that preset's properties (the package's values)."""
-    from restitution.fmu.models.sphere_plate_impact.variables import MATERIAL_CHOICES
+    calculated parameters plate.used.* that preset's properties (the package's values, copied)."""
     import restitution as r
 
-    md = read_model_description(str(fmi3_impact))
+    md = read_model_description(str(fmi3_impact_fmu))
     material = next(v for v in md.modelVariables if v.name == "plate.material")
     assert material.type == "Enumeration" and material.declaredType.name == "Material"
-    fmu = Loaded(fmi3_impact)
-    try:
-        code = MATERIAL_CHOICES.index("tungsten_carbide")
-        fmu.s.enterInitializationMode(startTime=0.0)
-        fmu.s.setInt64([fmu.vr["plate.material"]], [code])
-        fmu.s.exitInitializationMode()
-        assert list(fmu.s.getInt64([fmu.vr["plate.material"]])) == [code]
-        used = fmu.reals(["plate.used.E", "plate.used.nu", "plate.used.Sy", "plate.used.rho"])
+    with FmuInstance(fmi3_impact_fmu, "materials", parameters={"plate.material": "tungsten_carbide"}) as fmu:
+        assert fmu.get("plate.material") == [fmu.item_code("plate.material", "tungsten_carbide")]
         preset = r.MATERIALS["tungsten_carbide"]
-        assert used == [preset.E, preset.nu, preset.Sy, preset.rho]
-    finally:
-        fmu.close()
+        assert fmu.get_reals(["plate.used.E", "plate.used.nu", "plate.used.Sy", "plate.used.rho"]) == [
+            preset.E, preset.nu, preset.Sy, preset.rho]
 
 
 HOSTILE = r'''
@@ -246,12 +176,12 @@ report(**results)
 '''
 
 
-def test_fmi3_hostile_calls_are_refused_with_an_error_and_keep_the_values(fmi3_impact, tmp_path):
+def test_fmi3_hostile_calls_are_refused_with_an_error_and_keep_the_values(fmi3_impact_fmu, tmp_path):
     """Each bad call (run in a child process: a crash fails this test only) returns fmi3Error (3), never
     fmi3Fatal, logs why, and leaves the values as they were; instantiations that cannot be honoured return
     NULL with a message. `time` is read-only and follows the communication points."""
-    unzip = extract(str(fmi3_impact), str(tmp_path / "unzip"))
-    child = run_child(HOSTILE, fmi3_impact, unzip)
+    unzip = extract(str(fmi3_impact_fmu), str(tmp_path / "unzip"))
+    child = run_child(HOSTILE, fmi3_impact_fmu, unzip)
     assert child.returncode == 0 and child.report is not None, child.explain()
     got = child.report
     for key in ("step_before_init", "negative_speed", "nan_speed", "int32_on_enumeration", "enumeration_out_of_range",
@@ -271,34 +201,31 @@ def test_fmi3_hostile_calls_are_refused_with_an_error_and_keep_the_values(fmi3_i
         assert needed in text, needed
 
 
-def test_fmi3_states_serialize_and_move_to_the_fmi2_native_fmu(native_impact_fmu, fmi3_impact):
+def test_fmi3_states_serialize_and_move_to_the_fmi2_native_fmu(native_impact_fmu, fmi3_impact_fmu):
     """A state serialized by the FMI 3.0 FMU restores into the FMI 2.0 native FMU (one core, one state
-    format) and brings its inputs and parameters: the same outputs afterwards."""
-    three, two = Loaded(fmi3_impact), Loaded(native_impact_fmu)
-    try:
-        params = {FMU_NAME[k]: v for k, v in params_for("T4-A1", 0.2).items()}
-        three.initialise(params)
-        three.set_reals({"v_approach": 3.7})
-        state = three.s.getFMUState()
-        data = three.s.serializeFMUState(state)
-        three.s.freeFMUState(state)
-        two.initialise({})
-        two.s.setFMUstate(two.s.deSerializeFMUstate(data))
-        names = list(FMU_REALS)
-        assert two.reals(["v_approach"]) == [3.7]
-        assert two.reals(names) == three.reals(names)
-    finally:
-        three.close()
-        two.close()
+    format) and brings its inputs and parameters exactly (they are copied): the same outputs afterwards,
+    within their conditioning."""
+    params = params_for("T4-A1", 0.2)
+    with FmuInstance(fmi3_impact_fmu, "three", parameters={FMU_NAME[k]: v for k, v in params.items()}) as three, \
+            FmuInstance(native_impact_fmu, "two") as two:
+        three.set(v_approach=3.7)
+        state = three.get_state()
+        data = three.serialize_state(state)
+        three.free_state(state)
+        restored = two.deserialize_state(data)
+        two.set_state(restored)
+        two.free_state(restored)
+        assert two.get_reals(["v_approach", *(FMU_NAME[k] for k in params)]) == [3.7, *params.values()]
+        assert_versions_agree(two, three, 3.7, params, "restored state")
 
 
-def test_fmi3_bouncing_ball_meets_the_plate_at_the_free_fall_time(fmi3_ball):
+def test_fmi3_bouncing_ball_meets_the_plate_at_the_free_fall_time(fmi3_ball_fmu):
     """Dropped from h0 = 0.3 m with e = 1, the ball meets the plate at t = sqrt(2 h0 / g) (closed form),
     located inside the step to rounding (the ball's flight is a parabola solved exactly), and
     rebounds to h0 (energy kept with e = 1) half a period later."""
     h0, g = 0.3, 9.80665
     t1 = math.sqrt(2 * h0 / g)
-    result = simulate_fmu(str(fmi3_ball), stop_time=2.5 * t1, output_interval=1e-3,
+    result = simulate_fmu(str(fmi3_ball_fmu), stop_time=2.5 * t1, output_interval=1e-3,
                           output=["h", "impacts", "t_impact", "v_impact"])
     assert result["impacts"][-1] == 1
     first = result[result["impacts"] == 1]

@@ -182,9 +182,14 @@ def test_python_fmu_and_package_masters_agree_bit_for_bit(impact_fmu):
     assert clock == pytest.approx(direct.rest_time, rel=1e-12)
 
 
-def test_fmi3_and_fmi2_native_fmus_bounce_bit_for_bit(native_impact_fmu, fmi3_impact_fmu):
+def test_fmi3_and_fmi2_native_fmus_bounce_alike(native_impact_fmu, fmi3_impact_fmu):
     """The FMI 3.0 FMU runs the FMI 2.0 native FMU's C core and physics behind another version layer that
-    only copies doubles: through FmuInstance, the same drop gives the same bits, and the same clock."""
+    only copies doubles: through FmuInstance, the same drop gives the same impacts and clock. Not bit
+    identity between two binaries: each impact's outputs agree within restitution.agreement's bound
+    (~1e-13 relative on this case), and the drop carries each e into the next approach speed, so over
+    its impacts a difference can grow by a factor of at most (1 + |d ln e / d ln v|) per impact (< 1.3
+    here, where e varies slowly with v); 1e-9 covers that many times and still catches a layer that
+    changes a value (a float32 conversion: ~1e-7; a wrong variable: O(1))."""
     sphere, plate = CASES["T3-s2/al6061-t3.175mm"]
     drops, clocks = [], []
     for path in (native_impact_fmu, fmi3_impact_fmu):
@@ -192,9 +197,9 @@ def test_fmi3_and_fmi2_native_fmus_bounce_bit_for_bit(native_impact_fmu, fmi3_im
             drops.append(_drop(fmu, sphere, plate, drop_height=1.0, gravity=3.7, v_min=0.02))
             clocks.append(fmu.time)
     two, three = drops
-    assert two.n_impacts == three.n_impacts > 5 and clocks[0] == clocks[1]
+    assert two.n_impacts == three.n_impacts > 5 and clocks[0] == pytest.approx(clocks[1], rel=1e-9)
     for field in ("time", "v_approach", "e", "e_ep", "e_ze", "lam", "tau0", "t_contact", "v_rebound", "apex"):
-        assert np.array_equal(getattr(two, field), getattr(three, field)), field
+        np.testing.assert_allclose(getattr(three, field), getattr(two, field), rtol=1e-9, atol=0, err_msg=field)
 
 
 def test_stop_rule_ends_a_zeno_like_sequence():
