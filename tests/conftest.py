@@ -45,49 +45,44 @@ def ball_fmu(built_fmus) -> Path:
     return built_fmus / "BouncingBall.fmu"
 
 
-def _native(built_fmus, model):
-    path = built_fmus / "native" / f"{model}.fmu"
+#: The folder of each native FMU of the build: FMI 2.0 and FMI 3.0.
+NATIVE_FOLDERS = {"native": "native", "fmi3": "FMI 3.0"}
+
+
+def _built_native(built_fmus, folder, model):
+    path = built_fmus / folder / f"{model}.fmu"
     if not path.is_file():
-        pytest.skip(f"native {model}.fmu not built here (needs gcc)")
+        pytest.skip(f"{NATIVE_FOLDERS[folder]} {model}.fmu not built here (needs gcc)")
     return path
 
 
 @pytest.fixture(scope="session")
 def native_impact_fmu(built_fmus) -> Path:
     """The native SpherePlateImpact.fmu (C front and C physics, no Python)."""
-    return _native(built_fmus, "SpherePlateImpact")
+    return _built_native(built_fmus, "native", "SpherePlateImpact")
 
 
 @pytest.fixture(scope="session")
 def native_ball_fmu(built_fmus) -> Path:
     """The native BouncingBall.fmu."""
-    return _native(built_fmus, "BouncingBall")
-
-
-def _fmi3(built_fmus, model):
-    path = built_fmus / "fmi3" / f"{model}.fmu"
-    if not path.is_file():
-        pytest.skip(f"FMI 3.0 {model}.fmu not built here (needs gcc)")
-    return path
+    return _built_native(built_fmus, "native", "BouncingBall")
 
 
 @pytest.fixture(scope="session")
 def fmi3_impact_fmu(built_fmus) -> Path:
     """The native FMI 3.0 SpherePlateImpact.fmu (the same C core and physics as the native FMI 2.0 one)."""
-    return _fmi3(built_fmus, "SpherePlateImpact")
+    return _built_native(built_fmus, "fmi3", "SpherePlateImpact")
 
 
 @pytest.fixture(scope="session")
 def fmi3_ball_fmu(built_fmus) -> Path:
     """The native FMI 3.0 BouncingBall.fmu."""
-    return _fmi3(built_fmus, "BouncingBall")
+    return _built_native(built_fmus, "fmi3", "BouncingBall")
 
 
 def _implementation(built_fmus, model, which) -> Path:
     """``model``.fmu as ``which``: "python" (pythonfmu), "native" (FMI 2.0 C) or "fmi3" (FMI 3.0 C)."""
-    if which == "python":
-        return built_fmus / f"{model}.fmu"
-    return _native(built_fmus, model) if which == "native" else _fmi3(built_fmus, model)
+    return built_fmus / f"{model}.fmu" if which == "python" else _built_native(built_fmus, which, model)
 
 
 #: The two FMI 2.0 implementations of each FMU: tests that hold for both take these fixtures
