@@ -16,17 +16,23 @@
 #include <string.h>
 
 #define VECTOR_MODES (RST_MODE_INITIALIZATION | ME_MODES | RST_MODE_TERMINATED)
-#define CHUNK 64
+
+/* Is this a model-exchange instance? Logs why not. */
+static int only_model_exchange(rst_instance *inst, const char *function)
+{
+    if (inst->model_exchange)
+        return 1;
+    rst_log(inst, RST_ERROR, "%s: this instance is a co-simulation instance (model exchange only)", function);
+    return 0;
+}
 
 /* Is this a model-exchange instance whose vector has `expected` elements where the host gave `n` (and a
  * non-NULL array where n > 0)? Logs why not. */
 static int check_vector(rst_instance *inst, const char *function, const void *array, size_t n, size_t expected,
                         const char *what)
 {
-    if (!inst->model_exchange) {
-        rst_log(inst, RST_ERROR, "%s: this instance is a co-simulation instance (model exchange only)", function);
+    if (!only_model_exchange(inst, function))
         return 0;
-    }
     if (n != expected) {
         rst_log(inst, RST_ERROR, "%s: %u %s asked for; %s has %u", function, (unsigned int)n, what,
                 inst->model->identifier, (unsigned int)expected);
@@ -39,28 +45,13 @@ static int check_vector(rst_instance *inst, const char *function, const void *ar
     return 1;
 }
 
-/* Reads the variables `vrs` through the backend, CHUNK at a time. */
+static void write_double(void *values, size_t i, double x) { ((double *)values)[i] = x; }
+
+/* Reads the variables `vrs` as a get call does. */
 static rst_status read_vector(rst_instance *inst, const char *function, const unsigned int *vrs, size_t n,
                               double out[])
 {
-    size_t i0;
-    rst_status status = RST_OK;
-    for (i0 = 0; i0 < n; i0 += CHUNK) {
-        size_t m = n - i0 < CHUNK ? n - i0 : CHUNK;
-        rst_status s = front_get_vector(inst, function, vrs + i0, m, out + i0);
-        status = s > status ? s : status;
-        if (s >= RST_ERROR)
-            break;
-    }
-    return status;
-}
-
-static int only_model_exchange(rst_instance *inst, const char *function)
-{
-    if (inst->model_exchange)
-        return 1;
-    rst_log(inst, RST_ERROR, "%s: this instance is a co-simulation instance (model exchange only)", function);
-    return 0;
+    return front_read(inst, function, RST_AS_REAL, vrs, n, out, write_double);
 }
 
 rst_status front_enter_event_mode(void *c, const char *function)

@@ -268,11 +268,8 @@ fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind s, fmi2Real *
 
 fmi2Status fmi2GetIntegerStatus(fmi2Component c, const fmi2StatusKind s, fmi2Integer *value)
 {
-    ENTER("fmi2GetIntegerStatus", STATUS_MODES)
-    (void)s;
-    (void)value;
-    rst_log(inst, RST_ERROR, "fmi2GetIntegerStatus: no integer status is defined by FMI 2.0");
-    LEAVE(RST_ERROR);
+    (void)s, (void)value;
+    return (fmi2Status)front_refuse(c, "fmi2GetIntegerStatus", STATUS_MODES, "no integer status is defined by FMI 2.0");
 }
 
 fmi2Status fmi2GetBooleanStatus(fmi2Component c, const fmi2StatusKind s, fmi2Boolean *value)
@@ -288,11 +285,9 @@ fmi2Status fmi2GetBooleanStatus(fmi2Component c, const fmi2StatusKind s, fmi2Boo
 
 fmi2Status fmi2GetStringStatus(fmi2Component c, const fmi2StatusKind s, fmi2String *value)
 {
-    ENTER("fmi2GetStringStatus", STATUS_MODES)
-    (void)s;
-    (void)value;
-    rst_log(inst, RST_ERROR, "fmi2GetStringStatus: fmi2PendingStatus does not exist here (no asynchronous steps)");
-    LEAVE(RST_ERROR);
+    (void)s, (void)value;
+    return (fmi2Status)front_refuse(c, "fmi2GetStringStatus", STATUS_MODES,
+                                    "fmi2PendingStatus does not exist here (no asynchronous steps)");
 }
 
 /* ------------------------------------------------------------------------------------------------ */
@@ -302,28 +297,25 @@ fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReferenc
                                         const fmi2ValueReference vKnown_ref[], size_t nKnown,
                                         const fmi2Real dvKnown[], fmi2Real dvUnknown[])
 {
-    ENTER("fmi2GetDirectionalDerivative", GET_MODES)
     (void)vUnknown_ref, (void)nUnknown, (void)vKnown_ref, (void)nKnown, (void)dvKnown, (void)dvUnknown;
-    rst_log(inst, RST_ERROR, "fmi2GetDirectionalDerivative is not provided (providesDirectionalDerivative = false)");
-    LEAVE(RST_ERROR);
+    return (fmi2Status)front_refuse(c, "fmi2GetDirectionalDerivative", GET_MODES,
+                                    "not provided (providesDirectionalDerivative = false)");
 }
 
 fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
                                        const fmi2Integer order[], const fmi2Real value[])
 {
-    ENTER("fmi2SetRealInputDerivatives", SET_MODES)
     (void)vr, (void)nvr, (void)order, (void)value;
-    rst_log(inst, RST_ERROR, "fmi2SetRealInputDerivatives is not provided (canInterpolateInputs = false)");
-    LEAVE(RST_ERROR);
+    return (fmi2Status)front_refuse(c, "fmi2SetRealInputDerivatives", SET_MODES,
+                                    "not provided (canInterpolateInputs = false)");
 }
 
 fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
                                         const fmi2Integer order[], fmi2Real value[])
 {
-    ENTER("fmi2GetRealOutputDerivatives", STATUS_MODES | RST_MODE_ERROR)
     (void)vr, (void)nvr, (void)order, (void)value;
-    rst_log(inst, RST_ERROR, "fmi2GetRealOutputDerivatives is not provided (maxOutputDerivativeOrder = 0)");
-    LEAVE(RST_ERROR);
+    return (fmi2Status)front_refuse(c, "fmi2GetRealOutputDerivatives", STATUS_MODES | RST_MODE_ERROR,
+                                    "not provided (maxOutputDerivativeOrder = 0)");
 }
 
 /* ------------------------------------------------------------------------------------------------ */

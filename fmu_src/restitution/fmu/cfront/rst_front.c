@@ -363,31 +363,32 @@ static rst_status get_chunk(rst_instance *inst, const char *function, unsigned i
     return status;
 }
 
-rst_status front_get_vector(rst_instance *inst, const char *function, const unsigned int vr[], size_t n, double out[])
-{
-    return get_chunk(inst, function, RST_AS_REAL, vr, n, out);
-}
-
-rst_status front_get(void *c, const char *function, unsigned int kinds, const rst_vr vr[], size_t n,
-                     void *values, size_t n_values, rst_write_fn write)
+rst_status front_read(rst_instance *inst, const char *function, unsigned int kinds, const rst_vr vr[], size_t n,
+                      void *values, rst_write_fn write)
 {
     size_t i0, j;
     double buffer[CHUNK];
     rst_status status = RST_OK;
-    ENTER(function, GET_MODES)
-    if (!check_counts(inst, function, vr, n, values, n_values))
-        LEAVE(RST_ERROR);
     for (i0 = 0; i0 < n; i0 += CHUNK) {
         size_t m = n - i0 < CHUNK ? n - i0 : CHUNK;
         rst_status s = get_chunk(inst, function, kinds, vr + i0, m, buffer);
         if (s > status)
             status = s;
         if (s >= RST_ERROR)
-            LEAVE(status);
+            return status;
         for (j = 0; j < m; j++)
             write(values, i0 + j, buffer[j]);
     }
-    LEAVE(status);
+    return status;
+}
+
+rst_status front_get(void *c, const char *function, unsigned int kinds, const rst_vr vr[], size_t n,
+                     void *values, size_t n_values, rst_write_fn write)
+{
+    ENTER(function, GET_MODES)
+    if (!check_counts(inst, function, vr, n, values, n_values))
+        LEAVE(RST_ERROR);
+    LEAVE(front_read(inst, function, kinds, vr, n, values, write));
 }
 
 rst_status front_refuse_type(void *c, const char *function, const char *type_name, const rst_vr vr[], size_t n,

@@ -55,7 +55,7 @@
 #define front_get_event_indicators RST_PREFIXED(front_get_event_indicators)
 #define front_get_nominals RST_PREFIXED(front_get_nominals)
 #define front_get_sizes RST_PREFIXED(front_get_sizes)
-#define front_get_vector RST_PREFIXED(front_get_vector)
+#define front_read RST_PREFIXED(front_read)
 #define front_set_debug_logging RST_PREFIXED(front_set_debug_logging)
 #define front_decode_file_uri RST_PREFIXED(front_decode_file_uri)
 #define front_get_state RST_PREFIXED(front_get_state)
@@ -181,8 +181,10 @@ int front_allowed(rst_instance *inst, const char *function, unsigned int modes);
 rst_status front_backend_status(rst_instance *inst, rst_status status);       /* Error, Fatal: change mode */
 
 /* Values (rst_front.c). */
-/* Reads the variables `vr` (at most 64) through the backend as a get call would (locked, mode checked). */
-rst_status front_get_vector(rst_instance *inst, const char *function, const unsigned int vr[], size_t n, double out[]);
+/* Reads `n` variables of `kinds` as a get call does (the instance locked, the mode checked), handing each
+ * value to `write`: inputs and parameters from the store, what the model computes from the backend. */
+rst_status front_read(rst_instance *inst, const char *function, unsigned int kinds, const rst_vr vr[], size_t n,
+                      void *values, rst_write_fn write);
 int front_in_range(const rst_variable *var, double value);
 void front_describe_value(rst_type type, double value, char *out, size_t size);
 const char *front_type_name(rst_type type);
