@@ -92,7 +92,7 @@ def complete_model_description(xml_text: str, table) -> str:
     if table.enumerations:
         root.insert(position + 1, _type_definitions(table))
 
-    inputs = [index[var.name] for var in table if var.causality == "input"]
+    inputs = [index[var.name] for var in table.inputs]
     structure = root.find("ModelStructure")
     for child in list(structure):
         structure.remove(child)
@@ -107,8 +107,7 @@ def complete_model_description(xml_text: str, table) -> str:
         ET.SubElement(outputs, "Unknown", attrs)
     for var in table.derivatives:  # may depend on every state, parameter and input (no dependencies given)
         ET.SubElement(derivatives, "Unknown", {"index": str(index[var.name])})
-    # InitialUnknowns: the outputs, the state derivatives and the calculated parameters, in order
-    for var in sorted(table.outputs + table.derivatives + table.calculated, key=lambda v: index[v.name]):
+    for var in table.initial_unknowns:
         ET.SubElement(initial, "Unknown", {"index": str(index[var.name])})
     for element in root.iter():
         if element.text is not None and not element.text.strip():

@@ -205,10 +205,10 @@ GUARD_CFLAGS = ("-std=gnu99", "-O2", "-Wall", "-Wextra", "-Werror", "-shared", "
 
 
 def _fmi2_headers() -> Path:
-    from restitution.fmu.build_native import NativeBuildSkipped, fmi2_include_dir
+    from restitution.fmu.build_native import NativeBuildSkipped, fmi_include_dir
 
     try:
-        return fmi2_include_dir()
+        return fmi_include_dir("2.0")
     except NativeBuildSkipped as exc:
         raise StandaloneError(f"the FMU guard cannot be compiled: {exc}") from None
 

@@ -42,7 +42,6 @@ PHYSICS_MODELS = {"SpherePlateImpact"}
 #: bring them).
 FMI_HEADERS = {"2.0": ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h"),
                "3.0": ("fmi3Functions.h", "fmi3FunctionTypes.h", "fmi3PlatformTypes.h")}
-FMI2_HEADERS = FMI_HEADERS["2.0"]
 INTERFACE_HEADER = "rst_{model}_interface.h"
 MODEL_INFO_HEADER = "rst_model_info.h"
 COMPILERS = {  # platform folder -> (compiler, extra flags, binary suffix)
@@ -73,10 +72,6 @@ def fmi_include_dir(fmi_version: str = "2.0") -> Path:
         raise NativeBuildSkipped(f"FMI {fmi_version} headers not found in {path}")
     return path
 
-
-def fmi2_include_dir() -> Path:
-    """fmpy's copy of the FMI 2.0 C headers."""
-    return fmi_include_dir("2.0")
 
 
 def front_files(fmi_version: str = "2.0") -> list[Path]:

@@ -173,7 +173,7 @@ def _model_structure(table: Table) -> ET.Element:
     files: the outputs, the state derivatives and the calculated parameters, without dependencies
     (an absent attribute: may depend on every known)."""
     node = ET.Element("ModelStructure")
-    inputs = [str(row.vr) for row in table if row.causality == "input"]
+    inputs = [str(row.vr) for row in table.inputs]
     for row in table.outputs:
         attrs = {"valueReference": str(row.vr), "dependencies": " ".join(inputs) if row.feedthrough else ""}
         if row.feedthrough and inputs:
@@ -181,7 +181,7 @@ def _model_structure(table: Table) -> ET.Element:
         ET.SubElement(node, "Output", attrs)
     for row in table.derivatives:  # may depend on every state, parameter and input (no dependencies given)
         ET.SubElement(node, "ContinuousStateDerivative", valueReference=str(row.vr))
-    for row in sorted(table.outputs + table.derivatives + table.calculated, key=lambda r: r.vr):
+    for row in table.initial_unknowns:
         ET.SubElement(node, "InitialUnknown", valueReference=str(row.vr))
     for row in table.event_indicators:
         ET.SubElement(node, "EventIndicator", valueReference=str(row.vr))

@@ -198,6 +198,17 @@ class Table:
         return tuple(row for row in self.rows if row.causality == "output")
 
     @property
+    def inputs(self) -> tuple[Variable, ...]:
+        """The inputs, in value-reference order (what a feedthrough output depends on)."""
+        return tuple(row for row in self.rows if row.causality == "input")
+
+    @property
+    def initial_unknowns(self) -> tuple[Variable, ...]:
+        """What the modelDescription's InitialUnknowns list, in value-reference order: the outputs, the
+        state derivatives and the calculated parameters."""
+        return tuple(sorted(self.outputs + self.derivatives + self.calculated, key=lambda row: row.vr))
+
+    @property
     def calculated(self) -> tuple[Variable, ...]:
         """The calculated parameters, in value-reference order."""
         return tuple(row for row in self.rows if row.causality == "calculatedParameter")
