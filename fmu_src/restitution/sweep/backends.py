@@ -183,7 +183,6 @@ class _LoadedFmu:
                                     unzip_dir=unzip_dir, instantiate=self._instantiate)
         self.slave = self.instance.slave  # None once closed
         variables = self.instance.variables
-        self.vr = {name: variables[name].valueReference for name in variables}
         missing = [name for name, _kw, _t, _s in INPUTS if name not in variables]
         missing += [name for name, _f, _t in OUTPUTS if name not in variables]
         if missing:
