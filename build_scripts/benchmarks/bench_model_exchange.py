@@ -28,9 +28,9 @@ HERE = Path(__file__).resolve().parent
 ROOT = HERE.parents[1]
 sys.path.insert(0, str(ROOT / "fmu_src"))
 
+from bench_native_build import compile_host  # noqa: E402
 from restitution.fmu.build import build_all  # noqa: E402
 from restitution.fmu.build_native import fmi_include_dir  # noqa: E402
-from restitution.fmu.compile import CFLAGS  # noqa: E402
 
 HOST = HERE / "bench_c" / "exchange_timing.c"
 VERSIONS = {"2.0": ("native", "linux64", 2), "3.0": ("fmi3", "x86_64-linux", 3)}
@@ -47,9 +47,8 @@ def measure(fmu_dir: Path, work: Path, seconds: float) -> dict:
             z.extractall(unzipped)
         root = ET.parse(unzipped / "modelDescription.xml").getroot()
         token = root.get("guid") or root.get("instantiationToken")
-        host = work / f"exchange_timing_{number}"
-        subprocess.run(["gcc", *CFLAGS, f"-DFMI_VERSION={number}", f"-I{fmi_include_dir(version)}", "-o", str(host),
-                        str(HOST), "-ldl"], check=True, capture_output=True, text=True)
+        host = compile_host(work / f"exchange_timing_{number}", [HOST], [fmi_include_dir(version)], ["-ldl"],
+                            defines=[f"FMI_VERSION={number}"])
         done = subprocess.run([str(host), str(unzipped / "binaries" / platform_dir / "BouncingBall.so"), token,
                                str(unzipped / "resources"), str(seconds)], check=True, capture_output=True, text=True)
         times = {line.split()[0]: float(line.split()[1]) for line in done.stdout.splitlines()}

@@ -119,11 +119,13 @@ def build_floor(work: Path, model_description: str) -> Path:
     return stage
 
 
-def _compile(out: Path, sources: list[Path], includes: list[Path], libs: list[str]) -> Path:
-    """gcc with the native build's flags (C99, -Wall -Wextra -Werror -pedantic, -O2, no FMA contraction)."""
+def compile_host(out: Path, sources: list[Path], includes: list[Path], libs: list[str], defines=()) -> Path:
+    """gcc with the native build's flags (C99, -Wall -Wextra -Werror -pedantic, -O2, no FMA contraction);
+    ``defines``: ``NAME=VALUE`` texts for -D."""
     from restitution.fmu.compile import CFLAGS
 
-    cmd = ["gcc", *CFLAGS, *(f"-I{p}" for p in includes), "-o", str(out), *map(str, sources), *libs]
+    cmd = ["gcc", *CFLAGS, *(f"-D{d}" for d in defines), *(f"-I{p}" for p in includes), "-o", str(out),
+           *map(str, sources), *libs]
     done = subprocess.run(cmd, capture_output=True, text=True)
     if done.returncode != 0:
         raise RuntimeError(f"gcc failed for {out.name}:\n{done.stderr}")
@@ -150,10 +152,10 @@ def build_all(work: Path, log=None) -> Built:
     fmi3 = _unzip(fmi3_fmu, work / "fmi3", "fmi3", guid=native.guid, version=3)  # the token is the GUID
     _same_value_references(native_fmu, fmi3_fmu)
     floor = Unzipped("floor", build_floor(work, xml), native.guid)
-    host = _compile(work / "bench_host", [TIMING_HOST], sorted({fmi_include_dir("2.0"), fmi_include_dir("3.0")}),
+    host = compile_host(work / "bench_host", [TIMING_HOST], sorted({fmi_include_dir("2.0"), fmi_include_dir("3.0")}),
                     ["-ldl"])
     src = prepare_sources(work / "physics")
-    loop = _compile(work / "physics_loop", [PHYSICS_LOOP, src / "rst_physics.c"],
+    loop = compile_host(work / "physics_loop", [PHYSICS_LOOP, src / "rst_physics.c"],
                     [src], ["-lm"])
     return Built(python, native, fmi3, floor, host, loop, xml)
 
