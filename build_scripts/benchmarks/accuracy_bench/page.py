@@ -6,6 +6,7 @@ import os
 import platform
 import time
 
+from restitution.fmu.models import table
 from restitution.zener import TAU0_HERTZ
 
 from .config import RANGES, TARGETS
@@ -153,14 +154,16 @@ def markdown(res: dict, cfg_name: str, elapsed: float) -> str:
               "Both are fits of the studied range [0, 1.5] and are shown outside it only to say so.", ""]
 
     # --- costs
+    outputs = table("SpherePlateImpact").outputs
+    n_real, n_bool = sum(v.type == "Real" for v in outputs), sum(v.type == "Boolean" for v in outputs)
     lines += [
         "## Cost per evaluation",
         "",
         "(a) one scalar call `zener_restitution(lam, method)` with a Python float (1000 lambdas of the range "
         "in turn; `ode`: median over the reference lambdas); (b) per element of one vectorized call on "
         f"{cfg_n(res):,} lambdas (`ode`: a loop of solves on {res['n_vector_ode']} lambdas); (c) one FMU round "
-        "trip through `fmpy.fmi2.FMU2Slave`: `setReal(v_approach)`, `doStep`, `getReal` of the 11 Real and "
-        "`getBoolean` of the 6 Boolean outputs, with a new speed each time (a full model evaluation); "
+        f"trip through `fmpy.fmi2.FMU2Slave`: `setReal(v_approach)`, `doStep`, `getReal` of the {n_real} Real and "
+        f"`getBoolean` of the {n_bool} Boolean outputs, with a new speed each time (a full model evaluation); "
         "(c)/floor is the ratio to the trivial FMU below.",
         "",
     ]
