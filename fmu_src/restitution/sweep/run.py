@@ -8,7 +8,9 @@
     result.write("map.parquet"); result.plot("map.png")
 
 The work is cut into chunks of consecutive case indices; each Dask task builds its cases
-from the spec (nothing large travels to the workers) and evaluates them with the back end.
+from the spec (nothing large travels to the workers) and evaluates them with the back end; a
+finished chunk comes back as one buffer (:class:`~restitution.sweep.table.PackedColumns`) and the
+table is joined from the chunks once they are all in.
 
 With ``parts=DIR`` every finished chunk is written to DIR as it completes (one ``.npz`` file a
 chunk, written under a temporary name and renamed, so a file there is always whole), beside a
@@ -36,7 +38,7 @@ from .cluster import count_workers, describe_client, open_client
 from .parts import DiskSweepResult, PartStore
 from .size import check_case_numbers
 from .spec import SweepSpec
-from .table import SweepResult, assemble, keep_columns, table_counts
+from .table import PackedColumns, SweepResult, assemble, keep_columns, table_counts
 
 __all__ = ["run_sweep", "SweepInterrupted"]
 
@@ -55,7 +57,8 @@ class SweepInterrupted(KeyboardInterrupt):
 IN_FLIGHT_PER_WORKER = 2
 
 
-def _run_chunk(start: int, stop: int, spec: SweepSpec, backend: Backend, payload=None, keep=None):
+def _run_chunk(start: int, stop: int, spec: SweepSpec, backend: Backend, payload=None, keep=None,
+               packed: bool = False):
     cpu = time.thread_time()
     cases = spec.cases(start, stop)
     outputs, info = backend.evaluate(cases, payload, keep)
@@ -64,7 +67,7 @@ def _run_chunk(start: int, stop: int, spec: SweepSpec, backend: Backend, payload
     if keep is not None:
         cases = {k: v for k, v in cases.items() if k in keep}
     info["counts"] = table_counts(cases)
-    return cases, info
+    return (PackedColumns(cases) if packed else cases), info
 
 
 def _chunks(n: int, chunk_size: int):
@@ -166,7 +169,7 @@ def run_sweep(spec: SweepSpec | dict, backend: str | Backend = "package", *, fmu
                 ab = next(pending, None)
                 if ab is not None:
                     future = client.submit(_run_chunk, *ab, spec=spec, backend=backend, payload=payload,
-                                           keep=keep, pure=False)
+                                           keep=keep, packed=True, pure=False)
                     futures[future.key], bounds[future.key] = future, ab
                     finished.add(future)
 
@@ -174,10 +177,11 @@ def run_sweep(spec: SweepSpec | dict, backend: str | Backend = "package", *, fmu
                 submit_next()
             for future in finished:
                 a, b = bounds.pop(future.key)
-                run.finished(a, b, future.result())
+                part = future.result()
                 futures.pop(future.key)
                 future.release()
-                submit_next()
+                submit_next()  # before this chunk is copied in and written: the worker does not wait for it
+                run.finished(a, b, part)
                 bar.update(len(run.done))
         except KeyboardInterrupt:
             bar.close(len(run.done))
@@ -198,8 +202,9 @@ def run_sweep(spec: SweepSpec | dict, backend: str | Backend = "package", *, fmu
 
 
 class _Run:
-    """The finished chunks of one run: in memory (start -> (columns, info)), or on disk only
-    (start -> (None, info)) when ``in_memory`` is false; written to ``store`` as they finish."""
+    """The finished chunks of one run: in memory (start -> (columns, info); the columns as they came,
+    packed from a worker), or on disk only (start -> (None, info)) when ``in_memory`` is false;
+    written to ``store`` as they finish."""
 
     def __init__(self, spec, backend, keep, store, in_memory: bool):
         self.spec, self.backend, self.keep, self.store, self.in_memory = spec, backend, keep, store, in_memory
@@ -213,18 +218,27 @@ class _Run:
         self.t0 = time.perf_counter()
 
     def finished(self, a, b, part):
+        columns, info = part
         if self.store is not None:
-            self.store.write(a, b, part)
-        self.done[a] = part if self.in_memory else (None, part[1])
+            self.store.write(a, b, (columns.columns() if isinstance(columns, PackedColumns) else columns, info))
+        self.done[a] = (columns if self.in_memory else None, info)
 
     def result(self) -> SweepResult:
+        """The table of the finished chunks (their columns are consumed: call once)."""
         elapsed = time.perf_counter() - self.t0
-        results = [self.done[a] for a in sorted(self.done)]
+        starts = sorted(self.done)
+        info = _info(self.backend, [self.done[a][1] for a in starts])
+        kwargs = dict(spec=self.spec, backend=self.backend.describe(), scheduler=self.where, n_workers=self.workers,
+                      elapsed=elapsed, n_chunks=self.n_chunks, info=info)
         if self.in_memory:
-            return _result(self.spec, self.backend, results, self.where, self.workers, elapsed, self.n_chunks,
-                           self.keep)
-        return _disk_result(self.spec, self.backend, self.done, self.where, self.workers, elapsed, self.n_chunks,
-                            self.keep, self.store.path)
+            parts = []
+            for a in starts:
+                parts.append(self.done[a][0])
+                self.done[a] = (None, self.done[a][1])
+            return SweepResult(columns=assemble(self.spec, parts, self.keep), **kwargs)
+        info["keep"] = self.keep
+        return DiskSweepResult(columns={}, parts=Path(self.store.path),
+                               chunk_counts={a: self.done[a][1]["counts"] for a in starts}, **kwargs)
 
     def interrupted(self) -> "SweepInterrupted":
         result = self.result()
@@ -289,18 +303,3 @@ def _info(backend, infos) -> dict:
         warnings.warn(f"the workers ran restitution code {codes}, this process has {info['client_code']}: "
                       f"install the same restitution on the workers", RuntimeWarning, stacklevel=4)
     return info
-
-
-def _disk_result(spec, backend, done, where, workers, elapsed, n_chunks, keep, parts) -> "DiskSweepResult":
-    info = _info(backend, [done[a][1] for a in sorted(done)])
-    info["keep"] = keep
-    return DiskSweepResult(columns={}, spec=spec, backend=backend.describe(), scheduler=where, n_workers=workers,
-                           elapsed=elapsed, n_chunks=n_chunks, info=info, parts=Path(parts),
-                           chunk_counts={a: done[a][1]["counts"] for a in done})
-
-
-def _result(spec, backend, results, where, workers, elapsed, n_chunks, keep) -> SweepResult:
-    parts = [r[0] for r in results]
-    info = _info(backend, [r[1] for r in results])
-    return SweepResult(columns=assemble(spec, parts, keep), spec=spec, backend=backend.describe(), scheduler=where,
-                       n_workers=workers, elapsed=elapsed, n_chunks=n_chunks, info=info)

@@ -12,8 +12,8 @@ import numpy as np
 
 from .spec import INPUT_NAMES, INTEGER_INPUTS, OUTPUT_NAMES, OUTPUTS as _OUTPUT_TYPES, T_OVER_D, SweepSpec
 
-__all__ = ["COLUMNS", "VALIDITY", "SweepResult", "read_table", "table_counts", "assemble", "keep_columns",
-           "write_atomic", "write_csv_rows"]
+__all__ = ["COLUMNS", "VALIDITY", "SweepResult", "PackedColumns", "read_table", "table_counts", "assemble",
+           "keep_columns", "write_atomic", "write_csv_rows"]
 
 #: Column order of a result table.
 COLUMNS = ("case", "pair", *INPUT_NAMES, T_OVER_D, *OUTPUT_NAMES, "ok")
@@ -42,21 +42,73 @@ def table_counts(columns: dict) -> dict:
     return counts
 
 
-def assemble(spec: SweepSpec, parts, keep) -> dict:
-    """The table from the chunks' columns (consumed: each column of the chunks is freed once joined,
-    so the peak is the table plus one column, not twice the table)."""
+class PackedColumns:
+    """A chunk's columns in one buffer, for the trip from a worker to this process.
+
+    Dask sends each array as its own buffer; the receiving process allocates each one fresh (about
+    a megabyte a column of a 100,000-case chunk) and the allocator hands those pages back to the
+    system when they are freed, so every chunk faulted its 25 MB in again, 4 KiB at a time, on the
+    one thread that receives. One buffer for the whole chunk is one frame on the wire, allocated in
+    huge pages where the system has them (numpy asks for them from 4 MiB on). A column that holds
+    one value throughout the chunk (bit for bit: a material's constants, the fixed parameters)
+    travels as that value."""
+
+    def __init__(self, columns: dict):
+        self.layout = []  # (name, dtype string, offset in the buffer, rows, travels as one value)
+        self.rows = int(np.size(columns["case"]))
+        arrays, offset = [], 0
+        for name, col in columns.items():
+            col = np.ascontiguousarray(col).reshape(-1)
+            bits = col.view(f"u{col.dtype.itemsize}")
+            constant = col.size > 1 and bool(np.all(bits == bits[0]))
+            sent = col[:1] if constant else col
+            offset = -(-offset // 8) * 8  # every column on an 8-byte boundary
+            self.layout.append((name, col.dtype.str, offset, col.size, constant))
+            arrays.append(sent)
+            offset += sent.nbytes
+        self.buffer = np.empty(offset, dtype=np.uint8)
+        for (_name, _dtype, start, _rows, _constant), sent in zip(self.layout, arrays):
+            self.buffer[start:start + sent.nbytes] = sent.view(np.uint8)
+
+    def columns(self) -> dict:
+        """The columns, as views of the buffer (no copy; a one-value column read-only, repeated)."""
+        out = {}
+        for name, dtype, start, rows, constant in self.layout:
+            count = 1 if constant else rows
+            col = self.buffer[start:start + count * np.dtype(dtype).itemsize].view(dtype)
+            out[name] = np.broadcast_to(col, (rows,)) if constant else col
+        return out
+
+
+def _column_type(name: str):
+    if name in ("case", "pair") or name in INTEGER_INPUTS:
+        return np.int64
+    if name == "ok" or any(name == n and t == "Boolean" for n, _f, t in _OUTPUT_TYPES):
+        return bool
+    return float
+
+
+def assemble(spec: SweepSpec, parts: list, keep) -> dict:
+    """The table from consecutive chunks (each a dict of columns or a :class:`PackedColumns`).
+
+    ``parts`` is consumed: each chunk is dropped once copied into the table, whose columns are
+    allocated at their final types and filled chunk by chunk, so the memory in use stays near one
+    table (the chunks not yet copied plus the rows filled)."""
     names = [c for c in COLUMNS if keep is None or c in keep]
-    if parts:
-        columns = {name: np.concatenate([p.pop(name) for p in parts]) for name in names}
-    else:
-        booleans = {"ok", *(n for n, _f, t in _OUTPUT_TYPES if t == "Boolean")}
-        columns = {name: np.empty(0, dtype=bool if name in booleans else np.int64 if name == "case" else float)
-                   for name in names}
-    labels = np.array(list(spec.pairs) + [""], dtype=object)
-    columns["pair"] = labels[np.asarray(columns["pair"], dtype=np.int64)]
-    for name in INTEGER_INPUTS:
-        if name in columns:
-            columns[name] = np.asarray(columns[name]).astype(np.int64)
+    n = sum(part.rows if isinstance(part, PackedColumns) else int(np.size(part["case"])) for part in parts)
+    columns = {name: np.empty(n, dtype=_column_type(name)) for name in names}
+    parts.reverse()
+    row = 0
+    while parts:
+        part = parts.pop()
+        chunk = part.columns() if isinstance(part, PackedColumns) else part
+        end = row + int(np.size(chunk["case"]))
+        for name in names:
+            columns[name][row:end] = chunk[name]
+        row = end
+        del part, chunk
+    labels = np.array(list(spec.pairs) + [""], dtype=object)  # pair -1 (no pairs) reads ""
+    columns["pair"] = labels[columns["pair"]]
     return columns
 
 

@@ -1,0 +1,88 @@
+"""How a sweep's table is put together: chunks packed for the trip from a worker (one buffer, a column
+of one value sent as that value) and joined into the table. Every value
+must come back bit for bit: this is transport, no arithmetic, so equality of the bits is the right test."""
+import numpy as np
+import pytest
+
+from restitution.sweep import SweepSpec, run_sweep
+from restitution.sweep.backends import PackageBackend
+from restitution.sweep.table import PackedColumns, assemble, keep_columns
+
+SPEC = SweepSpec(pairs=["s2_tool_steel/al_6061", "brass_260/borosilicate_glass"],
+                 grid={"v_approach": {"geomspace": [0.05, 20.0, 30]}, "t_over_d": {"geomspace": [0.05, 10.0, 20]}})
+
+
+def _same_bits(a, b):
+    a, b = np.asarray(a), np.asarray(b)
+    return a.dtype == b.dtype and a.shape == b.shape and np.array_equal(
+        a.view(f"u{a.dtype.itemsize}"), b.view(f"u{b.dtype.itemsize}"))
+
+
+@pytest.mark.parametrize("rows", [0, 1, 2, 7, 1000])
+def test_packed_columns_come_back_bit_for_bit(rows):
+    rng = np.random.default_rng(rows)
+    nan_payload = np.array([0x7FF8_0000_0000_0001], dtype=np.uint64).view(float)[0]
+    columns = {
+        "case": np.arange(rows, dtype=np.int64),
+        "varying": rng.normal(size=rows),
+        "constant": np.full(rows, 2.5e11),
+        "signed_zeros": np.where(np.arange(rows) % 2 == 0, 0.0, -0.0),  # equal as numbers, not as bits
+        "nan_payloads": np.where(np.arange(rows) % 3 == 0, np.nan, nan_payload),
+        "flag": np.arange(rows) % 2 == 0,
+        "all_true": np.ones(rows, dtype=bool),
+        "odd_sized": np.arange(rows, dtype=np.int8),  # the next column still lands on an 8-byte boundary
+        "after_odd": np.arange(rows, dtype=float),
+        "strided": np.arange(2 * rows, dtype=float)[::2],
+    }
+    packed = PackedColumns(columns)
+    back = packed.columns()
+    assert list(back) == list(columns)
+    for name, col in columns.items():
+        assert _same_bits(back[name], col), name
+    if rows > 1:  # the one-value columns ("constant", "all_true") travel as one value each
+        sent = sum(c.nbytes for c in columns.values()) - (rows - 1) * (8 + 1)
+        assert sent <= packed.buffer.nbytes <= sent + 8 * len(columns)
+
+
+def test_packed_chunk_survives_pickling_as_one_buffer():
+    import pickle
+
+    cases = SPEC.cases(0, 300)
+    packed = PackedColumns(cases)
+    buffers = []
+    data = pickle.dumps(packed, protocol=5, buffer_callback=buffers.append)
+    assert len(buffers) == 1 and len(data) < 4096  # Dask sends the buffer as one frame beside a small header
+    back = pickle.loads(data, buffers=buffers).columns()
+    for name, col in cases.items():
+        assert _same_bits(back[name], col), name
+
+
+def test_assemble_joins_packed_and_plain_chunks_into_the_table():
+    whole = run_sweep(SPEC, "package", scheduler="serial")
+    n = len(whole)
+    parts = []
+    for k, a in enumerate(range(0, n, 97)):  # uneven chunks, every other one as it comes from a worker
+        cols = SPEC.cases(a, min(a + 97, n))
+        cols.update(PackageBackend().evaluate(cols)[0])
+        parts.append(PackedColumns(cols) if k % 2 else cols)
+    table = assemble(SPEC, parts, None)
+    assert parts == []  # consumed: each chunk is dropped once it is in
+    assert list(table) == list(whole.columns)
+    for name, col in whole.columns.items():
+        if col.dtype == object:
+            assert list(table[name]) == list(col), name
+        else:
+            assert _same_bits(table[name], col), name
+
+
+def test_assemble_keeps_the_asked_columns_with_their_types():
+    keep = keep_columns(["v_approach", "e", "zener_method"])
+    cols = SPEC.cases(0, 50)
+    cols.update(PackageBackend().evaluate(cols)[0])
+    table = assemble(SPEC, [PackedColumns({k: v for k, v in cols.items() if k in keep})], keep)
+    assert set(table) == set(keep)
+    assert table["case"].dtype == np.int64 and table["zener_method"].dtype == np.int64
+    assert table["ok"].dtype == bool and table["valid"].dtype == bool and table["e"].dtype == float
+    assert np.array_equal(table["zener_method"], cols["zener_method"].astype(np.int64))
+    empty = assemble(SPEC, [], keep)
+    assert set(empty) == set(keep) and all(len(c) == 0 for c in empty.values())
