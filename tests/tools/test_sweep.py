@@ -211,6 +211,11 @@ def test_parquet_table_round_trip(tmp_path):
     table = read_table(res.write(tmp_path / "t.parquet"))
     for name, col in res.columns.items():
         assert np.array_equal(table[name], col), name
+    import pyarrow.parquet as pq
+
+    schema = pq.read_schema(tmp_path / "t.parquet")  # no column of a sweep has missing values
+    assert schema.names == list(res.columns) and not any(field.nullable for field in schema)
+    assert str(schema.field("pair").type) == "string" and str(schema.field("e").type) == "double"
 
 
 def test_dask_scheduler_address_setting_is_used(cluster):

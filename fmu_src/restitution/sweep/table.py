@@ -224,10 +224,14 @@ def _csv_text(x) -> str:
 
 
 def arrow_table(columns: dict):
-    """The table's columns as a pyarrow Table (text columns as strings)."""
+    """The table's columns as a pyarrow Table (text columns as strings), every column declared without
+    missing values, as a sweep's columns are (an out-of-range case has NaN outputs, a value): Parquet
+    then stores no definition levels, which took a fifth of the write."""
     import pyarrow as pa
 
-    return pa.table({name: (col.tolist() if col.dtype == object else col) for name, col in columns.items()})
+    arrays = [pa.array(col, type=pa.string()) if col.dtype == object else pa.array(col) for col in columns.values()]
+    schema = pa.schema([pa.field(name, a.type, nullable=False) for name, a in zip(columns, arrays)])
+    return pa.Table.from_arrays(arrays, schema=schema)
 
 
 def parquet_options(columns: dict) -> dict:
