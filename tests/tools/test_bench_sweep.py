@@ -7,7 +7,7 @@ import numpy as np
 
 from restitution.sweep import SweepSpec, run_sweep
 from restitution.sweep.table import assemble
-from sweep_goals import _chunks, goal_lines, sweep_over_model, write_over_gather
+from sweep_goals import _chunks, goal_lines, machine_scaling, sweep_over_model, write_over_gather
 
 SPEC = SweepSpec(pairs=["s2_tool_steel/al_6061", "brass_260/borosilicate_glass"],
                  grid={"v_approach": {"geomspace": [0.05, 20.0, 30]}, "t_over_d": {"geomspace": [0.05, 10.0, 20]}})
@@ -25,7 +25,11 @@ def test_goal_measurements_run_and_report_every_goal():
     model = sweep_over_model(SPEC, repeats=1)
     write = write_over_gather(model.pop("result"), 3, repeats=1)
     assert model["cases"] == 1200 and all(math.isfinite(x) and x > 0 for x in (model["ratio"], write["parquet_s"]))
-    text = "\n".join(goal_lines(model, write, {"package": 0.97}, task_cpu_us=1.0, dask_gather_us=0.5))
+    ceiling = machine_scaling(SPEC, chunk=200, n_chunks=3, repeats=1)
+    assert all(math.isfinite(x) and x > 0 for x in ceiling.values())
+    text = "\n".join(goal_lines(model, write, {"package": 0.97}, task_cpu_us=1.0, dask_gather_us=0.5,
+                                 ceiling=ceiling))
     assert "streamed runs were not part" in text
-    for goal in ("sweep / model per case, serial", "per Dask worker", "Parquet write / gather", "1 worker / 2 workers"):
+    for goal in ("sweep / model per case, serial", "per Dask worker", "Parquet write / gather", "1 worker / 2 workers",
+                 "What the machine allows a second worker"):
         assert goal in text
