@@ -235,7 +235,7 @@ def test_invalid_message_names_value():
 # tests the loader and the construction themselves (a mutation tool switches mutants on per call,
 # after import, so the import-time build is out of its reach otherwise).
 _TABLE_GLOBALS = ("_H", "_INV_H", "LAMBDA_TABLE_MAX", "E_INF", "TAU0_LAMBDA0", "_U_MAX", "_G_CHEB", "_COEF",
-                  "_COEF_ARR")
+                  "_COEF_ARR", "_COEF_COLS")
 
 
 def _rebuilt(monkeypatch, table):
