@@ -150,12 +150,15 @@ def impact_groups(cases: dict, rows):
     rows = np.asarray(rows)
     if rows.size == 0:
         return
-    options = np.stack([np.asarray(cases[k], dtype=float)[rows] for k in _OPTION_NAMES], axis=1)
-    if (options == options[0]).all():  # the usual chunk: one choice of options (np.unique sorts: 60 % of a sweep)
-        groups, inverse = options[:1], None
-    else:
-        groups, inverse = np.unique(options, axis=0, return_inverse=True)
     every_case = rows.size == np.size(cases["v_approach"])  # rows is then 0..n-1: no copies needed
+    columns = [np.asarray(cases[k], dtype=float) if every_case else np.asarray(cases[k], dtype=float)[rows]
+               for k in _OPTION_NAMES]
+    if all((col == col[0]).all() for col in columns):
+        # the usual chunk: one choice of options, found without stacking the columns (np.unique sorts
+        # the cases: 60 % of a sweep)
+        groups, inverse = np.array([[col[0] for col in columns]]), None
+    else:
+        groups, inverse = np.unique(np.stack(columns, axis=1), axis=0, return_inverse=True)
     for g, opt in enumerate(groups):
         sel = rows if inverse is None else rows[inverse.ravel() == g]
         whole = inverse is None and every_case
