@@ -72,6 +72,24 @@ def test_cases_do_not_depend_on_chunking_and_are_reproducible():
     assert np.allclose(whole["t_over_d"], whole["plate.t"] / 6.35e-3)
 
 
+def test_one_value_columns_are_read_only_views_and_pairs_split_inside_a_range():
+    spec = SweepSpec(pairs=["brass_260/al_6061", "s2_tool_steel/borosilicate_glass"], grid={"v_approach": [0.5, 1, 2]},
+                     fixed={"zener_method": "paper_fit"})
+    one_pair, both = spec.cases(0, 3), spec.cases(0, 6)  # cases 0-2: the first pair; 3-5: the second
+    for name in ("sphere.E", "plate.rho", "sphere.d", "zener_method"):  # one value in the range: no memory
+        col = one_pair[name]
+        assert col.strides == (0,) and not col.flags.writeable, name
+    assert one_pair["zener_method"][0] == 2.0 and one_pair["sphere.d"][0] == 6.35e-3
+    brass, steel = r.MATERIALS["brass_260"], r.MATERIALS["s2_tool_steel"]
+    assert list(both["sphere.E"]) == [brass.E] * 3 + [steel.E] * 3  # two pairs in one range: each its own
+    assert list(both["plate.E"]) == [r.MATERIALS["al_6061"].E] * 3 + [r.MATERIALS["borosilicate_glass"].E] * 3
+    # the table holds whole columns, equal to the views, and a chunk spanning both pairs gives the same table
+    cut = run_sweep(spec, "package", scheduler="serial", chunk_size=3)
+    joint = run_sweep(spec, "package", scheduler="serial", chunk_size=4)
+    for name, col in cut.columns.items():
+        assert col.flags.writeable and np.array_equal(joint[name], col, equal_nan=col.dtype.kind == "f"), name
+
+
 def test_grid_axes_names_and_derived_thickness():
     spec = SweepSpec(grid={"v": "0.5,1", "t/d": "geomspace:0.1:10:3", "sphere_d": [2e-3, 4e-3]},
                      fixed={"zener_method": "paper_fit", "plasticity": "off"})

@@ -33,14 +33,15 @@ def test_packed_columns_come_back_bit_for_bit(rows):
         "odd_sized": np.arange(rows, dtype=np.int8),  # the next column still lands on an 8-byte boundary
         "after_odd": np.arange(rows, dtype=float),
         "strided": np.arange(2 * rows, dtype=float)[::2],
+        "one_value_view": np.broadcast_to(np.float64(-0.0), (rows,)),  # as SweepSpec.cases gives constants
     }
     packed = PackedColumns(columns)
     back = packed.columns()
     assert list(back) == list(columns)
     for name, col in columns.items():
         assert _same_bits(back[name], col), name
-    if rows > 1:  # the one-value columns ("constant", "all_true") travel as one value each
-        sent = sum(c.nbytes for c in columns.values()) - (rows - 1) * (8 + 1)
+    if rows > 1:  # the one-value columns ("constant", "all_true", "one_value_view") travel as one value each
+        sent = sum(c.size * c.itemsize for c in columns.values()) - (rows - 1) * (8 + 1 + 8)
         assert sent <= packed.buffer.nbytes <= sent + 8 * len(columns)
 
 

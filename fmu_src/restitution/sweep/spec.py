@@ -416,7 +416,11 @@ class SweepSpec:
     # --- cases ---
     def cases(self, start: int = 0, stop: int | None = None) -> dict:
         """Columns of cases ``start <= i < stop``: ``case``, ``pair`` (index into :attr:`pairs`,
-        -1 without pairs), every FMU input/parameter by name, and ``t_over_d``."""
+        -1 without pairs), every FMU input/parameter by name, and ``t_over_d``.
+
+        A column that holds one value for every case of the range (a start value, a fixed parameter,
+        a material constant where the range has one pair) is a read-only view of that value
+        (``numpy.broadcast_to``): no memory is written for it, and the table is filled from the value."""
         n = self.n_cases
         stop = n if stop is None else min(int(stop), n)
         start = int(start)
@@ -424,10 +428,10 @@ class SweepSpec:
             raise ValueError(f"case range [{start}, {stop}) outside [0, {n})")
         index = np.arange(start, stop, dtype=np.int64)
         grid_index = index // self.samples
-        cols = {name: np.full(index.size, float(START[name])) for name in INPUT_NAMES}
+        cols = {name: float(START[name]) for name in INPUT_NAMES}  # a float: one value for the whole range
         for k, v in self._fixed.items():
             if k != T_OVER_D:
-                cols[k] = np.full(index.size, v[0])
+                cols[k] = float(v[0])
         # Grid coordinates, C order (last axis fastest).
         axes = self.axes
         coords = {}
@@ -435,14 +439,14 @@ class SweepSpec:
         for name, values in reversed(list(axes.items())):
             coords[name] = values[rem % values.size]
             rem //= values.size
-        pair = np.full(index.size, -1, dtype=np.int64)
+        pair = np.broadcast_to(np.int64(-1), index.shape)
         if self.pairs:
             pair = coords.pop("pair").astype(np.int64)
-            for j, p in enumerate(self.pairs):
-                sel = pair == j
-                if sel.any():
-                    for k, val in _pair_values(p).items():
-                        cols[k][sel] = val
+            one_pair = pair.size > 0 and pair.min() == pair.max()  # the usual range: inside one pair's block
+            values = [_pair_values(p) for p in self.pairs]
+            for k in values[0]:
+                by_pair = np.array([v[k] for v in values], dtype=float)
+                cols[k] = float(by_pair[pair[0]]) if one_pair else by_pair[pair]
         t_over_d = None
         for k, v in coords.items():
             if k == T_OVER_D:
@@ -450,7 +454,9 @@ class SweepSpec:
             else:
                 cols[k] = v
         if T_OVER_D in self._fixed:
-            t_over_d = np.full(index.size, self._fixed[T_OVER_D][0])
+            t_over_d = float(self._fixed[T_OVER_D][0])
+        cols = {k: np.broadcast_to(np.float64(v), index.shape) if isinstance(v, float) else v
+                for k, v in cols.items()}
         # Random draws, in blocks independent of the chunking.
         if self._dists:
             draws = self._random_draws(start, stop)
@@ -462,7 +468,7 @@ class SweepSpec:
                 else:
                     cols[k] = draws[k]
         if t_over_d is not None:
-            cols["plate.t"] = t_over_d * cols["sphere.d"]
+            cols["plate.t"] = np.broadcast_to(t_over_d * cols["sphere.d"], index.shape)  # a fixed t/d, one d: one value
         with np.errstate(divide="ignore", invalid="ignore"):
             cols[T_OVER_D] = cols["plate.t"] / cols["sphere.d"]
         out = {"case": index, "pair": pair}

@@ -58,12 +58,16 @@ class PackedColumns:
         self.rows = int(np.size(columns["case"]))
         arrays, offset = [], 0
         for name, col in columns.items():
-            col = np.ascontiguousarray(col).reshape(-1)
-            bits = col.view(f"u{col.dtype.itemsize}")
-            constant = col.size > 1 and bool(np.all(bits == bits[0]))
+            col = np.asarray(col).reshape(-1)
+            if col.size > 1 and col.strides[0] == 0:  # a view of one value (SweepSpec.cases): sent as it
+                col, constant = col[:1].copy(), True
+            else:
+                col = np.ascontiguousarray(col)
+                bits = col.view(f"u{col.dtype.itemsize}")
+                constant = col.size > 1 and bool(np.all(bits == bits[0]))
             sent = col[:1] if constant else col
             offset = -(-offset // 8) * 8  # every column on an 8-byte boundary
-            self.layout.append((name, col.dtype.str, offset, col.size, constant))
+            self.layout.append((name, col.dtype.str, offset, self.rows, constant))
             arrays.append(sent)
             offset += sent.nbytes
         self.buffer = np.empty(offset, dtype=np.uint8)
