@@ -135,7 +135,7 @@ def main(argv=None) -> int:
     parser.add_argument("--fmu-cases", type=int, default=24_000, help="cases of the FMU sweeps (default 24000)")
     parser.add_argument("--package-cases", type=int, default=4_800_000,
                         help="cases of the package sweeps (default 4800000)")
-    parser.add_argument("--repeats", type=int, default=3, help="runs of each measurement; the fastest (wall) and the least CPU count")
+    parser.add_argument("--repeats", type=int, default=5, help="runs of each measurement; the fastest (wall) and the least CPU count")
     parser.add_argument("--goal-cases", type=int, default=1_000_000,
                         help="cases of the sweep / model and write / gather measurements (default 1000000)")
     parser.add_argument("--streamed-cases", type=float, default=1e8,

@@ -180,7 +180,7 @@ def run_sweep(spec: SweepSpec | dict, backend: str | Backend = "package", *, fmu
                 part = future.result()
                 futures.pop(future.key)
                 future.release()
-                submit_next()  # before this chunk is copied in and written: the worker does not wait for it
+                submit_next()  # before this chunk is handled (written to the parts): no worker waits for it
                 run.finished(a, b, part)
                 bar.update(len(run.done))
         except KeyboardInterrupt:
