@@ -58,6 +58,7 @@ from accuracy_bench.model_costs import model_costs  # noqa: E402
 from accuracy_bench.page import headline, machine_info, markdown  # noqa: E402
 from accuracy_bench.plot import plot  # noqa: E402
 from accuracy_bench.reference import lambda_points, reference_many  # noqa: E402
+from accuracy_bench.timing import settle_allocator  # noqa: E402
 from accuracy_bench.zener_costs import method_list, zener_accuracy, zener_scalar_costs, zener_vector_costs  # noqa: E402
 
 
@@ -72,6 +73,7 @@ def run(quick: bool = False, out_dir: Path | None = None, jobs: int | None = Non
         if verbose:
             print(f"[{time.perf_counter() - start:6.1f} s] {msg}", flush=True)
 
+    settle_allocator()
     res = {"machine": machine_info(), "methods": method_list(cfg), "n_vector": cfg.n_vector,
            "n_vector_ode": cfg.n_vector_ode}
     lams = lambda_points(cfg)

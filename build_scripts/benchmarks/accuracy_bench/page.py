@@ -268,8 +268,10 @@ def markdown(res: dict, cfg_name: str, elapsed: float) -> str:
         "outputs are cached until an input changes.",
         "- A scalar call is the same equations on Python floats (`math`), a vectorized call runs them once "
         "per array in numpy; the ratio is Python's per-operation overhead against numpy's per-element cost, "
-        "and falls when the scalar path gets faster. Vectorized cost per case grows with lambda's spread "
-        "(the table no longer fits in cache; lambda up to 100 in random order costs ~2x).",
+        "and falls when the scalar path gets faster. Vectorized cost per case grows a little with lambda's "
+        "spread (lambda up to 100 in random order reads the `exact` table from more of memory). The timings "
+        "start once glibc's allocator is in the state of a long-running process "
+        "(`accuracy_bench.timing.settle_allocator`).",
     ]
     for k in missed:
         if k == "fmu_over_floor":

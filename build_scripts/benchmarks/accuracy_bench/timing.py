@@ -10,6 +10,20 @@ def clock() -> float:
     return time.thread_time()
 
 
+def settle_allocator() -> None:
+    """Bring glibc's allocator to the state a long-running process is in before anything is timed.
+
+    glibc maps every block over 128 KiB fresh (and page-faults it) until the first large mapped block
+    is freed; it then raises that threshold to the block's size, up to 32 MiB, and serves such blocks
+    from its heap. A process that has ever freed a big array (a sweep's table, a model call on 10^6
+    cases) is in that state; without it a vectorized call on 10^5 cases measured 25 ns a case where it
+    takes 7 (paper_fit), whatever the model did."""
+    import numpy as np
+
+    block = np.ones(2 << 20)  # 16 MiB: mapped, then freed
+    del block
+
+
 def interleaved(variants: dict, reps: int, batch_seconds: float) -> dict:
     """{name: [seconds per evaluation, one per batch]} for ``variants`` {name: run(n) -> evaluations}.
 
