@@ -131,6 +131,9 @@ def machine_scaling(spec, chunk: int = 100_000, n_chunks: int = 20, repeats: int
     cores share caches, memory bandwidth and, on many CPUs, a lower clock, so ``ratio`` (alone / two at
     once) is the ceiling of the sweep's CPU scaling on this machine."""
     import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor
+
+    from restitution.sweep.cluster import _without_fmu_resources_on_sys_path
 
     starts = np.linspace(0, max(0, spec.n_cases - chunk), n_chunks).astype(int)  # across the sweep's cases
     bounds = [(int(a), int(min(a + chunk, spec.n_cases))) for a in starts]
@@ -138,8 +141,12 @@ def machine_scaling(spec, chunk: int = 100_000, n_chunks: int = 20, repeats: int
     ctx = multiprocessing.get_context("spawn")  # as Dask starts its workers
     cpu = {}
     for processes in (1, 2):
-        with ctx.Pool(processes, initializer=_set_barrier, initargs=(ctx.Barrier(processes),)) as pool:
-            runs = [sum(pool.starmap(_evaluate_after_barrier, [(spec, bounds)] * processes)) / processes
+        # the children start with this process's sys.path less any pythonfmu FMU's resources/ (its
+        # physics-only restitution would shadow this one), as open_client's workers do; a child that
+        # dies makes the pool broken (an error here), where multiprocessing.Pool waited forever
+        with _without_fmu_resources_on_sys_path(), ProcessPoolExecutor(
+                processes, mp_context=ctx, initializer=_set_barrier, initargs=(ctx.Barrier(processes),)) as pool:
+            runs = [sum(pool.map(_evaluate_after_barrier, [spec] * processes, [bounds] * processes)) / processes
                     for _ in range(repeats + 1)]
         cpu[processes] = min(runs[1:]) / n  # the first run warms the thread's arena, as a worker's first tasks do
     alone, both = cpu[1], cpu[2]

@@ -33,3 +33,16 @@ def test_goal_measurements_run_and_report_every_goal():
     for goal in ("sweep / model per case, serial", "per Dask worker", "Parquet write / gather", "1 worker / 2 workers",
                  "What the machine allows a second worker"):
         assert goal in text
+
+
+def test_machine_scaling_children_ignore_a_pythonfmu_resources_dir_on_sys_path(tmp_path, monkeypatch):
+    """pythonfmu puts an FMU's resources/ (with its own physics-only ``restitution``) first on sys.path;
+    spawned children inherited it, could not unpickle the sweep spec and died, and the pool waited
+    forever. Here a resources/ whose ``restitution`` cannot be imported at all stands in for it."""
+    fake = tmp_path / "resources"
+    (fake / "restitution").mkdir(parents=True)
+    (fake / "slavemodule.txt").write_text("model\n")
+    (fake / "restitution" / "__init__.py").write_text("raise ImportError('the FMU copy, not this one')\n")
+    monkeypatch.syspath_prepend(str(fake))
+    ceiling = machine_scaling(SPEC, chunk=200, n_chunks=2, repeats=1)
+    assert all(math.isfinite(x) and x > 0 for x in ceiling.values())
