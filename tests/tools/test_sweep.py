@@ -18,6 +18,7 @@ from restitution.model import PARAMETERS, published
 from restitution.sweep import (INPUTS, OUTPUTS, SweepSpec, code_fingerprint, compare_results, open_client,
                                read_table, release_fmus, run_sweep)
 from restitution.sweep.__main__ import main as sweep_cli
+from restitution.sweep.compare import agreement_report
 from restitution.sweep.spec import RANDOM_BLOCK
 
 TOL = 1e-12
@@ -83,11 +84,16 @@ def test_one_value_columns_are_read_only_views_and_pairs_split_inside_a_range():
     brass, steel = r.MATERIALS["brass_260"], r.MATERIALS["s2_tool_steel"]
     assert list(both["sphere.E"]) == [brass.E] * 3 + [steel.E] * 3  # two pairs in one range: each its own
     assert list(both["plate.E"]) == [r.MATERIALS["al_6061"].E] * 3 + [r.MATERIALS["borosilicate_glass"].E] * 3
-    # the table holds whole columns, equal to the views, and a chunk spanning both pairs gives the same table
+    # the table holds whole columns; a chunk spanning both pairs gives each case its own inputs (data,
+    # equal exactly) and outputs within their conditioning (two evaluations: numpy's kernels may differ
+    # in the last bit between array lengths)
     cut = run_sweep(spec, "package", scheduler="serial", chunk_size=3)
     joint = run_sweep(spec, "package", scheduler="serial", chunk_size=4)
-    for name, col in cut.columns.items():
-        assert col.flags.writeable and np.array_equal(joint[name], col, equal_nan=col.dtype.kind == "f"), name
+    assert all(col.flags.writeable for col in cut.columns.values())
+    for name in ("case", "pair", *(n for n, _kw, _t, _s in INPUTS), "t_over_d"):
+        assert np.array_equal(joint[name], cut[name]), name
+    compared, problems = agreement_report(joint.columns, cut.columns)
+    assert compared == 6 and not problems, problems
 
 
 def test_grid_axes_names_and_derived_thickness():

@@ -4,9 +4,9 @@ must come back bit for bit: this is transport, no arithmetic, so equality of the
 import numpy as np
 import pytest
 
-from restitution.sweep import SweepSpec, run_sweep
+from restitution.sweep import SweepSpec
 from restitution.sweep.backends import PackageBackend
-from restitution.sweep.table import PackedColumns, assemble, keep_columns
+from restitution.sweep.table import COLUMNS, PackedColumns, assemble, keep_columns
 
 SPEC = SweepSpec(pairs=["s2_tool_steel/al_6061", "brass_260/borosilicate_glass"],
                  grid={"v_approach": {"geomspace": [0.05, 20.0, 30]}, "t_over_d": {"geomspace": [0.05, 10.0, 20]}})
@@ -59,20 +59,22 @@ def test_packed_chunk_survives_pickling_as_one_buffer():
 
 
 def test_assemble_joins_packed_and_plain_chunks_into_the_table():
-    whole = run_sweep(SPEC, "package", scheduler="serial")
-    n = len(whole)
-    parts = []
+    """The table against the same chunks' own columns joined by hand: a copy of the values each chunk
+    computed, so every bit must survive (the chunks are evaluated once; no two evaluations compared)."""
+    n = SPEC.n_cases
+    parts, expected = [], []
     for k, a in enumerate(range(0, n, 97)):  # uneven chunks, every other one as it comes from a worker
         cols = SPEC.cases(a, min(a + 97, n))
         cols.update(PackageBackend().evaluate(cols)[0])
+        expected.append({name: np.array(col) for name, col in cols.items()})
         parts.append(PackedColumns(cols) if k % 2 else cols)
     table = assemble(SPEC, parts, None)
     assert parts == []  # consumed: each chunk is dropped once it is in
-    assert list(table) == list(whole.columns)
-    for name, col in whole.columns.items():
-        if col.dtype == object:
-            assert list(table[name]) == list(col), name
-        else:
+    assert list(table) == list(COLUMNS)
+    assert list(table["pair"]) == [SPEC.pairs[j] for e in expected for j in e["pair"]]
+    for name in COLUMNS:
+        if name != "pair":
+            col = np.concatenate([e[name] for e in expected]).astype(table[name].dtype)
             assert _same_bits(table[name], col), name
 
 
