@@ -468,7 +468,7 @@ class SweepSpec:
                 else:
                     cols[k] = draws[k]
         if t_over_d is not None:
-            cols["plate.t"] = np.broadcast_to(t_over_d * cols["sphere.d"], index.shape)  # a fixed t/d, one d: one value
+            cols["plate.t"] = t_over_d * cols["sphere.d"]
         with np.errstate(divide="ignore", invalid="ignore"):
             cols[T_OVER_D] = cols["plate.t"] / cols["sphere.d"]
         out = {"case": index, "pair": pair}
