@@ -93,11 +93,15 @@ typedef struct rst_message {
     char text[1];         /* the message (its '%' doubled), NUL, the category, NUL */
 } rst_message;
 
+/* An FMU state. Its words are kept as they were read (a deserialized or host-overwritten state may
+ * hold anything): rst_state.c checks them (one mode of the interface, flags 0 or 1, the interface of
+ * the instance) before any reaches the instance. */
 typedef struct rst_state {
     unsigned int magic;
     struct rst_state *next;
-    rst_mode mode;
-    int has_start, has_time;
+    unsigned int mode;           /* one rst_mode bit */
+    unsigned int model_exchange; /* the interface it was taken from: 0 co-simulation, 1 model exchange */
+    unsigned int has_start, has_time;
     double start_time, next_time, last_time;
     double values[1]; /* one per state variable of the table (allocated to size) */
 } rst_state;

@@ -1,14 +1,23 @@
-/* The front's FMU states: snapshots of the store's state variables, the communication point and the
- * mode; getting, setting and freeing them and their serialization (versioned, checksummed,
- * little-endian, the same bytes whatever the FMI version), every restored value checked as a set
- * call would. */
+/* The front's FMU states: snapshots of the store's state variables, the communication point, the mode
+ * and the interface; getting, setting and freeing them and their serialization (versioned, checksummed,
+ * little-endian, the same bytes whatever the FMI version). Every state is checked before it is restored
+ * or becomes a state (check_snapshot): exactly one mode of its interface, the instance's interface,
+ * finite times, every Real finite and every input and parameter as a set call would check it. */
 #include "rst_front_internal.h"
 
 #include <math.h>
 #include <stdint.h>
+#include <stdio.h>
 #include <string.h>
 
-#define RST_STATE_FORMAT 1u /* serialized layout version (see front_serialize) */
+/* Serialized layout version (see front_serialize); 2: the interface is recorded. Only this one is read. */
+#define RST_STATE_FORMAT 2u
+
+/* The modes a state of each interface may hold (exactly one of them). */
+#define CS_STATE_MODES (RST_MODE_INSTANTIATED | RST_MODE_INITIALIZATION | RST_MODE_STEP_COMPLETE | \
+                        RST_MODE_STEP_FAILED | RST_MODE_TERMINATED | RST_MODE_ERROR)
+#define ME_STATE_MODES (RST_MODE_INSTANTIATED | RST_MODE_INITIALIZATION | ME_MODES | RST_MODE_TERMINATED | \
+                        RST_MODE_ERROR)
 
 void front_free_states(rst_instance *inst)
 {
@@ -95,9 +104,10 @@ rst_status front_get_state(void *c, const char *function, void **FMUstate)
     s = target_state(inst, function, FMUstate);
     if (s == NULL)
         LEAVE(RST_ERROR);
-    s->mode = inst->mode;
-    s->has_start = inst->has_start;
-    s->has_time = inst->has_time;
+    s->mode = (unsigned int)inst->mode;
+    s->model_exchange = inst->model_exchange != 0;
+    s->has_start = inst->has_start != 0;
+    s->has_time = inst->has_time != 0;
     s->start_time = inst->start_time;
     s->next_time = inst->next_time;
     s->last_time = inst->last_time;
@@ -108,22 +118,36 @@ rst_status front_get_state(void *c, const char *function, void **FMUstate)
     LEAVE(status);
 }
 
-/* Is every value of a snapshot one this instance could hold? (A deserialized state passes here
- * before it becomes a state; checks as a set call would, plus the types of the other variables.) */
+/* Is a snapshot a state of this instance: one mode of its interface, the instance's interface, finite
+ * times, every value one the instance could hold? (A deserialized state passes here before it becomes a
+ * state, a state before it is restored; values checked as a set call would, plus every Real finite and
+ * the types of the other variables.) Logs one line and returns 0 when not. */
 static int check_snapshot(rst_instance *inst, const char *function, const rst_state *s)
 {
     size_t i, k = 0;
     char text[40];
-    if (!(s->mode & (ANY_LIVE_MODE)) || !isfinite(s->start_time) || !isfinite(s->next_time) ||
-        !isfinite(s->last_time)) {
-        rst_log(inst, RST_ERROR, "%s: the state's mode or times are invalid", function);
+    unsigned int modes;
+    if (s->model_exchange > 1u) {
+        rst_log(inst, RST_ERROR, "%s: the state's interface word %u is neither co-simulation (0) nor model "
+                "exchange (1)", function, s->model_exchange);
         return 0;
     }
-    if (inst->model_exchange ? (s->mode & (RST_MODE_STEP_COMPLETE | RST_MODE_STEP_FAILED)) != 0
-                             : (s->mode & ME_MODES) != 0) {
+    if ((s->model_exchange != 0) != (inst->model_exchange != 0)) {
         rst_log(inst, RST_ERROR, "%s: the state was taken from a %s instance; this one is %s", function,
-                inst->model_exchange ? "co-simulation" : "model-exchange",
+                s->model_exchange ? "model-exchange" : "co-simulation",
                 inst->model_exchange ? "model exchange" : "co-simulation");
+        return 0;
+    }
+    modes = inst->model_exchange ? ME_STATE_MODES : CS_STATE_MODES;
+    if (s->mode == 0 || (s->mode & (s->mode - 1u)) != 0 || (s->mode & modes) == 0) {
+        rst_log(inst, RST_ERROR, "%s: the state's mode word 0x%x is not one mode of the %s state machine",
+                function, s->mode, inst->model_exchange ? "model-exchange" : "co-simulation");
+        return 0;
+    }
+    if (s->has_start > 1u || s->has_time > 1u || !isfinite(s->start_time) || !isfinite(s->next_time) ||
+        !isfinite(s->last_time)) {
+        rst_log(inst, RST_ERROR, "%s: the state's times are not finite or its time flags are not 0 or 1",
+                function);
         return 0;
     }
     for (i = 0; i < inst->model->n_variables; i++) {
@@ -142,11 +166,12 @@ static int check_snapshot(rst_instance *inst, const char *function, const rst_st
             }
             if (inst->model->accept != NULL && inst->model->accept(inst, var, value) != RST_OK)
                 return 0;
-        } else if ((var->type == RST_BOOLEAN && value != 0.0 && value != 1.0) ||
+        } else if ((var->type == RST_REAL && !isfinite(value)) ||
+                   (var->type == RST_BOOLEAN && value != 0.0 && value != 1.0) ||
                    (var->type == RST_INTEGER &&
                     !(value == floor(value) && value >= -2147483648.0 && value <= 2147483647.0))) {
-            rst_log(inst, RST_ERROR, "%s: the state has %s = %s, not a valid %s", function, var->name, text,
-                    front_type_name(var->type));
+            rst_log(inst, RST_ERROR, "%s: the state has %s = %s, not a %s %s", function, var->name, text,
+                    var->type == RST_REAL ? "finite" : "valid", front_type_name(var->type));
             return 0;
         }
     }
@@ -165,12 +190,14 @@ rst_status front_set_state(void *c, const char *function, void *FMUstate)
                 "%s or %s of the same instance)", function, inst->api->get_state, inst->api->deserialize_state);
         LEAVE(RST_ERROR);
     }
+    if (!check_snapshot(inst, function, s)) /* the host may have written over it: nothing changes */
+        LEAVE(RST_ERROR);
     for (i = 0; i < inst->model->n_variables; i++)
         if (inst->model->variables[i].state)
             inst->store[i] = s->values[k++];
-    inst->mode = s->mode;
-    inst->has_start = s->has_start;
-    inst->has_time = s->has_time;
+    inst->mode = (rst_mode)s->mode;
+    inst->has_start = (int)s->has_start;
+    inst->has_time = (int)s->has_time;
     inst->start_time = s->start_time;
     inst->next_time = s->next_time;
     inst->last_time = s->last_time;
@@ -197,15 +224,17 @@ rst_status front_free_state(void *c, const char *function, void **FMUstate)
 }
 
 /* Serialized layout (little-endian whatever the platform):
- *   "RSTFMUST" | u32 format | u32 len + model identifier | u32 len + GUID | u32 number of state variables
- *   | u32 mode | u32 has_start | u32 has_time | f64 start_time | f64 next_time | f64 last_time
- *   | per state variable: u32 value reference, u32 type, f64 value | u64 FNV-1a of everything before. */
+ *   "RSTFMUST" | u32 format (2) | u32 len + model identifier | u32 len + GUID | u32 number of state
+ *   variables | u32 mode (one rst_mode bit) | u32 has_start | u32 has_time | f64 start_time
+ *   | f64 next_time | f64 last_time | per state variable: u32 value reference, u32 type, f64 value
+ *   | u32 interface (0 co-simulation, 1 model exchange) | u64 FNV-1a of everything before.
+ * Format 1 (no interface word) and any other version are refused. */
 #define SERIAL_MAGIC "RSTFMUST"
 
 static size_t serialized_size(const rst_instance *inst)
 {
     return 8 + 4 + 4 + strlen(inst->model->identifier) + 4 + strlen(inst->model->guid) + 4 + 3 * 4 + 3 * 8 +
-           inst->n_state * (4 + 4 + 8) + 8;
+           inst->n_state * (4 + 4 + 8) + 4 + 8;
 }
 
 static void put_u32(unsigned char **p, uint32_t x)
@@ -294,6 +323,7 @@ rst_status front_serialize(void *c, const char *function, void *FMUstate, unsign
             put_u32(&p, (uint32_t)inst->model->variables[i].type);
             put_f64(&p, s->values[k++]);
         }
+    put_u32(&p, s->model_exchange);
     put_u64(&p, fnv1a((const unsigned char *)serializedState, (size_t)(p - (unsigned char *)serializedState)));
     LEAVE(RST_OK);
 }
@@ -339,11 +369,14 @@ static int get_text_equal(reader *r, const char *expected)
     return equal;
 }
 
-/* Reads serialized bytes into the snapshot `s` (room for n_state values); NULL, or what is wrong. */
-static const char *read_snapshot(const rst_instance *inst, const unsigned char bytes[], size_t size, rst_state *s)
+/* Reads serialized bytes into the snapshot `s` (room for n_state values); NULL, or what is wrong (a
+ * constant, or written into `why`). */
+static const char *read_snapshot(const rst_instance *inst, const unsigned char bytes[], size_t size, rst_state *s,
+                                 char *why, size_t why_size)
 {
     reader r;
     size_t i, k = 0;
+    uint64_t format;
     r.p = (const unsigned char *)bytes;
     r.end = r.p + size;
     r.ok = 1;
@@ -354,17 +387,22 @@ static const char *read_snapshot(const rst_instance *inst, const unsigned char b
         return "the checksum does not match (truncated or corrupted bytes)";
     r.p = (const unsigned char *)bytes + 8;
     r.end = (const unsigned char *)bytes + size - 8;
-    if (get_uint(&r, 4) != RST_STATE_FORMAT && r.ok)
-        return "the state was written in another format version";
+    format = get_uint(&r, 4);
+    if (format != RST_STATE_FORMAT && r.ok) {
+        snprintf(why, why_size, "the state was written in another format version (%lu); this FMU reads only "
+                 "format %u, which records the interface (take the state again with this FMU)",
+                 (unsigned long)format, RST_STATE_FORMAT);
+        return why;
+    }
     if (!get_text_equal(&r, inst->model->identifier) && r.ok)
         return "the state belongs to another model";
     if (!get_text_equal(&r, inst->model->guid) && r.ok)
         return "the state belongs to another build of this model (GUID differs)";
     if (get_uint(&r, 4) != inst->n_state && r.ok)
         return "the state has another number of variables";
-    s->mode = (rst_mode)get_uint(&r, 4);
-    s->has_start = get_uint(&r, 4) != 0;
-    s->has_time = get_uint(&r, 4) != 0;
+    s->mode = (unsigned int)get_uint(&r, 4); /* the words as they are: check_snapshot judges them */
+    s->has_start = (unsigned int)get_uint(&r, 4);
+    s->has_time = (unsigned int)get_uint(&r, 4);
     s->start_time = get_f64(&r);
     s->next_time = get_f64(&r);
     s->last_time = get_f64(&r);
@@ -375,6 +413,7 @@ static const char *read_snapshot(const rst_instance *inst, const unsigned char b
             return r.ok ? "the state's variable list differs from this FMU's" : "the state is truncated";
         s->values[k++] = get_f64(&r);
     }
+    s->model_exchange = (unsigned int)get_uint(&r, 4);
     if (!r.ok)
         return "the state is truncated";
     return r.p == r.end ? NULL : "the state has trailing bytes";
@@ -385,6 +424,7 @@ rst_status front_deserialize(void *c, const char *function, const unsigned char 
 {
     rst_state *s, *target;
     const char *problem;
+    char why[256];
     ENTER(function, ANY_LIVE_MODE)
     if (serializedState == NULL || FMUstate == NULL) {
         rst_log(inst, RST_ERROR, "%s: NULL %s", function, serializedState == NULL ? "bytes" : "FMUstate pointer");
@@ -399,7 +439,7 @@ rst_status front_deserialize(void *c, const char *function, const unsigned char 
         rst_log(inst, RST_ERROR, "%s: out of memory", function);
         LEAVE(RST_ERROR);
     }
-    problem = read_snapshot(inst, serializedState, size, s);
+    problem = read_snapshot(inst, serializedState, size, s, why, sizeof why);
     if (problem != NULL)
         rst_log(inst, RST_ERROR, "%s: %s; nothing was changed", function, problem);
     /* checked like a set call before it may become a state */
