@@ -3,19 +3,20 @@
     check FILE...                      load and check scene files, print what they contain
     run FILE [--out DIR] [--all-on] [--zener-method M] [--fmu PATH] [--rebuild] [--no-plot]
                                        simulate a scene; write DIR/<stem>.csv, <stem>_summary.csv, <stem>.png;
-                                       exit status 3 when a drop stops at its bounce limit still bouncing
+                                       exit status 3 when a drop stops at its bounce limit still bouncing,
+                                       74 on an I/O error writing them (ENOSPC, EIO, ...)
     report FILE... [--out docs/scenes.md] [--repeat N] [--methods exact,ode]
                                        auto vs every effect on: effect counts, wall times, differences
 """
 from __future__ import annotations
 
 import argparse
-import os
 import sys
-import tempfile
 from pathlib import Path
 
 from ..fmu.build import BuildError
+from ..output_files import (EXIT_IO_ERROR, EXIT_REFUSED, OutputPathError, check_output, check_output_dir,
+                            describe_os_error)
 from .loader import SceneError, load_scene
 
 
@@ -39,37 +40,6 @@ class UsageError(Exception):
     """A command-line value that cannot be used (one line, exit 2)."""
 
 
-def _output_dir(out: Path) -> Path:
-    """``out`` created if missing and checked writable, before the run starts."""
-    if out.exists() and not out.is_dir():
-        raise UsageError(f"--out {out}: exists and is not a directory")
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-        with tempfile.TemporaryFile(dir=out):  # a real write: permission bits lie to root
-            pass
-    except OSError as exc:
-        raise UsageError(f"--out {out}: cannot write there: {exc.strerror or exc}") from None
-    return out
-
-
-def _output_file(out: Path) -> Path:
-    """``out`` (a file to write or refresh) checked before the run starts."""
-    if out.is_dir():
-        raise UsageError(f"--out {out}: is a directory; give a file name (e.g. scenes.md)")
-    parent = out.parent
-    if parent.exists() and not parent.is_dir():
-        raise UsageError(f"--out {out}: {parent} is not a directory")
-    try:
-        parent.mkdir(parents=True, exist_ok=True)
-        with tempfile.TemporaryFile(dir=parent):
-            pass
-    except OSError as exc:
-        raise UsageError(f"--out {out}: cannot write in {parent}: {exc.strerror or exc}") from None
-    if out.exists() and not os.access(out, os.W_OK):
-        raise UsageError(f"--out {out}: not writable")
-    return out
-
-
 def _fmu(args) -> Path:
     """The FMU to run, checked (or built) before anything is written."""
     from .runner import ensure_fmu
@@ -88,12 +58,19 @@ def _run(args) -> int:
     from .runner import SceneInterrupted, run_scene
 
     scene = load_scene(args.file)
-    out = _output_dir(Path(args.out) if args.out else Path("scene-results") / scene.stem)
-    fmu = _fmu(args)
+    out = check_output_dir(Path(args.out) if args.out else Path("scene-results") / scene.stem)
     suffix = "_all_on" if args.all_on else ""
     table = out / f"{scene.stem}{suffix}.csv"
     summary = out / f"{scene.stem}{suffix}_summary.csv"
-    with DropWriter(table, scene) as writer:  # each finished drop is on disk before the next starts
+    plot = None if args.no_plot else out / f"{scene.stem}{suffix}.png"
+    for path in (table, summary, plot):  # before any work: a regular file or nothing
+        if path is not None:
+            check_output(path)
+    fmu = _fmu(args)
+    # Each finished drop is on disk (fsynced) before the next starts; the CSV is kept with the drops
+    # that finished, whatever stops the run, except on an I/O error (writing it or the summary): then
+    # both files that were there before stay as they were.
+    with DropWriter(table, scene) as writer:
         try:
             result = run_scene(scene, fmu=fmu, effects="all_on" if args.all_on else "scene",
                                zener_method=args.zener_method, progress=False if args.no_progress else None,
@@ -103,9 +80,14 @@ def _run(args) -> int:
             print(f"interrupted: {len(exc.result.drops)} of {exc.n_drops} drops finished and written to {table} "
                   f"and {summary}; {exc.n_drops - len(exc.result.drops)} drops missing", file=sys.stderr)
             return EXIT_INTERRUPTED
-    written = [table, result.write_summary_csv(summary)]
-    if not args.no_plot:
-        written.append(result.plot(out / f"{scene.stem}{suffix}.png"))
+        result.write_summary_csv(summary)
+    written = [table, summary]
+    if plot is not None:
+        try:
+            written.append(result.plot(plot))
+        except OSError as exc:
+            print(f"error: {describe_os_error(exc)}; wrote {table} and {summary}", file=sys.stderr)
+            return EXIT_IO_ERROR
     print(result.summary())
     print("wrote " + ", ".join(str(p) for p in written))
     for warning in (result.warning(), result.rest_warning()):
@@ -126,7 +108,7 @@ def _report(args) -> int:
     for path in args.files:  # every scene loads before any runs
         load_scene(path)
     if args.out is not None:
-        _output_file(args.out)
+        check_output(args.out)
     fmu = _fmu(args)
     reports, table = write_report(args.files, out=args.out, fmu=fmu, repeat=args.repeat, methods=methods,
                                   progress=False if args.no_progress else None,
@@ -182,9 +164,12 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     try:
         return args.func(args)
-    except (SceneError, BuildError, UsageError) as exc:
+    except (SceneError, BuildError, UsageError, OutputPathError) as exc:
         print(f"error: {exc}", file=sys.stderr)
-        return 2
+        return EXIT_REFUSED
+    except OSError as exc:  # an I/O error (ENOSPC, EIO, EACCES, ...): nothing half written under an output's name
+        print(f"error: {describe_os_error(exc)}", file=sys.stderr)
+        return EXIT_IO_ERROR
     except KeyboardInterrupt:  # outside the drops (FMU build or load, report): nothing finished to keep
         print("\ninterrupted", file=sys.stderr)
         return EXIT_INTERRUPTED

@@ -6,6 +6,8 @@ from pathlib import Path
 
 import numpy as np
 
+from ..output_files import atomic_write
+
 
 def plot_scene(result, path) -> Path:
     """One panel per requested output (bounce heights vs time, COR and contact durations vs speed)."""
@@ -48,8 +50,10 @@ def plot_scene(result, path) -> Path:
                  f"zener_method = {result.zener_method})", fontsize=9)
     fig.tight_layout()
     path = Path(path)
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    try:  # under a temporary name, renamed when whole (restitution.output_files)
+        atomic_write(path, lambda tmp: fig.savefig(tmp, dpi=120), "plot")
+    finally:
+        plt.close(fig)
     return path
 
 

@@ -17,6 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..output_files import atomic_write, check_output
 from .loader import Scene, load_scene
 from .explain import explain
 from .results import READ_OUTPUTS, SceneResult
@@ -189,9 +190,13 @@ def markdown(reports, repeat: int) -> str:
 def write_report(paths, out=None, fmu=None, repeat: int = 3, methods=None, progress=None, log=print):
     """Run every scene file in ``paths`` and write/refresh the table in ``out`` (Markdown).
 
-    If ``out`` exists and holds the report markers, only the text between them is replaced.
+    If ``out`` exists and holds the report markers, only the text between them is replaced; the file
+    is written under a temporary name and renamed when whole, and ``out`` must be a regular file or
+    nothing (:func:`restitution.output_files.check_output`, before any scene runs).
     Returns the list of :class:`SceneReport`.
     """
+    if out is not None:
+        check_output(out, "out")  # before any scene runs
     fmu_path = ensure_fmu(fmu, log=log)
     scenes = [load_scene(p) for p in paths]
     instance = open_instance(fmu_path)
@@ -212,11 +217,12 @@ def write_report(paths, out=None, fmu=None, repeat: int = 3, methods=None, progr
     if out is not None:
         out = Path(out)
         block = f"{MARK_START}\n{table}{MARK_END}\n"
+        check_output(out, "out")  # a regular file or nothing: never read from a FIFO or a device
         if out.exists() and MARK_START in (text := out.read_text()) and MARK_END in text:
             before, rest = text.split(MARK_START, 1)
             after = rest.split(MARK_END, 1)[1].lstrip("\n")
-            out.write_text(before + block + ("\n" + after if after else ""))
+            text = before + block + ("\n" + after if after else "")
         else:
-            out.parent.mkdir(parents=True, exist_ok=True)
-            out.write_text(f"# Scenes: what skipping effects saves\n\n{block}")
+            text = f"# Scenes: what skipping effects saves\n\n{block}"
+        atomic_write(out, lambda tmp: Path(tmp).write_text(text), "report")
     return reports, table

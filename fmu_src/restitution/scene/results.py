@@ -4,7 +4,7 @@ CSVs), and the per-impact CSV written drop by drop (:class:`DropWriter`)."""
 from __future__ import annotations
 
 import csv
-import os
+import io
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -12,6 +12,7 @@ import numpy as np
 
 from ..cosim.bouncing import Trajectory
 from ..fmu.models.sphere_plate_impact.variables import TABLE
+from ..output_files import GrowingOutput, atomic_write
 from .explain import explain
 from .loader import MAX_BOUNCES, Drop, Scene
 
@@ -159,16 +160,14 @@ class SceneResult:
         return Path(path)
 
     def write_summary_csv(self, path) -> Path:
-        path = Path(path)
-        with path.open("w", newline="") as f:
-            w = csv.writer(f)
-            w.writerow(["ball", "plate", "drop_height_m", "impacts", "rest_time_s", "stop_reason",
-                        "plasticity_impacts", "plate_wave_impacts", "out_of_range_impacts"])
-            for d in self.drops:
-                w.writerow([d.drop.ball.name, d.drop.plate.name, f"{d.drop.drop_height:.9g}", d.n_impacts,
-                            f"{d.rest_time:.9g}", d.stop_reason, int(d.plasticity.sum()), int(d.plate_waves.sum()),
-                            d.out_of_range])
-        return path
+        """One row per drop; written under a temporary name, fsynced and renamed when whole
+        (:func:`restitution.output_files.atomic_write`)."""
+        rows = [["ball", "plate", "drop_height_m", "impacts", "rest_time_s", "stop_reason",
+                 "plasticity_impacts", "plate_wave_impacts", "out_of_range_impacts"]]
+        rows += [[d.drop.ball.name, d.drop.plate.name, f"{d.drop.drop_height:.9g}", d.n_impacts, f"{d.rest_time:.9g}",
+                  d.stop_reason, int(d.plasticity.sum()), int(d.plate_waves.sum()), d.out_of_range] for d in self.drops]
+        text = _csv_text(rows)
+        return atomic_write(path, lambda tmp: Path(tmp).write_text(text, encoding="utf-8", newline=""), "summary CSV")
 
     def summary(self) -> str:
         """Text table of the drops and of what was left out and why."""
@@ -205,36 +204,49 @@ class SceneResult:
 
 
 class DropWriter:
-    """The per-impact CSV of a scene, written drop by drop: each finished drop's rows are on
-    disk (flushed and fsynced) before the next drop starts, so an interrupt loses none."""
+    """The per-impact CSV of a scene, written drop by drop: each finished drop's rows are written at
+    once and fsynced before the next drop starts, so an interrupt loses none, and the file under
+    ``path`` only ever holds whole drops (:class:`restitution.output_files.GrowingOutput`). It appears
+    under ``path`` with the first finished drop; until then, the file that was there stays.
+
+    Leaving the ``with`` block keeps the file (finished drops included, whatever stopped the run),
+    except after an I/O error (an ``OSError``, e.g. writing the summary on a full disk): then the file
+    that was under ``path`` before is put back, or the new one removed."""
 
     def __init__(self, path, scene: Scene):
         self.path = Path(path)
         self.cols = [c for out in scene.outputs for c in READ_OUTPUTS[out][1]]
-        self.file = self.path.open("w", newline="")
-        self.csv = csv.writer(self.file)
-        self.csv.writerow(["ball", "plate", "drop_height_m", "impact", "time_s", "v_approach_m_s",
-                           *(COLUMNS[c] for c in self.cols), "plasticity", "plate_waves", *VALIDITY])
-        self._sync()
+        self.out = GrowingOutput(self.path, _csv_text([["ball", "plate", "drop_height_m", "impact", "time_s",
+                                                        "v_approach_m_s", *(COLUMNS[c] for c in self.cols),
+                                                        "plasticity", "plate_waves", *VALIDITY]]), "CSV")
 
     def write(self, d: DropResult) -> None:
         flags = [d.validity.get(name, np.ones(d.n_impacts, bool)) for name in VALIDITY]
-        for i in range(d.n_impacts):
-            self.csv.writerow([d.drop.ball.name, d.drop.plate.name, f"{d.drop.drop_height:.9g}", i + 1,
-                               f"{d.time[i]:.12g}", f"{d.v_approach[i]:.12g}",
-                               *(f"{d.columns[c][i]:.12g}" for c in self.cols),
-                               int(d.plasticity[i]), int(d.plate_waves[i]), *(int(f[i]) for f in flags)])
-        self._sync()
-
-    def _sync(self):
-        self.file.flush()
-        os.fsync(self.file.fileno())
+        self.out.append(_csv_text(
+            [d.drop.ball.name, d.drop.plate.name, f"{d.drop.drop_height:.9g}", i + 1, f"{d.time[i]:.12g}",
+             f"{d.v_approach[i]:.12g}", *(f"{d.columns[c][i]:.12g}" for c in self.cols),
+             int(d.plasticity[i]), int(d.plate_waves[i]), *(int(f[i]) for f in flags)]
+            for i in range(d.n_impacts)))
 
     def close(self):
-        self.file.close()
+        """Keep the file (OutputWriteError if its last fsync or rename fails: the old one is put back)."""
+        self.out.commit()
+
+    def discard(self):
+        """Put back the file that was under ``path`` (or remove the new one)."""
+        self.out.rollback()
 
     def __enter__(self):
         return self
 
-    def __exit__(self, *exc):
-        self.close()
+    def __exit__(self, exc_type, exc, tb):
+        if exc_type is not None and issubclass(exc_type, OSError):
+            self.discard()
+        else:
+            self.close()
+
+
+def _csv_text(rows) -> str:
+    buffer = io.StringIO()
+    csv.writer(buffer).writerows(rows)
+    return buffer.getvalue()

@@ -226,6 +226,10 @@ def run_scene(scene: Scene, fmu=None, *, effects: str = "scene", zener_method: s
     except KeyboardInterrupt:
         _final_line(bar, progress, scene, method, results, len(drops), start, "interrupted")
         raise SceneInterrupted(result(), len(drops)) from None
+    except BaseException:  # an I/O error writing a drop, ...: the bar is cleared, the error gets its own line
+        if bar is not None:
+            bar.close()
+        raise
     finally:
         if own:
             instance.close()

@@ -5,10 +5,11 @@ import argparse
 import contextlib
 import os
 import sys
-import tempfile
 from pathlib import Path
 
 from ..materials_table import text as materials_text
+from ..output_files import (EXIT_IO_ERROR, EXIT_REFUSED, OutputPathError, OutputWriteError,
+                            check_output, describe_os_error)
 from .spec import CODES, INPUT_NAMES, INPUTS, MAX_SAMPLES, MAX_SEED, T_OVER_D, SweepSpec, canonical_name, load_spec
 
 #: Exit status of an interrupted sweep (128 + SIGINT, as a shell reports Ctrl-C).
@@ -46,22 +47,16 @@ def _bytes_arg(text: str) -> int:
     return int(value)
 
 
-def check_output(path: Path, what: str = "--out") -> None:
-    """ValueError (one line) unless ``path`` can be written: not a directory, its parent a
-    writable directory (created if missing). Checked before the run starts."""
-    if path.is_dir():
-        raise ValueError(f"{what} {path}: is a directory; give a file name (.csv or .parquet)")
-    if path.parent.exists() and not path.parent.is_dir():
-        raise ValueError(f"{what} {path}: {path.parent} is not a directory")
-    parent = path.parent
-    try:
-        parent.mkdir(parents=True, exist_ok=True)
-        with tempfile.TemporaryFile(dir=parent):  # a real write: permission bits lie to root
-            pass
-    except OSError as exc:
-        raise ValueError(f"{what} {path}: cannot write in {parent}: {exc.strerror or exc}") from None
-    if path.exists() and not os.access(path, os.W_OK):
-        raise ValueError(f"{what} {path}: not writable")
+def _error(text: str, status: int) -> int:
+    """One line on stderr, no usage: the error is about a file, not about how the command is called."""
+    print(f"python -m restitution.sweep: error: {text}", file=sys.stderr, flush=True)
+    return status
+
+
+def _kept(parts: Path) -> str:
+    n = sum(1 for _ in parts.glob("*/chunk-*.npz")) if parts.is_dir() else 0
+    return f"the {n:,} finished chunk(s) are kept in {parts}" if n else f"no finished chunk is kept in {parts}"
+
 
 EXAMPLES = """examples:
   # e over speed and t/d for two material pairs, on a local Dask cluster (one worker per core)
@@ -178,6 +173,8 @@ def main(argv=None) -> int:
     except KeyboardInterrupt:  # outside the sweep itself (which writes what is done): nothing to keep
         print("\ninterrupted before the sweep started or after its table was written", file=sys.stderr)
         return EXIT_INTERRUPTED
+    except OSError as exc:  # an I/O error outside the outputs (the FMU extracted to a full /tmp, ...)
+        return _error(describe_os_error(exc), EXIT_IO_ERROR)
 
 
 def _main(parser, args) -> int:
@@ -217,6 +214,9 @@ def _main(parser, args) -> int:
         except ModuleNotFoundError:
             out = "sweep.csv"
     out = Path(out)
+    if out.name in ("", ".."):  # ".", "/", "..": no file name to write (nor to derive the map's from)
+        return _error(f"--out {out}: is a directory, not a regular file; give the name of a file to write "
+                      f"(.csv or .parquet)", EXIT_REFUSED)
     if out.suffix.lower() == ".parquet":
         try:
             import pyarrow  # noqa: F401
@@ -241,10 +241,16 @@ def _main(parser, args) -> int:
         return 0
     try:
         check_output(out)
-        if parts.exists() and not parts.is_dir():
-            raise ValueError(f"--out {out}: {parts} (where finished chunks go) exists and is not a directory")
+        for where in (parts, *(parts / name for name in ("package", "fmu"))):
+            if os.path.lexists(where) and not where.is_dir():
+                raise OutputPathError(f"--out {out}: {where} (where finished chunks go) exists and is not a directory")
         if plot is not None and not plan.stream:
             check_output(plot, "--plot")
+            if os.path.realpath(plot) == os.path.realpath(out):
+                raise OutputPathError(f"--plot {plot}: is the table's file (--out {out}); give another name")
+    except OutputPathError as exc:
+        return _error(str(exc), EXIT_REFUSED)
+    try:
         if backend in ("fmu", "both") and fmu is not None:
             from .backends import check_impact_fmu
             fmu = check_impact_fmu(fmu)
@@ -259,7 +265,7 @@ def _main(parser, args) -> int:
             parser.error(str(exc))
 
     from .cluster import open_client
-    from .parts import ResumeError
+    from .parts import PartError, ResumeError
     from .run import SweepInterrupted, run_sweep
 
     if plan.stream:
@@ -290,12 +296,20 @@ def _main(parser, args) -> int:
             print(f"\ninterrupted again while writing {out}: nothing written there; the finished chunks are "
                   f"kept in {parts}: run the same command with --resume", file=sys.stderr)
             return EXIT_INTERRUPTED
+        except (OutputWriteError, OutputPathError, PartError) as err:
+            return _error(f"interrupted, then {err}; {_kept(parts)}: run the same command with --resume",
+                          EXIT_REFUSED if isinstance(err, OutputPathError) else EXIT_IO_ERROR)
         print(f"\ninterrupted: wrote the {len(exc.result):,} finished cases to {written}; {exc.missing:,} of "
               f"{spec.n_cases:,} cases are missing (finished chunks kept in {parts}); run the same command "
               f"with --resume to complete them", file=sys.stderr)
         return EXIT_INTERRUPTED
-    except ResumeError as exc:  # --resume on another sweep's parts
-        parser.error(str(exc))
+    except ResumeError as exc:  # --resume on another sweep's parts, or a damaged part that cannot be removed
+        return _error(str(exc), EXIT_REFUSED)
+    except OutputPathError as exc:  # a part's name turned into a device or a directory during the run
+        return _error(f"{exc}; {_kept(parts)}", EXIT_REFUSED)
+    except OutputWriteError as exc:  # a part or the manifest: the chunks written before it stay
+        return _error(f"{exc}; {_kept(parts)}: run the same command with --resume once it can be written",
+                      EXIT_IO_ERROR)
     if backend == "both":
         from .compare import agreement_report
 
@@ -315,6 +329,10 @@ def _main(parser, args) -> int:
         print(f"\ninterrupted while writing {out}: nothing written there; every chunk is kept in {parts}: "
               f"run the same command with --resume to write the table", file=sys.stderr)
         return EXIT_INTERRUPTED
+    except (OutputWriteError, OutputPathError, PartError) as exc:
+        status = EXIT_REFUSED if isinstance(exc, OutputPathError) else EXIT_IO_ERROR
+        return _error(f"{exc}; nothing written there, every chunk is kept in {parts}: run the same command "
+                      f"with --resume to write the table", status)
     import shutil
 
     shutil.rmtree(parts, ignore_errors=True)  # the table is whole: the finished chunks are not needed
@@ -329,6 +347,9 @@ def _main(parser, args) -> int:
             print(f"COR map: {result.plot(plot)}")
         except ModuleNotFoundError as exc:
             print(f"no COR map ({exc}; pip install matplotlib)", file=sys.stderr)
+        except (OutputWriteError, OutputPathError) as exc:
+            status = EXIT_REFUSED if isinstance(exc, OutputPathError) else EXIT_IO_ERROR
+            return _error(f"{exc}; the table was written to {out}", status)
     return status
 
 

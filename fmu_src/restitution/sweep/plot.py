@@ -6,6 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..output_files import atomic_write
 from .spec import pair_label
 
 __all__ = ["plot_cor_map"]
@@ -184,7 +185,8 @@ def plot_cor_map(result, path, title: str | None = None, dpi: int = 120) -> Path
             title += "; red marks: outside the validated range"
     fit_title(fig, title, fontsize=10)
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=dpi)
-    plt.close(fig)
+    try:  # under a temporary name, renamed when whole (restitution.output_files)
+        atomic_write(path, lambda tmp: fig.savefig(tmp, dpi=dpi), "COR map")
+    finally:
+        plt.close(fig)
     return path

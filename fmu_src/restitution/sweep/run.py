@@ -13,10 +13,13 @@ finished chunk comes back as one buffer (:class:`~restitution.sweep.table.Packed
 table is joined from the chunks once they are all in.
 
 With ``parts=DIR`` every finished chunk is written to DIR as it completes (one ``.npz`` file a
-chunk, written under a temporary name and renamed, so a file there is always whole), beside a
-``manifest.json`` naming the spec, back end, chunk size and columns. An interrupt (Ctrl-C) then
+chunk, written under a temporary name, fsynced and renamed, holding its case range and the sha256 of
+its columns, :mod:`restitution.sweep.parts`), beside a ``manifest.json`` naming the spec, back end,
+chunk size and columns. An I/O error writing one raises
+:class:`~restitution.output_files.OutputWriteError` and keeps the chunks already written. An interrupt (Ctrl-C) then
 raises :class:`SweepInterrupted` carrying the table of the finished chunks, and
-``resume=True`` on the same DIR evaluates only the chunks that are missing. With
+``resume=True`` on the same DIR checks every part and evaluates only the chunks that are missing
+or damaged (a damaged part is removed, one line on stderr). With
 ``in_memory=False`` as well, nothing but counts stays in memory: the result's :meth:`~SweepResult.write`
 streams the table from DIR chunk by chunk (for tables bigger than the memory budget, see
 :func:`restitution.sweep.size.plan_size`).
@@ -133,6 +136,9 @@ def run_sweep(spec: SweepSpec | dict, backend: str | Backend = "package", *, fmu
         except KeyboardInterrupt:
             bar.close(len(run.done))
             raise run.interrupted() from None
+        except BaseException:  # an I/O error writing a part, ...: the error goes on a line of its own
+            bar.abandon()
+            raise
         finally:
             if isinstance(backend, FmuBackend) and release:
                 release_fmus()
@@ -188,6 +194,9 @@ def run_sweep(spec: SweepSpec | dict, backend: str | Backend = "package", *, fmu
             with contextlib.suppress(Exception):
                 client.cancel(list(futures.values()))
             raise run.interrupted() from None
+        except BaseException:
+            bar.abandon()
+            raise
         finally:
             with contextlib.suppress(Exception):
                 client.cancel(list(futures.values()))
@@ -283,6 +292,12 @@ class _Progress:
         if self.tty and time.perf_counter() - self.t0 >= 1.0:
             print(f"\r[{self.label}] {done}/{self.total} chunks", end="", file=sys.stderr, flush=True)
             self.drawn = True
+
+    def abandon(self) -> None:
+        """End a redrawn line (an error follows on its own line)."""
+        if self.drawn:
+            print(file=sys.stderr, flush=True)
+            self.drawn = False
 
     def close(self, done: int) -> None:
         if not self.enabled:

@@ -2,14 +2,13 @@
 temporary name renamed when whole), and reading a written table back."""
 from __future__ import annotations
 
-import contextlib
 import math
-import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
+from ..output_files import atomic_write as write_atomic
 from .spec import INPUT_NAMES, INTEGER_INPUTS, OUTPUT_NAMES, OUTPUTS as _OUTPUT_TYPES, T_OVER_D, SweepSpec
 
 __all__ = ["COLUMNS", "VALIDITY", "SweepResult", "PackedColumns", "read_table", "table_counts", "assemble",
@@ -183,9 +182,11 @@ class SweepResult:
 
     # --- output ---
     def write(self, path) -> Path:
-        """Write the table: ``.parquet`` (needs pyarrow) or ``.csv``, under a temporary name renamed
-        when whole (an interrupted write leaves no half table)."""
-        return write_atomic(Path(path), lambda tmp: self._write_to(tmp, Path(path).suffix))
+        """Write the table: ``.parquet`` (needs pyarrow) or ``.csv``, under a temporary name, fsynced and
+        renamed when whole (an interrupted or failed write leaves no half table, and the file that was
+        there whole; :func:`restitution.output_files.atomic_write`). An I/O error raises
+        :class:`~restitution.output_files.OutputWriteError` (one line naming ``path``)."""
+        return write_atomic(Path(path), lambda tmp: self._write_to(tmp, Path(path).suffix), "table")
 
     def _write_to(self, path: Path, suffix: str) -> None:
         if suffix.lower() == ".parquet":
@@ -266,19 +267,6 @@ def write_csv_rows(f, columns: dict) -> None:
             else:
                 cols.append([_csv_text(x) for x in col.tolist()])
         f.write("".join(",".join(row) + "\n" for row in zip(*cols)))
-
-
-def write_atomic(path: Path, write) -> Path:
-    """``write(tmp)`` to a temporary file beside ``path``, then renamed to ``path``."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.tmp{os.getpid()}")
-    try:
-        write(tmp)
-        os.replace(tmp, path)
-    finally:
-        with contextlib.suppress(OSError):
-            tmp.unlink()
-    return path
 
 
 def read_table(path) -> dict:
