@@ -15,10 +15,15 @@ The FMU state is exactly the inputs and parameters, tagged with the model, the s
 and the variable list; a state is validated as the setters would before anything is restored.
 
 The module has a name of its own (not ``model``): two pythonfmu FMUs whose scripts share
-a module name clash in one process.
+a module name clash in one process. Which ``restitution`` it runs, and which class pythonfmu
+instantiates, is decided at start-up (restitution_slave_support.py): the FMU's own code, or a copy
+verified to be the same, whatever the host and other FMUs loaded before and whether their folders
+still exist.
 """
 from __future__ import annotations
 
+import hashlib
+import importlib.util
 import math
 import operator
 import os
@@ -27,18 +32,34 @@ import sys
 from pythonfmu import Fmi2Causality, Fmi2Slave, Fmi2Variability, Boolean, Integer, Real
 from pythonfmu.enums import Fmi2Initial, Fmi2Status
 
-# Inside the FMU the bundled package sits next to this script in resources/; put it first
-# so the FMU runs the code it was built with, not whatever the host happens to have.
-_HERE = os.path.dirname(os.path.abspath(__file__))
-if os.path.isdir(os.path.join(_HERE, "restitution")) and sys.path[0] != _HERE:
-    sys.path.insert(0, _HERE)
-
-from restitution.fmu.models.sphere_plate_impact.variables import (  # noqa: E402
-    MATERIAL_SELECTORS, TABLE, resolve_materials)
-from restitution.model import PARAMETERS, impact, published  # noqa: E402
-from restitution.quantities import si_only  # noqa: E402
+# Start-up: which code this instance runs (restitution_slave_support.py says what and why). pythonfmu
+# executes this script twice at each fmi2Instantiate: as an import (only the first time in a process),
+# then with the cached module's globals, whose __file__ may be another FMU's, and this FMU's resources/
+# first on sys.path. Up to settle() at the end, straight-line code only (a function defined here would
+# read the cached module's globals) that cannot raise at the second execution (pythonfmu would crash).
+_here = os.path.dirname(os.path.abspath(__file__)) if globals() is locals() else sys.path[0]
+_resources = _here if os.path.isfile(os.path.join(_here, "slavemodule.txt")) else None  # None: not in an FMU
+if _resources is not None:  # the support module this FMU ships, unless the one loaded has the same source
+    _path = os.path.join(_resources, "restitution_slave_support.py")
+    with open(_path, "rb") as _file:
+        _source = hashlib.sha256(_file.read()).hexdigest()
+    if getattr(sys.modules.get("restitution_slave_support"), "SOURCE_SHA256", None) != _source:
+        _spec = importlib.util.spec_from_file_location("restitution_slave_support", _path)
+        _support = importlib.util.module_from_spec(_spec)
+        _spec.loader.exec_module(_support)
+        sys.modules[_spec.name] = _support
+import restitution_slave_support as _support  # noqa: E402 (the one just loaded, or the importable one)
 from restitution_slave_support import (checked_setter, restore_state, state_check,  # noqa: E402
                                        state_from_bytes, state_schema, state_to_bytes)
+
+# the package this instance runs: the one the FMU ships, or a copy of the same code
+_restitution = _support.start(globals(), locals(), "SpherePlateImpact", _resources)
+_variables = _support.submodule(_restitution, "fmu.models.sphere_plate_impact.variables")
+MATERIAL_SELECTORS, TABLE = _variables.MATERIAL_SELECTORS, _variables.TABLE
+resolve_materials = _variables.resolve_materials
+_model = _support.submodule(_restitution, "model")
+PARAMETERS, impact, published = _model.PARAMETERS, _model.impact, _model.published
+si_only = _support.submodule(_restitution, "quantities").si_only
 
 #: FMU name of each Real output, by ImpactResult key
 _REAL_OUTPUTS = {v.key: v.name for v in TABLE.outputs if v.type == "Real"}
@@ -248,3 +269,6 @@ class SpherePlateImpact(Fmi2Slave):
 
     _fmu_state_to_bytes = staticmethod(state_to_bytes)
     _fmu_state_from_bytes = staticmethod(state_from_bytes)
+
+
+_support.settle(globals(), locals(), "SpherePlateImpact")
