@@ -71,8 +71,8 @@ def tolerances(v, params: dict, **options) -> tuple[dict, dict]:
         shifted = []
         for factor in (1.0 + STEP, 1.0 - STEP):
             moved = dict(values, **{name: values[name] * factor})
-            if name.endswith("_nu"):  # keep nu < 0.5: a relative step of nu near 0.5 stays inside
-                moved[name] = np.minimum(moved[name], np.nextafter(0.5, 0.0))
+            if name.endswith("_nu"):  # keep nu <= 0.5: a relative step of nu near 0.5 stays inside
+                moved[name] = np.minimum(moved[name], 0.5)
             shifted.append(impact(moved["v"], **{k: moved[k] for k in _INPUTS[1:]}, **probe))
         up, down = shifted
         for out in REALS:

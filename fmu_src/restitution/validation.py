@@ -44,11 +44,12 @@ def check_nonnegative(name: str, value, unit: str = ""):
 
 
 def check_poisson(name: str, value):
-    """Require a Poisson's ratio in [0, 0.5) (0.5, incompressible, makes E' infinite)."""
-    if value.__class__ is float and 0.0 <= value < 0.5:  # fast path, same result
+    """Require a Poisson's ratio in [0, 0.5] (0.5: incompressible; the model uses nu only through
+    E' = E/(1 - nu^2), Eq. 1, and C(nu), Eq. 2, both finite there)."""
+    if value.__class__ is float and 0.0 <= value <= 0.5:  # fast path, same result
         return value
-    return _check(name, value, "", lambda v: 0.0 <= v < 0.5,
-                  lambda a: (a >= 0.0) & (a < 0.5), "0 <= nu < 0.5")
+    return _check(name, value, "", lambda v: 0.0 <= v <= 0.5,
+                  lambda a: (a >= 0.0) & (a <= 0.5), "0 <= nu <= 0.5")
 
 
 def check_choice(name: str, value, choices):

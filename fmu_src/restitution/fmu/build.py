@@ -9,7 +9,11 @@ the installed ``restitution`` package (the same source ``pip install`` installs)
   and UnitDefinitions, descriptions, min/max, and a ModelStructure that declares each
   output's direct dependence on the input (direct feedthrough) and the InitialUnknowns;
   value references, names and types are left as pythonfmu wrote them, since the binary
-  never reads the XML;
+  never reads the XML; and what pythonfmu writes anew in every build: the GUID becomes the
+  model's instantiation token (:meth:`restitution.fmu.table.Table.instantiation_token`: a hash
+  of the interface table and the version, shared with the native FMUs; pythonfmu's binary does
+  not compare GUIDs, the guard does, against this one), ``generationDateAndTime`` comes from
+  SOURCE_DATE_EPOCH or is left out, so two builds of the same sources write the same file;
 * records a hash of the sources it was built from (``resources/build_info.json``), which
   :func:`default_fmu` compares to decide whether an FMU is stale;
 * puts the guard in front of pythonfmu's Linux binary (``build_guard.make_standalone``: the C FMI
@@ -34,6 +38,7 @@ from xml.etree import ElementTree as ET
 
 from ..about import AUTHOR, COPYRIGHT, LICENSE, VERSION
 from .documentation import license_files
+from .model_description3 import generation_date_and_time
 from .models import FOLDERS, SLAVE_SUPPORT, slave_script, table
 from .sources import BUILD_INFO, PACKAGE, bundle_filter, recorded_source_hash, source_hash
 from .table import UNITS
@@ -52,11 +57,18 @@ PARAMETER_CAUSALITIES = ("parameter", "input")
 def complete_model_description(xml_text: str, table) -> str:
     """modelDescription.xml with the package's version, author, copyright and license, and units,
     descriptions, limits and a full ModelStructure, from the model's interface ``table`` (:class:`restitution.fmu.table.Table`): each output's dependence on
-    the inputs is its ``feedthrough``."""
+    the inputs is its ``feedthrough``. The GUID is the table's instantiation token (pythonfmu writes a
+    new random one each time) and ``generationDateAndTime`` is SOURCE_DATE_EPOCH's, or absent
+    (:func:`restitution.fmu.model_description3.generation_date_and_time`)."""
     root = ET.fromstring(xml_text)
-    for attribute, value in (("author", AUTHOR), ("version", VERSION), ("copyright", COPYRIGHT),
-                             ("license", LICENSE)):
+    for attribute, value in (("guid", table.instantiation_token(VERSION)), ("author", AUTHOR), ("version", VERSION),
+                             ("copyright", COPYRIGHT), ("license", LICENSE)):
         root.set(attribute, value)
+    date = generation_date_and_time()
+    if date is None:
+        root.attrib.pop("generationDateAndTime", None)
+    else:
+        root.set("generationDateAndTime", date)
     model_variables = root.find("ModelVariables")
     scalar_variables = list(model_variables)
     index = {sv.get("name"): i + 1 for i, sv in enumerate(scalar_variables)}
@@ -108,7 +120,10 @@ def complete_model_description(xml_text: str, table) -> str:
     for var in table.derivatives:  # may depend on every state, parameter and input (no dependencies given)
         ET.SubElement(derivatives, "Unknown", {"index": str(index[var.name])})
     for var in table.initial_unknowns:
-        ET.SubElement(initial, "Unknown", {"index": str(index[var.name])})
+        attrs = {"index": str(index[var.name])}
+        if var.initial_dependencies is not None:
+            attrs["dependencies"] = " ".join(str(i) for i in sorted(index[name] for name in var.initial_dependencies))
+        ET.SubElement(initial, "Unknown", attrs)
     for element in root.iter():
         if element.text is not None and not element.text.strip():
             element.text = None
@@ -185,6 +200,10 @@ def build_one(model: str, out_dir: Path, standalone: bool = True, log=None) -> P
         def log(message):
             print(message, file=sys.stderr)
     FmuBuilder, validate_fmu = _require_build_tools()
+    try:
+        generation_date_and_time()  # a malformed SOURCE_DATE_EPOCH stops the build before anything is built
+    except ValueError as exc:
+        raise BuildError(str(exc)) from None
     script = FMUS[model]
     out_dir = _writable_dir(out_dir)
     with tempfile.TemporaryDirectory(prefix=f".{model}-build-", dir=out_dir) as tmp:

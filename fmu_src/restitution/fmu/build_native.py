@@ -26,6 +26,7 @@ import zipfile
 from pathlib import Path
 from xml.etree import ElementTree as ET
 
+from ..about import VERSION
 from .compile import CFLAGS, PHYSICS_SOURCES, prepare_sources
 from .documentation import license_files
 from . import model_description3
@@ -118,6 +119,18 @@ MODEL_EXCHANGE = {"needsExecutionTool": "false", "completedIntegratorStepNotNeed
                   "canGetAndSetFMUstate": "true", "canSerializeFMUstate": "true"}
 
 
+def _declare_native_limits(root: ET.Element, model_table) -> None:
+    """min and max of the variables whose native range is narrower (what the C does not offer)."""
+    for sv in root.find("ModelVariables"):
+        name = sv.get("name")
+        if name in model_table and model_table[name].native_interval is not None:
+            low, high = model_table[name].xml_limits(native=True)
+            node = next(iter(sv))
+            for attribute, text in (("min", low), ("max", high)):
+                if text is not None:
+                    node.set(attribute, str(int(float(text))) if model_table[name].type == "Integer" else text)
+
+
 def native_model_description(xml_text: str, c_files: list[str], model_table=None) -> str:
     """The pythonfmu FMU's modelDescription.xml for the native FMU: same interface, C sources declared,
     and, given the model's interface table, model exchange offered beside co-simulation (its number
@@ -132,6 +145,7 @@ def native_model_description(xml_text: str, c_files: list[str], model_table=None
         cosim.remove(old)
     parts = [cosim]
     if model_table is not None:
+        _declare_native_limits(root, model_table)
         root.set("numberOfEventIndicators", str(len(model_table.event_indicators)))
         exchange = ET.Element("ModelExchange", {"modelIdentifier": cosim.get("modelIdentifier"), **MODEL_EXCHANGE})
         root.insert(list(root).index(cosim), exchange)  # FMI 2.0 order: ModelExchange, then CoSimulation
@@ -173,7 +187,8 @@ def _zip_dir(directory: Path, fmu: Path) -> None:
 def build_native_one(model: str, out_dir: Path, python_fmu: Path, log=None, fmi_version: str = "2.0") -> Path:
     """Build and validate ``out_dir/native/<model>.fmu`` (FMI 2.0) or ``out_dir/fmi3/<model>.fmu``
     (FMI 3.0) beside the pythonfmu ``python_fmu``, whose GUID both carry (FMI 3.0: as the instantiation
-    token) and whose modelDescription the FMI 2.0 one reuses."""
+    token), the model's :meth:`~restitution.fmu.table.Table.instantiation_token` (a ``python_fmu`` of
+    another interface or version is refused), and whose modelDescription the FMI 2.0 one reuses."""
     from fmpy.validation import validate_fmu
 
     log = log or (lambda message: print(message, file=sys.stderr))
@@ -188,10 +203,13 @@ def build_native_one(model: str, out_dir: Path, python_fmu: Path, log=None, fmi_
             raise NativeBuildSkipped(f"{python_fmu} missing: the native FMU takes its GUID from it")
         with zipfile.ZipFile(python_fmu) as z:
             xml = z.read("modelDescription.xml").decode("utf-8")
+        token = table(model).instantiation_token(VERSION)
+        if model_info(xml)[1] != token:
+            raise NativeBuildSkipped(f"{python_fmu} is of another interface or version (its GUID is not {token}): rebuild it")
         if fmi_version == "2.0":
             description = native_model_description(xml, c_files, table(model))
         else:
-            description = model_description3.model_description(model, model_info(xml)[1])
+            description = model_description3.model_description(model, token)
             (sources / "buildDescription.xml").write_text(model_description3.build_description(model, c_files),
                                                           encoding="utf-8")
         (stage / "modelDescription.xml").write_text(description, encoding="utf-8")

@@ -23,6 +23,7 @@ Pure data in, text out: no compiler, no fmpy (tests validate the result against 
 from __future__ import annotations
 
 import math
+import os
 import re
 from datetime import datetime, timezone
 from xml.etree import ElementTree as ET
@@ -31,7 +32,8 @@ from ..about import AUTHOR, COPYRIGHT, LICENSE, VERSION
 from .models import table as _table
 from .table import UNITS, Table, Variable
 
-__all__ = ["model_description", "build_description", "enumeration_type", "TIME_NAME", "GENERATION_TOOL"]
+__all__ = ["model_description", "build_description", "enumeration_type", "generation_date_and_time", "TIME_NAME",
+           "GENERATION_TOOL"]
 
 GENERATION_TOOL = "restitution native build (C99 front + native physics)"
 #: The independent variable every FMI 3.0 FMU must have (its value reference: ``len(table)``).
@@ -97,6 +99,23 @@ def _enumeration_types(table: Table) -> dict[str, Variable]:
     return types
 
 
+def generation_date_and_time(environ=None) -> str | None:
+    """The ``generationDateAndTime`` of every modelDescription the build writes (FMI 2.0 and 3.0): the
+    time in ``SOURCE_DATE_EPOCH`` (seconds since 1970-01-01 UTC, https://reproducible-builds.org/specs/source-date-epoch/)
+    in the form the standard recommends (UTC, whole seconds, "Z": ``2026-11-25T10:00:00Z``); None where
+    it is unset or empty, and the attribute (optional) is then left out, so that two builds of the same
+    sources write the same files. ValueError for a value that is not a whole number of seconds."""
+    text = (os.environ if environ is None else environ).get("SOURCE_DATE_EPOCH", "").strip()
+    if not text:
+        return None
+    if not re.fullmatch(r"[0-9]+", text):
+        raise ValueError(f"SOURCE_DATE_EPOCH={text!r} is not a whole number of seconds since 1970-01-01 UTC")
+    try:
+        return datetime.fromtimestamp(int(text), timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
+    except (OverflowError, OSError, ValueError):
+        raise ValueError(f"SOURCE_DATE_EPOCH={text} is beyond the dates a modelDescription can state") from None
+
+
 def _float(value) -> str:
     """A Float64 attribute: the shortest text that reads back as the same double (Python's repr, the
     'minimal printer' the standard recommends), so a start value survives the XML exactly."""
@@ -132,7 +151,7 @@ def _variable(parent: ET.Element, row: Variable, table: Table) -> None:
     if row.derivative is not None:
         attrs["derivative"] = str(table[row.derivative].vr)
     if row.causality in PARAMETER_CAUSALITIES:
-        low, high = row.xml_limits()
+        low, high = row.xml_limits(native=True)  # every FMI 3.0 FMU is native
         if low is not None:
             attrs["min"] = _limit(row, low)
         if high is not None:
@@ -170,8 +189,8 @@ def _type_definitions(table: Table) -> ET.Element | None:
 def _model_structure(table: Table) -> ET.Element:
     """Outputs with their direct dependence on the inputs (``feedthrough``: every input, else none);
     the state derivatives and event indicators (model exchange); InitialUnknowns as in the FMI 2.0
-    files: the outputs, the state derivatives and the calculated parameters, without dependencies
-    (an absent attribute: may depend on every known)."""
+    files: the outputs, the state derivatives and the calculated parameters, with the dependencies the
+    table declares (``initial_dependencies``; none declared: no attribute, may depend on every known)."""
     node = ET.Element("ModelStructure")
     inputs = [str(row.vr) for row in table.inputs]
     for row in table.outputs:
@@ -182,7 +201,10 @@ def _model_structure(table: Table) -> ET.Element:
     for row in table.derivatives:  # may depend on every state, parameter and input (no dependencies given)
         ET.SubElement(node, "ContinuousStateDerivative", valueReference=str(row.vr))
     for row in table.initial_unknowns:
-        ET.SubElement(node, "InitialUnknown", valueReference=str(row.vr))
+        attrs = {"valueReference": str(row.vr)}
+        if row.initial_dependencies is not None:
+            attrs["dependencies"] = " ".join(str(vr) for vr in sorted(table[name].vr for name in row.initial_dependencies))
+        ET.SubElement(node, "InitialUnknown", attrs)
     for row in table.event_indicators:
         ET.SubElement(node, "EventIndicator", valueReference=str(row.vr))
     return node
@@ -193,28 +215,31 @@ def _text(root: ET.Element) -> str:
     return '<?xml version="1.0" encoding="UTF-8"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
 
 
-def model_description(model: str, instantiation_token: str) -> str:
+def model_description(model: str, instantiation_token: str | None = None) -> str:
     """The FMI 3.0 ``modelDescription.xml`` of ``model``'s native co-simulation FMU, from its interface
     table (:func:`restitution.fmu.models.table`).
 
     ``instantiation_token`` is the string a host passes to fmi3InstantiateCoSimulation and the binary
-    compares with its own (the FMI 2.0 guid's role). Element order is the schema's:
+    compares with its own (the FMI 2.0 guid's role); by default the table's
+    (:meth:`restitution.fmu.table.Table.instantiation_token` of this version), the GUID of the model's
+    FMI 2.0 FMUs. ``generationDateAndTime`` is :func:`generation_date_and_time` (absent without
+    SOURCE_DATE_EPOCH). Element order is the schema's:
     CoSimulation, UnitDefinitions, TypeDefinitions, LogCategories, ModelVariables, ModelStructure (no
     DefaultExperiment: the FMI 2.0 files have none; the host chooses start, stop and step).
     """
     table = _table(model)
+    date = generation_date_and_time()
     root = ET.Element("fmiModelDescription", {
         "fmiVersion": "3.0",
         "modelName": model,
-        "instantiationToken": instantiation_token,
+        "instantiationToken": instantiation_token or table.instantiation_token(VERSION),
         "description": table.description,
         "author": AUTHOR,
         "version": VERSION,
         "copyright": COPYRIGHT,
         "license": LICENSE,
         "generationTool": GENERATION_TOOL,
-        # the form the standard recommends: UTC, whole seconds, "Z"
-        "generationDateAndTime": datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ"),
+        **({"generationDateAndTime": date} if date is not None else {}),
         "variableNamingConvention": "structured",
     })
     ET.SubElement(root, "ModelExchange", {"modelIdentifier": model, **MODEL_EXCHANGE})

@@ -8,8 +8,11 @@ its physics. Shipped inside the pythonfmu FMUs with the physics (the slaves read
 """
 from __future__ import annotations
 
+import hashlib
+import json
 import math
-from dataclasses import dataclass, replace
+import uuid
+from dataclasses import asdict, dataclass, replace
 
 __all__ = ["Variable", "Table", "parameter", "input_", "output", "local", "calculated_parameter"]
 
@@ -42,8 +45,10 @@ class Variable:
     unit: str | None
     description: str
     start: float | int | bool | None = None
-    #: allowed values of an input or parameter: (low, high, low_open, high_open); an infinite bound is
-    #: open (non-finite values are refused); None for outputs and locals
+    #: allowed values of an input or parameter: (low, high, low_open, high_open); a finite bound is
+    #: closed (the modelDescription declares it as min or max, which FMI reads as inclusive: the declared
+    #: range is the accepted range), an infinite bound open (non-finite values are refused); None for
+    #: outputs and locals
     interval: tuple | None = None
     #: the allowed range as an error message shows it (None: from the interval)
     range_text: str | None = None
@@ -65,6 +70,12 @@ class Variable:
     derivative: str | None = None
     #: a model-exchange event indicator: the host locates where it crosses zero (a state event)
     event_indicator: bool = False
+    #: the FMU names of the inputs and parameters this initial unknown depends on (the modelDescription's
+    #: InitialUnknowns ``dependencies``); None: it may depend on every known (no attribute)
+    initial_dependencies: tuple[str, ...] | None = None
+    #: the narrower interval the native (C) FMUs accept, where they do not offer all of ``interval``
+    #: (their modelDescriptions declare it); None: the same as ``interval``
+    native_interval: tuple | None = None
 
     @property
     def initial(self) -> str | None:
@@ -111,37 +122,41 @@ class Variable:
             value = int(value)  # ValueError for NaN, OverflowError for inf: the caller refuses the value
         return bool((low < value if low_open else low <= value) and (value < high if high_open else value <= high))
 
-    def xml_limits(self) -> tuple[str | None, str | None]:
-        """The min and max attributes of the modelDescription (None where the bound is infinite)."""
-        low, high = self.interval[:2]
+    def xml_limits(self, native: bool = False) -> tuple[str | None, str | None]:
+        """The min and max attributes of the modelDescription (None where the bound is infinite), of the
+        native FMUs' modelDescriptions where ``native``."""
+        low, high = (self.native_interval if native and self.native_interval is not None else self.interval)[:2]
         return (None if low == -math.inf else f"{low:g}"), (None if high == math.inf else f"{high:g}")
 
 
 def _settable(name, key, vtype, causality, variability, unit, start, description, interval=None, *,
-              choices=None, first_code=1, range_text=None, enumeration=None, item_descriptions=None):
+              choices=None, first_code=1, range_text=None, enumeration=None, item_descriptions=None,
+              native_interval=None):
     if choices is not None:
         interval = (first_code, first_code + len(choices) - 1, False, False)
     if interval is None:
-        interval = (0.0, math.inf, True, True)  # finite and > 0: the usual physical quantity
+        raise ValueError(f"{name}: an input or parameter needs its allowed interval")
     return Variable(name, key, vtype, causality, variability, unit, description, start, tuple(interval), range_text,
                     tuple(choices) if choices is not None else None, first_code, state=True,
-                    enumeration=enumeration, item_descriptions=tuple(item_descriptions) if item_descriptions else None)
+                    enumeration=enumeration, item_descriptions=tuple(item_descriptions) if item_descriptions else None,
+                    native_interval=tuple(native_interval) if native_interval is not None else None)
 
 
 def parameter(name, key, unit, start, description, interval=None, *, vtype="Real", variability="tunable", **kw):
-    """A parameter (tunable unless said otherwise); ``interval`` default: finite and > 0."""
+    """A parameter (tunable unless said otherwise); ``interval`` may be left out only for a choice."""
     return _settable(name, key, vtype, "parameter", variability, unit, start, description, interval, **kw)
 
 
-def input_(name, key, unit, start, description, interval=None, **kw):
-    """A continuous Real input; ``interval`` default: finite and > 0."""
+def input_(name, key, unit, start, description, interval, **kw):
+    """A continuous Real input allowed in ``interval``."""
     return _settable(name, key, "Real", "input", "continuous", unit, start, description, interval, **kw)
 
 
-def output(name, key, unit, description, *, vtype="Real", feedthrough=False, state=False):
+def output(name, key, unit, description, *, vtype="Real", feedthrough=False, state=False, initial_dependencies=None):
     """An output (Reals continuous, Integers and Booleans discrete)."""
     variability = "continuous" if vtype == "Real" else "discrete"
-    return Variable(name, key, vtype, "output", variability, unit, description, feedthrough=feedthrough, state=state)
+    return Variable(name, key, vtype, "output", variability, unit, description, feedthrough=feedthrough, state=state,
+                    initial_dependencies=_names(initial_dependencies))
 
 
 def calculated_parameter(name, key, unit, description):
@@ -149,11 +164,16 @@ def calculated_parameter(name, key, unit, description):
     return Variable(name, key, "Real", "calculatedParameter", "tunable", unit, description)
 
 
-def local(name, key, unit, description, *, state=True, derivative=None, event_indicator=False):
+def local(name, key, unit, description, *, state=True, derivative=None, event_indicator=False,
+          initial_dependencies=None):
     """A continuous Real local variable (one the model evolves: part of the state, unless it is
     recomputed from the others, as a ``derivative`` of a continuous state or an ``event_indicator``)."""
     return Variable(name, key, "Real", "local", "continuous", unit, description, state=state, derivative=derivative,
-                    event_indicator=event_indicator)
+                    event_indicator=event_indicator, initial_dependencies=_names(initial_dependencies))
+
+
+def _names(names):
+    return None if names is None else tuple(names)
 
 
 class Table:
@@ -172,9 +192,40 @@ class Table:
         for row in self.rows:
             if row.type not in TYPES or row.causality not in CAUSALITIES:
                 raise ValueError(f"{model}.{row.name}: unknown type {row.type!r} or causality {row.causality!r}")
+            if row.interval is not None and row.type == "Real":
+                low, high, low_open, high_open = row.interval
+                if (low_open and math.isfinite(low)) or (high_open and math.isfinite(high)):
+                    raise ValueError(f"{model}.{row.name}: a finite bound must be closed (FMI's min and max are "
+                                     "inclusive; declare the smallest or largest value accepted)")
+                if any(text is not None and float(text) != bound for text, bound in zip(row.xml_limits(), (low, high))):
+                    raise ValueError(f"{model}.{row.name}: a bound does not survive its modelDescription text")
+            for known in row.initial_dependencies or ():
+                if known not in self._by_name or self._by_name[known].causality not in ("parameter", "input"):
+                    raise ValueError(f"{model}.{row.name}: initial dependency {known!r} is not an input or parameter")
             if row.derivative is not None and (row.derivative not in self._by_name
                                                or self._by_name[row.derivative].type != "Real"):
                 raise ValueError(f"{model}.{row.name}: derivative of {row.derivative!r}, which is not a Real of the table")
+
+    def instantiation_token(self, version: str) -> str:
+        """The identity of every FMU of this model at the package's ``version``: the FMI 2.0 ``guid`` and
+        the FMI 3.0 ``instantiationToken`` of the pythonfmu FMU and of the native FMI 2.0 and 3.0 ones
+        (the one function the build writes them with), which a host passes back at instantiation and the
+        C front compares. A GUID, ``{xxxxxxxx-xxxx-8xxx-xxxx-xxxxxxxxxxxx}``: the first 16 bytes of the
+        sha256 of the table's canonical text, marked as an RFC 9562 version-8 (custom) UUID. The text
+        is JSON (sorted keys, no spaces, ASCII, floats as Python's repr, inf as Infinity) of the model's
+        name and description, ``version``, every field of every row in value-reference order (what
+        hosts see of a variable and what the FMU's state holds) and the base units of the units used;
+        so the token is the same in every build of the same table and version, and changes with any of
+        them. The model's ``constants`` (material presets: values, not interface) are not part of it."""
+        units = sorted({row.unit for row in self.rows if row.unit is not None})
+        text = json.dumps({"model": self.model, "description": self.description, "version": version,
+                           "rows": [asdict(row) for row in self.rows],
+                           "units": {unit: UNITS.get(unit) for unit in units}},
+                          sort_keys=True, separators=(",", ":"), ensure_ascii=True, allow_nan=True)
+        digest = bytearray(hashlib.sha256(text.encode("ascii")).digest()[:16])
+        digest[6] = (digest[6] & 0x0F) | 0x80  # version 8: a custom UUID (RFC 9562)
+        digest[8] = (digest[8] & 0x3F) | 0x80  # the RFC variant
+        return "{" + str(uuid.UUID(bytes=bytes(digest))) + "}"
 
     def __getitem__(self, name: str) -> Variable:
         return self._by_name[name]

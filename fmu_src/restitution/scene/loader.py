@@ -273,7 +273,7 @@ def _string_list(ctx, table, where, key):
 
 
 _MATERIAL_KEYS = {"name": "a label", "base": "a preset to start from", "E": 'elastic modulus, e.g. "69 GPa"',
-                  "nu": "Poisson's ratio, 0 <= nu < 0.5", "Sy": 'yield strength, e.g. "290 MPa", or "brittle"',
+                  "nu": "Poisson's ratio, 0 <= nu <= 0.5", "Sy": 'yield strength, e.g. "290 MPa", or "brittle"',
                   "rho": 'density, e.g. "2700 kg/m3"', "source": "where the values come from"}
 
 
@@ -315,7 +315,7 @@ def _material(ctx, value, where, custom) -> Material:
     _check_keys(ctx, value, where, _MATERIAL_KEYS, required)
     props = {}
     props["E"] = _quantity(ctx, value, where, "E", "pressure", domain=DOMAIN["sphere_E"])
-    props["nu"] = _number(ctx, value, where, "nu", low=0.0, high=0.5, high_open=True)
+    props["nu"] = _number(ctx, value, where, "nu", low=0.0, high=0.5)
     if value.get("Sy") == "brittle":
         props["Sy"] = BRITTLE_SY
     else:

@@ -155,6 +155,10 @@ rst_status front_get_nominals(void *c, const char *function, double nominals[], 
     ENTER(function, VECTOR_MODES)
     if (!check_vector(inst, function, nominals, n, inst->model->n_states, "nominals"))
         LEAVE(RST_ERROR);
+    if (inst->model->nominals != NULL && n > 0) {
+        inst->model->nominals(inst, nominals);
+        LEAVE(RST_OK);
+    }
     for (i = 0; i < n; i++)
         nominals[i] = 1.0; /* the default: the table declares no nominal */
     LEAVE(RST_OK);

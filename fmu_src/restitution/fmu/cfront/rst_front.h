@@ -126,6 +126,10 @@ typedef struct {
     /* fmi2NewDiscreteStates / fmi3UpdateDiscreteStates (model exchange, event mode, at rst_time):
      * handle the event; `result` starts all zero */
     rst_status (*update_discrete_states)(rst_instance *inst, rst_event_update *result);
+    /* fmi2GetNominalsOfContinuousStates / fmi3GetNominalsOfContinuousStates: the scale of each continuous
+     * state (> 0, finite) from the store, in the state vector's order. NULL: 1 for every state. A model
+     * whose nominals move reports nominals_changed from its event update. */
+    void (*nominals)(rst_instance *inst, double nominals[]);
 } rst_model;
 
 /* The model-exchange vectors of a glue's RST_MODEL, from its generated interface header. */

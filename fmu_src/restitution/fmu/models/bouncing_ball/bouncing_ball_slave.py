@@ -41,18 +41,45 @@ format and the variable list, and validated (parameters and input as the setters
 rest numbers) before anything is restored. Bad input never raises: a value outside its range is
 refused, the previous value kept, and the refusal logged with fmi2Error (in the built FMU the C
 guard refuses it first and returns fmi2Error). The module has a unique name (two pythonfmu FMUs
-whose scripts share a module name clash in one process).
+whose scripts share a module name clash in one process). Which ``restitution`` it runs, and which
+class pythonfmu instantiates, is decided at start-up (restitution_slave_support.py): the FMU's own
+code, or a copy verified to be the same, whatever the host and other FMUs loaded before and whether
+their folders still exist.
 """
 from __future__ import annotations
 
+import hashlib
+import importlib.util
 import math
+import os
+import sys
 
 from pythonfmu import Boolean, Fmi2Causality, Fmi2Slave, Fmi2Variability, Integer, Real
 from pythonfmu.enums import Fmi2Initial
 
-from restitution.fmu.models.bouncing_ball.variables import TABLE
-from restitution_slave_support import (checked_setter, restore_state, state_check, state_from_bytes, state_schema,
-                                       state_to_bytes)
+# Start-up: which code this instance runs (restitution_slave_support.py says what and why). pythonfmu
+# executes this script twice at each fmi2Instantiate: as an import (only the first time in a process),
+# then with the cached module's globals, whose __file__ may be another FMU's, and this FMU's resources/
+# first on sys.path. Up to settle() at the end, straight-line code only (a function defined here would
+# read the cached module's globals) that cannot raise at the second execution (pythonfmu would crash).
+_here = os.path.dirname(os.path.abspath(__file__)) if globals() is locals() else sys.path[0]
+_resources = _here if os.path.isfile(os.path.join(_here, "slavemodule.txt")) else None  # None: not in an FMU
+if _resources is not None:  # the support module this FMU ships, unless the one loaded has the same source
+    _path = os.path.join(_resources, "restitution_slave_support.py")
+    with open(_path, "rb") as _file:
+        _source = hashlib.sha256(_file.read()).hexdigest()
+    if getattr(sys.modules.get("restitution_slave_support"), "SOURCE_SHA256", None) != _source:
+        _spec = importlib.util.spec_from_file_location("restitution_slave_support", _path)
+        _support = importlib.util.module_from_spec(_spec)
+        _spec.loader.exec_module(_support)
+        sys.modules[_spec.name] = _support
+import restitution_slave_support as _support  # noqa: E402 (the one just loaded, or the importable one)
+from restitution_slave_support import (checked_setter, restore_state, state_check,  # noqa: E402
+                                       state_from_bytes, state_schema, state_to_bytes)
+
+# the package this instance runs: the one the FMU ships, or a copy of the same code
+_restitution = _support.start(globals(), locals(), "BouncingBall", _resources)
+TABLE = _support.submodule(_restitution, "fmu.models.bouncing_ball.variables").TABLE
 
 #: A contact found within this time [s] after the end of a step still belongs to the step:
 #: a master that steps exactly to a reported contact time (t_impact) must see the contact
@@ -122,6 +149,15 @@ def bounce_train(t0, u, e, g, v_min, limit):
         if n < rest and time(n + 1.0) <= limit:
             n += 1.0
     return n, time(n), speed(n)
+
+
+def contact_indicator(h, v, g):
+    """The model-exchange event indicator in flight [m]: the height h + max(v, 0)^2/(2 g) the ball
+    reaches before it falls (h [m], v [m/s] upward, g [m/s2]). It equals h while the ball falls, so
+    its crossing to <= 0 is the contact; while the ball rises it stays at the apex height, which right
+    after a rebound is v^2/(2 g) > 0: the ball is then strictly in flight, never at the indicator's
+    zero (a host that compares each indicator with its value after the last event sees every contact)."""
+    return h + v * v / (2.0 * g) if v > 0.0 else h
 
 
 _INITIAL_STATE = {
@@ -216,7 +252,7 @@ class BouncingBall(Fmi2Slave):
             dt = min(max(t - s["t_start"], 0.0), flight_duration(s["h_start"], s["v_start"], g))
             s["h"] = max(s["h_start"] + s["v_start"] * dt - 0.5 * g * dt * dt, 0.0)
             s["v"] = s["v_start"] - g * dt
-            s["v_approach"] = max(-s["v"], 0.0)
+            s["v_approach"] = -s["v"] if -s["v"] > 0.0 else 0.0  # +0.0 at the apex, never -0.0
         self._update_derivatives()
 
     def _update_derivatives(self):
@@ -227,7 +263,7 @@ class BouncingBall(Fmi2Slave):
             s["der_h"], s["der_v"] = 0.0, 0.0
         else:
             s["der_h"], s["der_v"] = s["v"], -float(self._values["g"])
-        s["contact_indicator"] = 1.0 if s["at_rest"] else s["h"]
+        s["contact_indicator"] = 1.0 if s["at_rest"] else contact_indicator(s["h"], s["v"], float(self._values["g"]))
 
     def _impact(self, t, v, count):
         """The last of `count` contacts: at time t [s] with approach speed v [m/s]."""
@@ -243,6 +279,8 @@ class BouncingBall(Fmi2Slave):
     def exit_initialization_mode(self):
         self._s = dict(_INITIAL_STATE)
         self._start_flight(self._start_time, self._values["h0"], 0.0)
+        if self._values["h0"] == 0.0:  # released on the plate: at rest from the start, no contact
+            self._s["at_rest"] = True
         self._update_outputs(self._start_time)
 
     def do_step(self, current_time: float, step_size: float) -> bool:
@@ -273,3 +311,6 @@ class BouncingBall(Fmi2Slave):
             self._values[var.name] = var.start
         self._s = dict(_INITIAL_STATE)
         self._start_time = 0.0
+
+
+_support.settle(globals(), locals(), "BouncingBall")

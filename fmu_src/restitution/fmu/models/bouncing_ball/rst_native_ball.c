@@ -12,6 +12,8 @@
 /* bouncing_ball_slave.MAX_IMPACTS and MAX_TRAIN */
 #define MAX_IMPACTS 2147483647.0
 #define MAX_TRAIN 1e18
+/* The highest a ball can fly [m]: h0 <= 1e6 m, and no rebound is faster than the first impact */
+#define MAX_APEX 1e6
 
 /* A variable of the value store, by its name in the generated header (RST_BOUNCINGBALL_VR_*). */
 #define AT(name) values[RST_BOUNCINGBALL_VR_##name]
@@ -48,6 +50,9 @@ static double flight_duration(double h_start, double v_start, double g)
     return (v_start + sqrt(v_start * v_start + 2.0 * g * h_start)) / g;
 }
 
+/* contact_indicator: the height [m] the ball reaches before it falls, h + max(v, 0)^2/(2 g). */
+static double contact_indicator(double h, double v, double g) { return v > 0.0 ? h + v * v / (2.0 * g) : h; }
+
 /* _update_derivatives: der(h), der(v) and the contact indicator from the state (flight under
  * gravity; nothing moves at the plate; at rest the indicator stays at 1 m: no more contacts). */
 void rst_ball_update_derivatives(double *values)
@@ -55,8 +60,11 @@ void rst_ball_update_derivatives(double *values)
     int still = AT(AT_REST) != 0.0 || AT(IN_CONTACT) != 0.0;
     AT(DER_H) = still ? 0.0 : AT(V);
     AT(DER_V) = still ? 0.0 : -AT(G);
-    AT(CONTACT_INDICATOR) = AT(AT_REST) != 0.0 ? 1.0 : AT(H);
+    AT(CONTACT_INDICATOR) = AT(AT_REST) != 0.0 ? 1.0 : contact_indicator(AT(H), AT(V), AT(G));
 }
+
+/* max(-v, 0) [m/s] (+0, never -0, at rest). */
+static double approach_speed(double v) { return -v > 0.0 ? -v : 0.0; }
 
 /* _update_outputs: height [m], velocity [m/s] and approach speed [m/s] at time t [s]. */
 static void update_outputs(double *values, double t)
@@ -77,7 +85,7 @@ static void update_outputs(double *values, double t)
         h = AT(FLIGHT_H_START) + AT(FLIGHT_V_START) * dt - 0.5 * g * dt * dt;
         AT(H) = h >= 0.0 ? h : 0.0;
         AT(V) = AT(FLIGHT_V_START) - g * dt;
-        AT(V_APPROACH) = -AT(V) >= 0.0 ? -AT(V) : 0.0;
+        AT(V_APPROACH) = approach_speed(AT(V));
     }
     rst_ball_update_derivatives(values);
 }
@@ -162,6 +170,8 @@ void rst_ball_initialize(double *values, double start_time)
 {
     rst_ball_clear(values);
     start_flight(values, start_time, AT(H0), 0.0);
+    if (AT(H0) == 0.0) /* released on the plate: at rest from the start, no contact */
+        AT(AT_REST) = 1.0;
     update_outputs(values, start_time);
 }
 
@@ -201,18 +211,32 @@ void rst_ball_states_changed(double *values)
     if (AT(AT_REST) != 0.0) { /* at rest the ball stays on the plate whatever a solver hands back */
         AT(H) = AT(V) = 0.0;
     }
-    AT(V_APPROACH) = -AT(V) >= 0.0 ? -AT(V) : 0.0;
+    AT(V_APPROACH) = approach_speed(AT(V));
     rst_ball_update_derivatives(values);
 }
 
 int rst_ball_contact_event(double *values, double t)
 {
-    if (AT(AT_REST) != 0.0 || !(AT(H) <= 0.0 && AT(V) < 0.0))
-        return 0; /* no contact: another event, or the crossing of the ball leaving the plate */
-    impact(values, t, -AT(V), 1.0);
+    if (AT(AT_REST) != 0.0 || contact_indicator(AT(H), AT(V), AT(G)) > 0.0)
+        return 0; /* no contact: the ball is in flight (another event, or a crossing located early) */
+    /* at or below the plate: a contact at speed |v| whatever the sign of v (a v > 0 arises only within
+     * the host's integration error of an apex at the plate, or from a state set below the plate) */
+    impact(values, t, fabs(AT(V)), 1.0);
     rebound(values, t);
     AT(H) = 0.0;
     AT(V) = AT(FLIGHT_V_START); /* the rebound speed, or 0 at rest */
     rst_ball_states_changed(values);
     return 1;
+}
+
+void rst_ball_nominals(const double *values, double nominals[2])
+{
+    double apex = AT(AT_REST) != 0.0 ? 0.0 : contact_indicator(AT(H), AT(V), AT(G));
+    if (!(apex > 0.0)) { /* at rest, or below the plate (a NaN too): no flight to scale by */
+        nominals[0] = nominals[1] = 1.0;
+        return;
+    }
+    apex = apex <= MAX_APEX ? apex : MAX_APEX;
+    nominals[0] = apex;
+    nominals[1] = sqrt(2.0 * AT(G) * apex);
 }

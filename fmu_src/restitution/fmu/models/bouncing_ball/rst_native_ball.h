@@ -16,6 +16,7 @@
 #define rst_ball_states_changed RST_PREFIXED(rst_ball_states_changed)
 #define rst_ball_update_derivatives RST_PREFIXED(rst_ball_update_derivatives)
 #define rst_ball_contact_event RST_PREFIXED(rst_ball_contact_event)
+#define rst_ball_nominals RST_PREFIXED(rst_ball_nominals)
 #endif
 
 #include <stddef.h>
@@ -37,9 +38,19 @@ void rst_ball_update_derivatives(double *values);
  * and the contact indicator follow from them. */
 void rst_ball_states_changed(double *values);
 
-/* Model exchange, at an event at time `t` [s]: a ball at or below the plate moving down meets it
- * (counted, its time and speed recorded) and rebounds with the COR on its input, or comes to rest.
- * Returns 1 when h and v changed. */
+/* Model exchange, at an event at time `t` [s]: a ball not at rest whose contact indicator is <= 0
+ * (at or below the plate, not rising above it) meets the plate at speed |v| (counted, its time and
+ * speed recorded), is put on the plate (h = 0) and rebounds with the COR on its input (then the
+ * indicator is v^2/(2 g) > 0: strictly in flight), or comes to rest (indicator 1 m). Returns 1 when h
+ * and v changed. */
 int rst_ball_contact_event(double *values, double t);
+
+/* Model exchange: the nominals of h [m] and v [m/s], the scale of the current flight: its apex
+ * height h + max(v, 0)^2/(2 g) (which a free flight keeps) and the speed sqrt(2 g apex) it meets the
+ * plate with (1 and 1 at rest, or for a state below the plate). A solver whose absolute tolerance is
+ * its relative one times the nominal (fmpy's CVode) then integrates every flight, however low, to
+ * the same relative accuracy: the rebounds near rest are micrometres high and would otherwise drown
+ * in an absolute tolerance meant for the drop. They change at every contact (reported as changed). */
+void rst_ball_nominals(const double *values, double nominals[2]);
 
 #endif

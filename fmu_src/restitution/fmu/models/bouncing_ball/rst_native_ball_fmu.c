@@ -59,12 +59,19 @@ static rst_status restore_state(rst_instance *inst)
 static rst_status update_discrete_states(rst_instance *inst, rst_event_update *result)
 {
     result->states_changed = rst_ball_contact_event(rst_store(inst), rst_time(inst));
+    result->nominals_changed = result->states_changed; /* the nominals are the new flight's scale */
     return RST_OK;
+}
+
+static void nominals(rst_instance *inst, double out[])
+{
+    rst_ball_nominals(rst_store(inst), out);
 }
 
 const rst_model RST_MODEL = {
     .identifier = RST_MODEL_IDENTIFIER, .guid = RST_MODEL_GUID,
     .variables = RST_MODEL_VARIABLES, .n_variables = RST_MODEL_N_VARIABLES, .backend_size = 0,
     .instantiate = instantiate, .exit_initialization = exit_initialization, .do_step = do_step, .reset = reset,
-    .set = set, .restore_state = restore_state, .update_discrete_states = update_discrete_states, .model_exchange = 1,
+    .set = set, .restore_state = restore_state, .update_discrete_states = update_discrete_states,
+    .nominals = nominals, .model_exchange = 1,
     RST_MODEL_EXCHANGE_VECTORS};

@@ -15,7 +15,7 @@ from ...table import Table, calculated_parameter, input_, output, parameter
 
 _BALL, _PLATE = MATERIALS["s2_tool_steel"], MATERIALS["al_6061"]
 _D = 6.35e-3  # [m] the paper's default ball diameter and plate thickness (1/4 in)
-_NU = (0.0, 0.5, False, True)  # 0.5 (incompressible) makes E' infinite
+_NU = (0.0, 0.5, False, False)  # 0.5: incompressible (E' = E/(1 - nu^2) stays finite)
 
 
 def _domain(key):
@@ -76,7 +76,7 @@ TABLE = Table("SpherePlateImpact", "Apparent coefficient of restitution of a sph
            _domain("v")),
     parameter("sphere.E", "sphere_E", "Pa", float(_BALL.E),
               "Sphere elastic modulus, 1e5 to 1e13 Pa (default: S2 tool steel, Table 3)", _domain("sphere_E")),
-    parameter("sphere.nu", "sphere_nu", "1", float(_BALL.nu), "Sphere Poisson's ratio, 0 <= nu < 0.5", _NU),
+    parameter("sphere.nu", "sphere_nu", "1", float(_BALL.nu), "Sphere Poisson's ratio, 0 <= nu <= 0.5", _NU),
     parameter("sphere.Sy", "sphere_Sy", "Pa", float(_BALL.Sy),
               "Sphere yield strength, 1e3 to 1e13 Pa (1e12 for brittle materials)", _domain("sphere_Sy")),
     parameter("sphere.rho", "sphere_rho", "kg/m3", float(_BALL.rho), "Sphere density, 1 to 1e5 kg/m3",
@@ -84,7 +84,7 @@ TABLE = Table("SpherePlateImpact", "Apparent coefficient of restitution of a sph
     parameter("sphere.d", "sphere_d", "m", _D, "Sphere diameter, 1e-6 to 10 m", _domain("sphere_d")),
     parameter("plate.E", "plate_E", "Pa", float(_PLATE.E),
               "Plate elastic modulus, 1e5 to 1e13 Pa (default: Al 6061, Table 3)", _domain("plate_E")),
-    parameter("plate.nu", "plate_nu", "1", float(_PLATE.nu), "Plate Poisson's ratio, 0 <= nu < 0.5", _NU),
+    parameter("plate.nu", "plate_nu", "1", float(_PLATE.nu), "Plate Poisson's ratio, 0 <= nu <= 0.5", _NU),
     parameter("plate.Sy", "plate_Sy", "Pa", float(_PLATE.Sy),
               "Plate yield strength, 1e3 to 1e13 Pa (1e12 for brittle materials)", _domain("plate_Sy")),
     parameter("plate.rho", "plate_rho", "kg/m3", float(_PLATE.rho), "Plate density, 1 to 1e5 kg/m3",
@@ -95,8 +95,8 @@ TABLE = Table("SpherePlateImpact", "Apparent coefficient of restitution of a sph
               vtype="Integer", choices=RESTITUTION_MODELS),
     parameter("zener_method", "zener_method", None, 1,
               "Zener COR and contact time: 1 = exact (tabulated ODE solution), 2 = paper_fit (Eqs. 13, 13a), "
-              "3 = linear (Eq. 22), 4 = ode (Eq. 10 integrated at every evaluation)",
-              vtype="Integer", choices=ZENER_METHODS),
+              "3 = linear (Eq. 22), 4 = ode (Eq. 10 integrated at every evaluation; the pythonfmu FMU only)",
+              vtype="Integer", choices=ZENER_METHODS, native_interval=(1, 3, False, False)),
     parameter("plasticity", "plasticity", None, 2,
               "Elastoplastic effect: 0 = off (e_ep = 1), 1 = on, 2 = auto (skipped where 1 - e_ep < effect_tolerance)",
               vtype="Integer", choices=EFFECT_MODES, first_code=0),
