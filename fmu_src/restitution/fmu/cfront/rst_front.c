@@ -534,8 +534,8 @@ rst_instance *front_instantiate(rst_instance *inst, const char *function, const 
     }
     inst->model_exchange = model_exchange;
     if (token == NULL || strcmp(token, inst->model->guid) != 0) {
-        rst_log(inst, RST_ERROR, "%s: %s %s does not match this FMU's %s (modelDescription.xml of another FMU or "
-                "another build?)", function, inst->api->token_name,
+        rst_log(inst, RST_ERROR, "%s: %s %s does not match this FMU's %s (modelDescription.xml of another model, "
+                "interface or version?)", function, inst->api->token_name,
                 token ? token : "(NULL)", inst->model->guid);
         free_memory(inst);
         return NULL;

@@ -397,7 +397,7 @@ static const char *read_snapshot(const rst_instance *inst, const unsigned char b
     if (!get_text_equal(&r, inst->model->identifier) && r.ok)
         return "the state belongs to another model";
     if (!get_text_equal(&r, inst->model->guid) && r.ok)
-        return "the state belongs to another build of this model (GUID differs)";
+        return "the state belongs to another interface or version of this model (GUID differs)";
     if (get_uint(&r, 4) != inst->n_state && r.ok)
         return "the state has another number of variables";
     s->mode = (unsigned int)get_uint(&r, 4); /* the words as they are: check_snapshot judges them */
