@@ -24,7 +24,9 @@ with the reason where its tool is missing. (The win64 DLL under Wine: tests/fmu/
    the 1 the SSP asks for, so the run is still the one compared.
 3. ``fmutool -check`` (fmu-manipulation-toolbox) says "No semantic error" and fmpy's validation finds no
    problem, for both native FMUs, FMI 2.0 and FMI 3.0; both checkers do flag an FMU with one start value
-   removed (so they read what they are given).
+   removed (so they read what they are given). The platforms fmutool lists are the archive's binaries/
+   folders; the Windows one is asserted where the build produced it (mingw-w64 installed), else that test
+   skips naming the compiler (tests/fmu_platforms.py).
 """
 from __future__ import annotations
 
@@ -48,6 +50,8 @@ import pytest
 import restitution as r
 from restitution.agreement import EPS, tolerances
 from restitution.cosim import CosimResult, ball_bounces, bounce, impact_fmu_parameters, package_rebound
+
+from fmu_platforms import binary_folders, skip_unless_built
 
 ROOT = Path(__file__).resolve().parents[2]
 EXAMPLE = ROOT / "examples" / "two_fmu_cosim.py"
@@ -461,6 +465,37 @@ def run_fmutool_check(fmu: Path) -> tuple[int, str]:
     return proc.returncode, proc.stdout + proc.stderr
 
 
+_FMUTOOL_REPORTS: dict = {}
+
+
+def fmutool_report(fmu: Path) -> tuple[int, str]:
+    """:func:`run_fmutool_check` of a built FMU, run once per test session (two tests read it)."""
+    if fmu not in _FMUTOOL_REPORTS:
+        _FMUTOOL_REPORTS[fmu] = run_fmutool_check(fmu)
+    return _FMUTOOL_REPORTS[fmu]
+
+
+def fmutool_platforms(report: str) -> set[str]:
+    """The binaries/ folders fmutool's summary lists under "Supported platforms" (without its "RT
+    (sources available)", which says that sources/ is there)."""
+    lines = report.splitlines()
+    start = next(i for i, line in enumerate(lines) if "Supported platforms:" in line)
+    listed = set()
+    for line in lines[start + 1:]:
+        item = line.split("|")[-1].strip()
+        if not item.startswith("- "):
+            break
+        listed.add(item[2:])
+    return listed - {"RT (sources available)"}
+
+
+def _native_fmu(built_fmus, folder, model) -> Path:
+    fmu = built_fmus / folder / f"{model}.fmu"
+    if not fmu.is_file():
+        pytest.skip(f"{folder}/{model}.fmu not built here (needs gcc)")
+    return fmu
+
+
 def _without_a_start_value(fmu: Path, out: Path) -> Path:
     """A copy of ``fmu`` whose first parameter has lost its start value (FMI 2.0 section 2.2.7 wants one)."""
     with zipfile.ZipFile(fmu) as src, zipfile.ZipFile(out, "w", zipfile.ZIP_DEFLATED) as dst:
@@ -481,20 +516,22 @@ def _without_a_start_value(fmu: Path, out: Path) -> Path:
 def test_fmutool_and_fmpy_find_no_problem_in_the_native_fmu(built_fmus, native_impact_fmu, native_ball_fmu, model,
                                                             folder, tmp_path):
     """Each native FMU, FMI 2.0 (native/) and FMI 3.0 (fmi3/): fmutool's conformity and semantic checks of
-    its version and fmpy's validation find nothing; both flag the FMU with one start value removed."""
+    its version and fmpy's validation find nothing; both flag the FMU with one start value removed. The
+    platforms fmutool lists are the binaries/ folders in the archive, the Linux one among them (the
+    Windows one where mingw-w64 built it: test_fmutool_lists_the_windows_binary_platform)."""
     from fmpy.validation import validate_fmu
 
-    fmu = built_fmus / folder / f"{model}.fmu"
-    if not fmu.is_file():
-        pytest.skip(f"{folder}/{model}.fmu not built here (needs gcc)")
-    version, platforms = ("2", ("linux64", "win64")) if folder == "native" else ("3", ("x86_64-linux", "x86_64-windows"))
-    code, report = run_fmutool_check(fmu)
+    fmu = _native_fmu(built_fmus, folder, model)
+    version, linux = ("2", "linux64") if folder == "native" else ("3", "x86_64-linux")
+    code, report = fmutool_report(fmu)
     assert code == 0, report[-3000:]
     assert f"fmiVersion = {version}.0" in report, report[-3000:]
     assert f"This FMU seems to be compliant with FMI-{version}.0." in report, report[-3000:]
     assert f"No semantic error against the FMI-{version} standard." in report, report[-3000:]
     assert "ERROR" not in report and "Traceback" not in report, report[-3000:]
-    assert f"modelIdentifier = {model}" in report and all(f"- {p}" in report for p in platforms), report[-3000:]
+    assert f"modelIdentifier = {model}" in report, report[-3000:]
+    assert fmutool_platforms(report) == set(binary_folders(fmu)) and linux in binary_folders(fmu), report[-3000:]
+    assert "- RT (sources available)" in report, report[-3000:]
     assert validate_fmu(str(fmu)) == []
     # both checkers read what they are given: one start value removed is one error for each
     broken = _without_a_start_value(fmu, tmp_path / f"{model}_broken.fmu")
@@ -502,3 +539,15 @@ def test_fmutool_and_fmpy_find_no_problem_in_the_native_fmu(built_fmus, native_i
     assert code != 0 and f"1 semantic error(s) against the FMI-{version} standard." in report, report[-3000:]
     assert "a start value is required" in report, report[-3000:]
     assert validate_fmu(str(broken)) != []
+
+
+@pytest.mark.parametrize("folder", ["native", "fmi3"])
+@pytest.mark.parametrize("model", ["SpherePlateImpact", "BouncingBall"])
+def test_fmutool_lists_the_windows_binary_platform(built_fmus, model, folder):
+    """Where the build produced the Windows x64 binary (mingw-w64 installed; skipped, naming it, where not),
+    fmutool lists its platform (FMI 2.0: win64, FMI 3.0: x86_64-windows) beside the Linux one."""
+    fmu = _native_fmu(built_fmus, folder, model)
+    windows = skip_unless_built(fmu, "win64")
+    code, report = fmutool_report(fmu)
+    linux = "linux64" if folder == "native" else "x86_64-linux"
+    assert code == 0 and fmutool_platforms(report) == {linux, windows}, report[-3000:]
