@@ -12,6 +12,7 @@ import ctypes
 import math
 import shutil
 import subprocess
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -28,6 +29,7 @@ from cases import FMU_FLAGS, FMU_REALS, NAMES, random_cases
 pytestmark = pytest.mark.skipif(shutil.which("gcc") is None, reason="gcc is needed to compile the native backend")
 
 TABLE = {v.name: v for v in variables("SpherePlateImpact")}
+HOSTILE_DRIVER = Path(__file__).resolve().parents[1] / "c_host" / "hostile_store_values.c"
 
 
 @pytest.fixture(scope="module")
@@ -107,76 +109,19 @@ def test_ode_is_refused_with_a_message_naming_the_python_fmu(backend):
     assert all(math.isnan(out[k]) for k in FMU_REALS) and not any(out[k] for k in FMU_FLAGS)
 
 
-_HOSTILE_DRIVER = r"""
-#include <math.h>
-#include <stdio.h>
-#include "rst_native_impact.h"
-#include "rst_native_ball.h"
-#include "rst_SpherePlateImpact_interface.h"
-#undef RST_MODEL_N_VARIABLES /* the generic names of the table, which a model's glue uses: here both models */
-#undef RST_MODEL_VARIABLES
-#undef RST_MODEL_N_STATES
-#undef RST_MODEL_N_EVENT_INDICATORS
-#undef RST_MODEL_STATE_VRS
-#undef RST_MODEL_DERIVATIVE_VRS
-#undef RST_MODEL_EVENT_INDICATOR_VRS
-#include "rst_BouncingBall_interface.h"
-int main(void)
-{
-    static const double bad[] = {NAN, INFINITY, -INFINITY, 1e300, -1e300, 0.0, -0.0, 4.9e-324, 2.5, -1.0, 5.0};
-    char message[256];
-    double store[64], t = 0.0;
-    size_t slot, k, i;
-    int failures = 0;
-    for (slot = 0; slot < RST_SPHEREPLATEIMPACT_N_VARIABLES; slot++) {
-        if (RST_SPHEREPLATEIMPACT_VARIABLES[slot].causality == RST_OUTPUT)
-            continue;
-        for (k = 0; k < sizeof bad / sizeof bad[0]; k++) {
-            for (i = 0; i < RST_SPHEREPLATEIMPACT_N_VARIABLES; i++)
-                store[i] = 1.0;
-            store[slot] = bad[k];
-            (void)rst_impact_evaluate(store, message, sizeof message);
-        }
-    }
-    for (slot = 0; slot < RST_BOUNCINGBALL_N_VARIABLES; slot++) {
-        if (RST_BOUNCINGBALL_VARIABLES[slot].causality == RST_OUTPUT
-            || RST_BOUNCINGBALL_VARIABLES[slot].causality == RST_LOCAL)
-            continue;
-        for (k = 0; k < sizeof bad / sizeof bad[0]; k++) {
-            for (i = 0; i < RST_BOUNCINGBALL_N_VARIABLES; i++)
-                store[i] = 0.0;
-            store[RST_BOUNCINGBALL_VR_H0] = 0.3;
-            store[RST_BOUNCINGBALL_VR_G] = 9.81;
-            store[RST_BOUNCINGBALL_VR_V_MIN] = 0.1;
-            store[RST_BOUNCINGBALL_VR_CONTACT_MODE] = RST_BOUNCINGBALL_CONTACT_MODE_IMMEDIATE;
-            store[RST_BOUNCINGBALL_VR_E] = 0.8;
-            store[slot] = bad[k];
-            rst_ball_initialize(store, 0.0);
-            for (t = 0.0, i = 0; i < 200; i++, t += 0.01)
-                rst_ball_do_step(store, t, 0.01);
-        }
-    }
-    printf("done %d\n", failures);
-    return 0;
-}
-"""
-
-
 def test_backends_take_hostile_store_values_under_sanitizers(tmp_path):
     """NaN, infinities, huge, subnormal and fractional values in every input slot of both backends, in
     an ASan + UBSan build (any report aborts) run as a child process: no undefined behaviour (a code
     beyond int is never cast), no hang, no crash. The front rejects such values before they get here;
-    this is the backends' own defence."""
-    from restitution.fmu.compile import prepare_sources
-
+    this is the backends' own defence (the program: tests/c_host/hostile_store_values.c)."""
     src = prepare_sources(tmp_path / "src")
     write_backend("SpherePlateImpact", src)
     write_backend("BouncingBall", src)
-    (src / "hostile.c").write_text(_HOSTILE_DRIVER)
     exe = tmp_path / "hostile"
     build = subprocess.run(["gcc", *CFLAGS, "-g", "-fsanitize=address,undefined,float-cast-overflow",
-                            "-fno-sanitize-recover=all", "-o", str(exe), *(str(src / f) for f in (
-                                "hostile.c", "rst_native_impact.c", "rst_native_ball.c", "rst_physics.c")), "-lm"],
+                            "-fno-sanitize-recover=all", "-I", str(src), "-o", str(exe), str(HOSTILE_DRIVER),
+                            *(str(src / f) for f in ("rst_native_impact.c", "rst_native_ball.c", "rst_physics.c")),
+                            "-lm"],
                            capture_output=True, text=True)
     assert build.returncode == 0, build.stderr
     run = subprocess.run([str(exe)], capture_output=True, text=True, timeout=120, env={"PATH": "/usr/bin:/bin"})

@@ -77,8 +77,8 @@ def build_fmus(work: Path) -> dict:
         script = src / f"bench_{name.lower()}.py"
         script.write_text(FLOOR_SCRIPT.format(counts=counts, name=name, extra=extra))
         out[name] = Path(FmuBuilder.build_FMU(script, dest=work))
-        # The same native loader as the project's FMUs: a like-for-like floor (the shim's
-        # forwarding is part of every call), and the fix for pythonfmu 0.7's exit double-free,
+        # The same guard as the project's pythonfmu FMU: a like-for-like floor (the guard's checks
+        # and forwarding are part of every call), and the fix for pythonfmu 0.7's exit double-free,
         # which a plain pythonfmu binary would bring into this process.
         make_standalone(out[name])
     out["counts"] = counts
