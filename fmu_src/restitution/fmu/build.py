@@ -37,7 +37,7 @@ from pathlib import Path
 from xml.etree import ElementTree as ET
 
 from ..about import AUTHOR, COPYRIGHT, LICENSE, VERSION
-from .documentation import license_files
+from .documentation import documentation_files
 from .model_description3 import generation_date_and_time
 from .models import FOLDERS, SLAVE_SUPPORT, slave_script, table
 from .sources import BUILD_INFO, PACKAGE, bundle_filter, recorded_source_hash, source_hash
@@ -215,7 +215,7 @@ def build_one(model: str, out_dir: Path, standalone: bool = True, log=None) -> P
                                         canGetAndSetFMUstate=True, canSerializeFMUstate=True))
         info = json.dumps({"model": model, "source_hash": source_hash(model)}, indent=1)
         _rewrite_zip(fmu, lambda xml: complete_model_description(xml, table(model)),
-                     member="modelDescription.xml", extra={BUILD_INFO: info, **license_files(True)})
+                     member="modelDescription.xml", extra={BUILD_INFO: info, **documentation_files(model, "2.0")})
         if standalone and shutil.which("gcc") is None:
             log(f"warning: gcc not found: {model}.fmu is built for Python hosts only (fmpy, libcosimpy), "
                 "without the C guard that checks every FMI call; install gcc")

@@ -28,7 +28,7 @@ from xml.etree import ElementTree as ET
 
 from ..about import VERSION
 from .compile import CFLAGS, PHYSICS_SOURCES, prepare_sources
-from .documentation import license_files
+from .documentation import documentation_files
 from . import model_description3
 from .interface import c_header, model_info, model_info_header
 from .models import FOLDERS, native_sources, table
@@ -226,7 +226,7 @@ def build_native_one(model: str, out_dir: Path, python_fmu: Path, log=None, fmi_
                 "platforms": sorted(p.parent.name for p in built)}
         (stage / BUILD_INFO).parent.mkdir(parents=True, exist_ok=True)
         (stage / BUILD_INFO).write_text(json.dumps(info, indent=1), encoding="utf-8")
-        for name, data in license_files(bundles_pythonfmu=False).items():
+        for name, data in documentation_files(model, fmi_version, native=True).items():
             (stage / name).parent.mkdir(parents=True, exist_ok=True)
             (stage / name).write_bytes(data)
         fmu = Path(tmp) / f"{model}.fmu"

@@ -67,7 +67,7 @@ def source_files(model: str) -> list[Path]:
     files = [slave_script(model), SLAVE_SUPPORT, *_table_files()]
     files += [FMU_DIR / name for name in ("build.py", "build_guard.py", "sources.py", "interface.py",
                                           "documentation.py")]
-    files += [PACKAGE / "LICENSE.txt"]
+    files += [PACKAGE / "LICENSE.txt"] + sorted(MODELS.glob("*/documentation.py"))  # documentation/index.html
     files += sorted(FRONT.glob("*.[ch]")) + sorted(GUARD.glob("*.[ch]"))
     files += sorted(PACKAGE.glob("*.py"))
     for sub in sorted(BUNDLED_SUBDIRS):
