@@ -5,7 +5,8 @@ A dimensional value in a scene is a string "<number> <unit>"; a bare number is r
 ratio, tolerances) are plain numbers. Units are read by pint, so any unit of the right kind works
 (``"0.125 in"``, ``"1 ft"``, ``"2.7 g/cm3"``, ``"9.81 m/s2"``);
 a digit right after a unit's letters is its exponent (``m3`` is m**3). Everything is converted to SI
-on load.
+on load. The sweep reads its values with the same parser (:func:`split_quantity`, :func:`convert_quantity`),
+where a bare number is SI and a fraction (``"1/4 in"``) is a number.
 """
 from __future__ import annotations
 
@@ -13,7 +14,8 @@ import math
 import re
 from functools import lru_cache
 
-__all__ = ["QUANTITIES", "EXAMPLES", "parse_quantity", "UnitError", "format_quantity"]
+__all__ = ["QUANTITIES", "EXAMPLES", "parse_quantity", "split_quantity", "convert_quantity", "UnitError",
+           "format_quantity"]
 
 
 class UnitError(ValueError):
@@ -30,6 +32,8 @@ _EXAMPLE_VALUE = {"length": "3.18 mm", "pressure": "69 GPa", "density": "2700 kg
 
 # ASCII digits only: float() would take "٣.١٨" (Arabic-Indic digits) as 3.18.
 _NUMBER = re.compile(r"^\s*([-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][-+]?[0-9]+)?)\s*(\S.*?)?\s*$", re.ASCII)
+# "1/4 in": a fraction of two integers, then a unit (or nothing) that does not start a number
+_FRACTION = re.compile(r"^\s*([-+]?[0-9]+)\s*/\s*([0-9]+)(?![0-9.eE])\s*(\S.*?)?\s*$", re.ASCII)
 # "kg/m3", "m/s2": an exponent written as digits right after a unit's letters
 _EXPONENT = re.compile(r"(?<=[A-Za-zµμ])([0-9]+)\b")
 
@@ -43,6 +47,44 @@ def _registry():
 
 def _pint_units(unit: str) -> str:
     return _EXPONENT.sub(r"**\1", unit)
+
+
+def split_quantity(text: str, fractions: bool = False) -> tuple[float, str | None] | None:
+    """``(number, unit)`` of "<number> <unit>" text (``unit`` None where there is none), or None when the
+    text is not a number in ASCII digits followed by a unit. With ``fractions``, a fraction of two
+    integers is a number too (``"1/4 in"``)."""
+    if fractions:
+        match = _FRACTION.match(text)
+        if match is not None:
+            if int(match.group(2)) == 0:
+                return None
+            return int(match.group(1)) / int(match.group(2)), match.group(3)
+    match = _NUMBER.match(text)
+    if match is None:
+        return None
+    return float(match.group(1)), match.group(2)
+
+
+def convert_quantity(name: str, text: str, number: float, unit: str, kind: str) -> float:
+    """SI value of ``number`` in ``unit`` for a quantity of ``kind``; ``text`` is the value as written and
+    ``name`` what the messages call the quantity. Raises :class:`UnitError` for an unknown unit or a
+    unit of another kind."""
+    ureg = _registry()
+    try:
+        given = ureg.parse_units(_pint_units(unit))
+    except Exception:  # noqa: BLE001 - pint raises several kinds for a unit it cannot read
+        raise UnitError(f"{text!r}: unknown unit {unit!r} for a {kind} (units: {EXAMPLES[kind]})") from None
+    target = ureg.parse_units(_pint_units(QUANTITIES[kind]))
+    if given.dimensionality != target.dimensionality:
+        other = next((k for k, si in QUANTITIES.items()
+                      if ureg.parse_units(_pint_units(si)).dimensionality == given.dimensionality),
+                     f"{given.dimensionality}" if given.dimensionality else "a dimensionless number")
+        raise UnitError(f"{text!r}: {unit} is a unit of {other}, but {name} is a {kind} "
+                        f"(units: {EXAMPLES[kind]})")
+    si = float(ureg.Quantity(number, given).to(target).magnitude)
+    if not math.isfinite(si):
+        raise UnitError(f"{text!r} is not finite")
+    return si
 
 
 def parse_quantity(key: str, value, kind: str) -> float:
@@ -59,29 +101,14 @@ def parse_quantity(key: str, value, kind: str) -> float:
     if not isinstance(value, str):
         raise UnitError(f"{value!r} has no unit: write the {kind} with its unit, e.g. {example} "
                         f"(units: {EXAMPLES[kind]})")
-    match = _NUMBER.match(value)
-    if match is None:
+    parsed = split_quantity(value)
+    if parsed is None:
         raise UnitError(f"{value!r} is not '<number> <unit>' (a number in ASCII digits), e.g. {example}")
-    number, unit = float(match.group(1)), match.group(2)
+    number, unit = parsed
     if unit is None:
         raise UnitError(f"{value!r} has no unit: write the {kind} with its unit, e.g. {example} "
                         f"(units: {EXAMPLES[kind]})")
-    ureg = _registry()
-    try:
-        given = ureg.parse_units(_pint_units(unit))
-    except Exception:  # noqa: BLE001 - pint raises several kinds for a unit it cannot read
-        raise UnitError(f"{value!r}: unknown unit {unit!r} for a {kind} (units: {EXAMPLES[kind]})") from None
-    target = ureg.parse_units(_pint_units(QUANTITIES[kind]))
-    if given.dimensionality != target.dimensionality:
-        other = next((k for k, si in QUANTITIES.items()
-                      if ureg.parse_units(_pint_units(si)).dimensionality == given.dimensionality),
-                     f"{given.dimensionality}" if given.dimensionality else "a dimensionless number")
-        raise UnitError(f"{value!r}: {unit} is a unit of {other}, but {short} is a {kind} "
-                        f"(units: {EXAMPLES[kind]})")
-    si = float(ureg.Quantity(number, given).to(target).magnitude)
-    if not math.isfinite(si):
-        raise UnitError(f"{value!r} is not finite")
-    return si
+    return convert_quantity(short, value, number, unit, kind)
 
 
 def format_quantity(value: float, kind: str) -> str:

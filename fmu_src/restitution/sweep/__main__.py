@@ -11,6 +11,7 @@ from ..materials_table import text as materials_text
 from ..output_files import (EXIT_IO_ERROR, EXIT_REFUSED, OutputPathError, OutputWriteError,
                             check_output, describe_os_error)
 from .spec import CODES, INPUT_NAMES, INPUTS, MAX_SAMPLES, MAX_SEED, T_OVER_D, SweepSpec, canonical_name, load_spec
+from .values import QuantityError
 
 #: Exit status of an interrupted sweep (128 + SIGINT, as a shell reports Ctrl-C).
 EXIT_INTERRUPTED = 130
@@ -68,6 +69,10 @@ EXAMPLES = """examples:
       --random sphere.E=normal_rel:0.03 --random plate.E=normal_rel:0.03 --samples 10000 \\
       --backend fmu --out mc.csv
 
+  # values with their units (a bare number is SI)
+  python -m restitution.sweep --set sphere.d="1/4 in" --set plate.E=114GPa --grid plate.t=linspace:1mm:5mm:9 \\
+      --grid v_approach=geomspace:10cm/s:10m/s:40 --out t.csv
+
   # the same sweep on an existing cluster
   python -m restitution.sweep spec.toml --scheduler tcp://scheduler-host:8786
 """
@@ -95,6 +100,9 @@ def _list() -> str:
 
 
 def build_spec(args) -> tuple[SweepSpec, dict]:
+    """The spec of the spec file and the options, with its explicit values checked against the inputs'
+    declared ranges, and its [run] table. A refused value is a :class:`QuantityError` naming the
+    option (or the spec file's table) that gave it."""
     data = load_spec(args.spec) if args.spec else {}
     if not isinstance(data, dict):
         raise ValueError(f"spec file {args.spec}: expected a table (pairs, grid, random, fixed, samples, seed, "
@@ -106,6 +114,7 @@ def build_spec(args) -> tuple[SweepSpec, dict]:
     data = {k: (dict(v) if isinstance(v, dict) else v) for k, v in data.items()}
     if args.pair:
         data["pairs"] = list(args.pair)
+    given = set()
     for section, items in (("grid", args.grid), ("random", args.random), ("fixed", args.set)):
         for name, value in _pairs(items).items():
             key = canonical_name(name)
@@ -114,11 +123,30 @@ def build_spec(args) -> tuple[SweepSpec, dict]:
                     if canonical_name(k) == key:
                         del data[other][k]
             data.setdefault(section, {})[key] = value
+            given.add((section, key))
     if args.samples is not None:
         data["samples"] = args.samples
     if args.seed is not None:
         data["seed"] = args.seed
-    return SweepSpec.from_dict(data), run
+    try:
+        spec = SweepSpec.from_dict(data)
+        spec.check_domain()  # explicit values inside the inputs' declared ranges, before any work
+    except QuantityError as exc:
+        raise QuantityError(_value_error(exc, given, args.spec), exc.name) from None
+    return spec, run
+
+
+#: The option that gives the values of each section of a spec.
+OPTIONS = {"grid": "--grid", "random": "--random", "fixed": "--set"}
+
+
+def _value_error(exc: QuantityError, given: set, spec_file) -> str:
+    """A refused value, named as it was given: ``--grid v_approach = -1 m/s is outside ...``."""
+    if exc.section is None:
+        return str(exc)
+    if (exc.section, exc.name) in given or not spec_file:
+        return f"{OPTIONS[exc.section]} {exc}"
+    return f"spec file {spec_file}: [{exc.section}] {exc}"
 
 
 def main(argv=None) -> int:
@@ -131,11 +159,13 @@ def main(argv=None) -> int:
     parser.add_argument("--pair", action="append", metavar="SPHERE/PLATE",
                         help="material pair, e.g. s2_tool_steel/al_6061 or table4:A1 (repeat for more)")
     parser.add_argument("--grid", action="append", metavar="NAME=VALUES",
-                        help="grid axis: 'a,b,c', 'linspace:a:b:n' or 'geomspace:a:b:n' (repeat)")
+                        help="grid axis: 'a,b,c', 'linspace:a:b:n' or 'geomspace:a:b:n'; values with units "
+                             "(plate.t=linspace:1mm:5mm:9) or SI (repeat)")
     parser.add_argument("--random", action="append", metavar="NAME=DIST",
                         help="random parameter: uniform:lo:hi, loguniform:lo:hi, normal:mean:sd, "
                              "normal_rel:sd, uniform_rel:h, choice:a,b (repeat)")
-    parser.add_argument("--set", action="append", metavar="NAME=VALUE", help="fixed value (repeat)")
+    parser.add_argument("--set", action="append", metavar="NAME=VALUE",
+                        help="fixed value, with a unit or SI: plate.t=3mm, plate.E=114GPa, sphere.d='1/4 in' (repeat)")
     parser.add_argument("--samples", type=_int_in(1, MAX_SAMPLES), help="random cases per grid point")
     parser.add_argument("--seed", type=_int_in(0, MAX_SEED), help="seed of the random draws (0 ... 2**63 - 1)")
     parser.add_argument("--backend", choices=("package", "fmu", "both"),
@@ -186,6 +216,8 @@ def _main(parser, args) -> int:
         spec, run = build_spec(args)
         run_ints = {key: _int_in(low, high)(str(run[key])) for key, low, high in (
             ("workers", 1, MAX_WORKERS), ("chunk_size", 1, MAX_CHUNK)) if run.get(key) is not None}
+    except QuantityError as exc:  # a value: one line naming it, no usage
+        return _error(str(exc), EXIT_REFUSED)
     except (ValueError, argparse.ArgumentTypeError) as exc:
         parser.error(str(exc))
     backend = args.backend or run.get("backend", "package")

@@ -12,10 +12,13 @@ cut into chunks (they come in fixed blocks of :data:`RANDOM_BLOCK` cases, each s
 
 Names are the FMU's (``sphere.E``, ``plate.t``, ``v_approach``, ...); the package's
 keyword names (``sphere_E``, ``plate_t``, ``v``) are accepted too. ``t_over_d`` is a derived
-axis: ``plate.t = t_over_d * sphere.d``.
+axis: ``plate.t = t_over_d * sphere.d``. Values take units (``"3mm"``, ``"114 GPa"``; a bare number
+is SI, :mod:`restitution.sweep.values`); :meth:`SweepSpec.check_domain` checks the explicit ones
+against the inputs' declared ranges.
 """
 from __future__ import annotations
 
+import contextlib
 import json
 import math
 from dataclasses import dataclass, field
@@ -25,9 +28,11 @@ import numpy as np
 
 from ..fmu.models.sphere_plate_impact.variables import MATERIAL_SELECTORS, TABLE, fmu_values
 from ..materials import MATERIALS, TABLE4_CASES, table4_case
+from .values import (MAX_AXIS_VALUES, ROWS, QuantityError, axis_form, axis_size, draw,  # noqa: F401 (axis_size)
+                     outside, parse_distribution, parse_values, range_ends, range_size, range_values)
 
 __all__ = ["SweepSpec", "INPUTS", "OUTPUTS", "CODES", "RANDOM_BLOCK", "canonical_name", "load_spec",
-           "parse_values", "parse_distribution", "resolve_pair", "SizeError"]
+           "parse_values", "parse_distribution", "resolve_pair", "SizeError", "QuantityError"]
 
 
 class SizeError(ValueError):
@@ -76,173 +81,6 @@ def canonical_name(name: str) -> str:
                      f"({', '.join(INPUT_NAMES)}) or {T_OVER_D!r}")
 
 
-def _code(name: str, value):
-    """An integer-coded parameter's code from a number or a word ('exact', 'e45', 'auto', ...)."""
-    if isinstance(value, str):
-        words = CODES[name]
-        if value.strip() in words:
-            return words[value.strip()]
-        try:
-            text = value.strip()
-            value = int(text) if text.lstrip("+-").isdigit() and text.isascii() else float(text)
-        except ValueError:
-            raise ValueError(f"{name} = {value!r}: use one of {sorted(words)} or a code "
-                             f"{sorted(words.values())}") from None
-    try:
-        integral = float(value) == int(value)
-    except (OverflowError, ValueError):
-        integral = False
-    if not integral:
-        raise ValueError(f"{name} = {value!r} is not an integer code")
-    code = int(value)
-    if code not in CODES[name].values():  # checked here: an FMU back end would wrap it to int32
-        raise ValueError(f"{name} = {value!r} is out of range: use one of {sorted(CODES[name])} or a code "
-                         f"{sorted(CODES[name].values())}")
-    return code
-
-
-def _number(name: str, value) -> float:
-    if name in CODES:
-        return float(_code(name, value))
-    try:
-        return float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} = {value!r} is not a number") from None
-
-
-# --- value lists and distributions -------------------------------------------------------
-#: Largest grid axis [values]: an axis is materialised (8 bytes a value) where the cases are built.
-MAX_AXIS_VALUES = 10**8
-
-
-def _range_form(name: str, spec):
-    """``(kind, args)`` of a linspace/geomspace/logspace/arange value range, else None."""
-    if isinstance(spec, str):
-        kind, _, rest = spec.strip().partition(":")
-        if rest and kind in ("linspace", "geomspace", "logspace", "arange"):
-            try:
-                return kind, [float(x) for x in rest.split(":")]
-            except ValueError:
-                raise ValueError(f"{name} = {spec!r}: {kind} takes numbers separated by ':'") from None
-        return None
-    if isinstance(spec, dict):
-        if len(spec) != 1:
-            raise ValueError(f"{name}: a value range has exactly one key, got {sorted(spec)}")
-        (kind, args), = spec.items()
-        if kind not in ("linspace", "geomspace", "logspace", "arange"):
-            raise ValueError(f"{name}: unknown value range {kind!r} (linspace, geomspace, logspace, arange)")
-        try:
-            args = [float(a) for a in (args if isinstance(args, (list, tuple)) else [args])]
-        except (TypeError, ValueError):
-            raise ValueError(f"{name}: {kind} takes numbers, got {args!r}") from None
-        return kind, args
-    return None
-
-
-def axis_size(name: str, spec) -> int:
-    """Number of values :func:`parse_values` gives for ``spec``, without building them (a Python int)."""
-    form = _range_form(name, spec)
-    if form is None:
-        if isinstance(spec, str):
-            return len([x for x in spec.strip().split(",") if x.strip()])
-        return len(spec) if isinstance(spec, (list, tuple, np.ndarray)) else 1
-    kind, args = form
-    if not all(math.isfinite(a) for a in args):
-        raise ValueError(f"{name}: {kind} needs finite numbers, got {args!r}")
-    if kind == "arange":
-        if len(args) not in (1, 2, 3):
-            raise ValueError(f"{name}: arange needs [stop], [start, stop] or [start, stop, step]")
-        start, stop, step = (0.0, args[0], 1.0) if len(args) == 1 else (*args, 1.0)[:3]
-        if step == 0:
-            raise ValueError(f"{name}: arange step = 0: the step must be non-zero")
-        return max(0, math.ceil((stop - start) / step))
-    if len(args) != 3 or int(args[2]) != args[2] or args[2] < 1:
-        raise ValueError(f"{name}: {kind} needs [first, last, count] with an integer count >= 1")
-    if kind == "geomspace" and (args[0] == 0 or args[1] == 0 or (args[0] < 0) != (args[1] < 0)):
-        raise ValueError(f"{name}: geomspace needs first and last non-zero and of the same sign, got {args[:2]!r}")
-    return int(args[2])
-
-
-def parse_values(name: str, spec) -> np.ndarray:
-    """Grid values: a number, a list, ``{"linspace": [a, b, n]}``, ``{"geomspace": [a, b, n]}``,
-    ``{"arange": [a, b, step]}``, or the CLI forms ``"a,b,c"``, ``"linspace:a:b:n"``, ``"geomspace:a:b:n"``."""
-    form = _range_form(name, spec)
-    if form is not None:
-        kind, args = form
-        size = axis_size(name, spec)
-        if size > MAX_AXIS_VALUES:
-            raise ValueError(f"{name}: {kind} gives {size:,} values; at most {MAX_AXIS_VALUES:,} per axis")
-        if kind == "arange":
-            values = np.arange(*args)
-        else:
-            fn = {"linspace": np.linspace, "geomspace": np.geomspace, "logspace": np.logspace}[kind]
-            values = fn(args[0], args[1], int(args[2]))
-    elif isinstance(spec, str):
-        values = np.array([_number(name, v) for v in spec.strip().split(",") if v.strip()], dtype=float)
-    elif isinstance(spec, (list, tuple, np.ndarray)):
-        values = np.array([_number(name, v) for v in spec], dtype=float)
-    else:
-        values = np.array([_number(name, spec)], dtype=float)
-    if values.size == 0:
-        raise ValueError(f"{name}: no values")
-    return values
-
-
-#: distribution -> number of parameters.
-DISTRIBUTIONS = {"uniform": 2, "loguniform": 2, "normal": 2, "normal_rel": 1, "uniform_rel": 1, "choice": None}
-
-
-def parse_distribution(name: str, spec) -> tuple[str, tuple]:
-    """A random parameter's distribution: ``{"uniform": [lo, hi]}``, ``{"loguniform": [lo, hi]}``,
-    ``{"normal": [mean, sd]}``, ``{"normal_rel": sd}`` (base value x (1 + sd N(0,1))),
-    ``{"uniform_rel": h}`` (base value x U(1-h, 1+h)), ``{"choice": [values]}``, or the CLI
-    form ``"uniform:lo:hi"``, ``"normal_rel:0.02"``, ``"choice:a,b,c"``. The base value of the
-    relative forms is what the case has without the draw (material pair, grid, fixed or start value)."""
-    if isinstance(spec, str):
-        kind, _, rest = spec.strip().partition(":")
-        if kind == "choice":
-            args = [x for x in rest.split(",") if x.strip()]
-        else:
-            args = [float(x) for x in rest.split(":") if x.strip()]
-        spec = {kind: args}
-    if not isinstance(spec, dict) or len(spec) != 1:
-        raise ValueError(f"{name}: a distribution is one of {sorted(DISTRIBUTIONS)} with its parameters, got {spec!r}")
-    (kind, args), = spec.items()
-    if kind not in DISTRIBUTIONS:
-        raise ValueError(f"{name}: unknown distribution {kind!r} (one of {sorted(DISTRIBUTIONS)})")
-    args = list(args) if isinstance(args, (list, tuple)) else [args]
-    if kind == "choice":
-        if not args:
-            raise ValueError(f"{name}: choice needs at least one value")
-        return kind, tuple(_number(name, a) for a in args)
-    if len(args) != DISTRIBUTIONS[kind]:
-        raise ValueError(f"{name}: {kind} takes {DISTRIBUTIONS[kind]} parameter(s), got {args!r}")
-    args = tuple(float(a) for a in args)
-    if kind in ("uniform", "loguniform") and not args[0] < args[1]:
-        raise ValueError(f"{name}: {kind} needs low < high, got {args!r}")
-    if kind == "loguniform" and args[0] <= 0:
-        raise ValueError(f"{name}: loguniform needs low > 0, got {args!r}")
-    if kind != "uniform" and kind != "loguniform" and min(args[1:] if kind == "normal" else args) < 0:
-        raise ValueError(f"{name}: {kind} needs a spread >= 0, got {args!r}")
-    if name in CODES and kind != "choice":
-        raise ValueError(f"{name} is integer-coded: only 'choice' can draw it")
-    return kind, args
-
-
-def _draw(rng: np.random.Generator, kind: str, args: tuple, n: int) -> np.ndarray:
-    if kind == "uniform":
-        return rng.uniform(args[0], args[1], n)
-    if kind == "loguniform":
-        return np.exp(rng.uniform(math.log(args[0]), math.log(args[1]), n))
-    if kind == "normal":
-        return args[0] + args[1] * rng.standard_normal(n)
-    if kind == "normal_rel":
-        return 1.0 + args[0] * rng.standard_normal(n)
-    if kind == "uniform_rel":
-        return rng.uniform(1.0 - args[0], 1.0 + args[0], n)
-    return np.asarray(args, dtype=float)[rng.integers(0, len(args), n)]
-
-
 # --- material pairs -------------------------------------------------------------------
 def resolve_pair(pair: str):
     """(sphere Material, plate Material) of ``"sphere_key/plate_key"`` (keys of
@@ -278,6 +116,16 @@ def pair_label(pair: str) -> str:
 
 
 # --- the spec --------------------------------------------------------------------------
+@contextlib.contextmanager
+def _section(section: str):
+    """A :class:`QuantityError` raised inside names ``section`` (where its value was given)."""
+    try:
+        yield
+    except QuantityError as exc:
+        exc.section = exc.section or section
+        raise
+
+
 @dataclass
 class SweepSpec:
     """A grid and/or random sample over FMU inputs/parameters (see the module docstring).
@@ -304,16 +152,15 @@ class SweepSpec:
         self.grid = {canonical_name(k): v for k, v in self.grid.items()}
         self.random = {canonical_name(k): v for k, v in self.random.items()}
         self.fixed = {canonical_name(k): v for k, v in self.fixed.items()}
-        self._axis_sizes = {k: axis_size(k, v) for k, v in self.grid.items()}
+        with _section("grid"):  # units are read here: a worker builds its axes from SI numbers
+            self._forms = {k: axis_form(k, v) for k, v in self.grid.items()}
+        self._axis_sizes = {k: args.size if kind == "values" else range_size(k, kind, args)
+                            for k, (kind, args) in self._forms.items()}
         self._axes_built = None  # the axes' values, built when cases are (see _axes)
-        for k, v in self.grid.items():  # value lists and codes are checked now (they are small)
-            if k in CODES or _range_form(k, v) is None:
-                if self._axis_sizes[k] > 1000:
-                    raise ValueError(f"{k}: {self._axis_sizes[k]:,} listed values; give a range "
-                                     f"(linspace, geomspace, arange) for long axes")
-                parse_values(k, v)
-        self._dists = {k: parse_distribution(k, v) for k, v in self.random.items()}
-        self._fixed = {k: parse_values(k, v) for k, v in self.fixed.items()}
+        with _section("random"):
+            self._dists = {k: parse_distribution(k, v) for k, v in self.random.items()}
+        with _section("fixed"):
+            self._fixed = {k: parse_values(k, v) for k, v in self.fixed.items()}
         for k, v in self._fixed.items():
             if v.size != 1:
                 raise ValueError(f"fixed {k}: one value, got {v.size} (use the grid for several)")
@@ -349,6 +196,30 @@ class SweepSpec:
             if kind.endswith("_rel") and k == T_OVER_D and T_OVER_D not in sources:
                 raise ValueError(f"{k}: a relative draw needs a base value from the grid or fixed")
 
+    def check_domain(self) -> None:
+        """:class:`QuantityError` (a ValueError, one line) for the first explicit value outside its
+        input's declared range: a fixed value, a value of a grid list, the first or last value of a grid
+        range, and ``plate.t`` as ``t_over_d`` times ``sphere.d`` gives it at their ends. Random draws
+        are not checked: a case they take outside is a row with ``ok = False``. The command line calls
+        it before any work; :func:`run_sweep` does not (such cases are rows with ``ok = False``)."""
+        explicit = {k: ("fixed", [float(v[0])]) for k, v in self._fixed.items()}
+        explicit.update({k: ("grid", list(args) if kind == "values" else range_ends(k, kind, args))
+                         for k, (kind, args) in self._forms.items() if k not in CODES})
+        for k, (section, values) in explicit.items():
+            for value in values:
+                problem = outside(k, value)
+                if problem:
+                    raise QuantityError(problem, k, section)
+        drawn = self._dists.get("sphere.d", ("", ()))[0]
+        if T_OVER_D in explicit and (not drawn or drawn.endswith("_rel")):
+            section, ratios = explicit[T_OVER_D]
+            for ratio in ratios:
+                for d in explicit.get("sphere.d", ("", [float(START["sphere.d"])]))[1]:
+                    if outside("plate.t", ratio * d):
+                        raise QuantityError(
+                            f"{T_OVER_D} = {ratio:.15g} with sphere.d = {d:.15g} m gives plate.t = {ratio * d:.15g} m, "
+                            f"outside {ROWS['plate.t'].allowed_text()} m", T_OVER_D, section)
+
     # --- structure ---
     def check_axes(self) -> None:
         """:class:`SizeError` when an axis has more values than :data:`MAX_AXIS_VALUES` (each worker
@@ -361,7 +232,8 @@ class SweepSpec:
     @property
     def _axes(self) -> dict:
         if self._axes_built is None:
-            self._axes_built = {k: parse_values(k, v) for k, v in self.grid.items()}
+            self._axes_built = {k: args if kind == "values" else range_values(k, kind, args)
+                                for k, (kind, args) in self._forms.items()}
         return self._axes_built
 
     @property
@@ -483,7 +355,7 @@ class SweepSpec:
             lo = max(start - b * RANDOM_BLOCK, 0)
             hi = min(stop - b * RANDOM_BLOCK, RANDOM_BLOCK)
             for k, (kind, args) in self._dists.items():
-                parts[k].append(_draw(rng, kind, args, RANDOM_BLOCK)[lo:hi])
+                parts[k].append(draw(rng, kind, args, RANDOM_BLOCK)[lo:hi])
         return {k: np.concatenate(v) if v else np.empty(0) for k, v in parts.items()}
 
     def describe(self) -> str:

@@ -1,0 +1,359 @@
+"""The values a sweep is given: numbers with units, value lists, ranges and distributions, and the
+range each input declares.
+
+A quantity is a number with an optional unit: ``"3mm"``, ``"3 mm"``, ``"6.35e-3 m"``, ``"114GPa"``,
+``"1/4 in"``; a bare number is SI (``"0.003"`` for ``plate.t`` is 3 mm). Units are read by the
+scene's parser (:mod:`restitution.scene.units`: pint, any unit of the right kind); a unit of another
+kind is refused naming the input, the unit given and the kind expected. Dimensionless inputs
+(``sphere.nu``, tolerances, ``t_over_d``) and relative spreads take plain numbers.
+
+An explicit value outside the input's declared range (the interface table's interval, the FMUs'
+``min``/``max``, :data:`restitution.model.DOMAIN`) is refused by :func:`outside`, with a hint where a
+slipped SI prefix explains it (``plate.E = 114 Pa ... did you mean 114 GPa?``).
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..fmu.models.sphere_plate_impact.variables import TABLE
+from ..scene.units import EXAMPLES, QUANTITIES, UnitError, convert_quantity, split_quantity
+
+__all__ = ["QuantityError", "quantity", "quantities", "unit_of", "outside", "parse_values", "parse_distribution",
+           "axis_size", "axis_form", "range_size", "range_values", "range_ends", "draw", "MAX_AXIS_VALUES",
+           "DISTRIBUTIONS"]
+
+#: FMU name -> row of the interface table, for every input and parameter.
+ROWS = {v.name: v for v in TABLE.settable}
+#: SI unit (as the interface table writes it) -> the kind of quantity the scene's parser converts to.
+KINDS = {si: kind for kind, si in QUANTITIES.items()}
+#: The prefixed units a slip of an SI prefix suggests: SI unit -> {factor to SI: unit}. A value
+#: outside the range that lands in it times a factor (1e3, 1e6, 1e9 or 1e-3) was likely meant in
+#: that unit (``plate.E = 114`` -> 114 GPa; ``plate.t = 3000`` -> 3000 mm).
+PREFIXED = {"m": {1e-3: "mm"}, "Pa": {1e3: "kPa", 1e6: "MPa", 1e9: "GPa"},
+            "m/s": {1e-3: "mm/s", 1e3: "km/s"}, "kg/m3": {1e3: "g/cm3"}}
+
+
+class QuantityError(ValueError):
+    """A value the sweep refuses: not a number, a unit it cannot take, or outside the input's declared
+    range. ``name`` is the input, ``section`` where the value was given ("grid", "random", "fixed";
+    set by :class:`~restitution.sweep.SweepSpec`), for the command line to name the option."""
+
+    def __init__(self, message: str, name: str, section: str | None = None):
+        super().__init__(message)
+        self.name, self.section = name, section
+
+
+def unit_of(name: str) -> str | None:
+    """The SI unit of input ``name`` (``"m"``, ``"Pa"``, ``"kg/m3"``, ``"m/s"``); None where it is
+    dimensionless or a code (no unit is taken)."""
+    row = ROWS.get(name)
+    return row.unit if row is not None and row.unit in KINDS else None
+
+
+def _read(name: str, value) -> tuple[float, bool]:
+    """(SI value, whether a unit was given) of one value."""
+    if not isinstance(value, str):
+        try:
+            return float(value), False
+        except (TypeError, ValueError):
+            raise QuantityError(f"{name} = {value!r} is not a number", name) from None
+    si = unit_of(name)
+    parsed = split_quantity(value, fractions=True)
+    if parsed is None:
+        example = f" with an optional unit ({EXAMPLES[KINDS[si]]}; a bare number is in {si})" if si else ""
+        raise QuantityError(f"{name} = {value!r} is not a number{example}", name)
+    number, unit = parsed
+    if unit is None:
+        return number, False
+    if si is None:
+        raise QuantityError(f"{name} = {value!r}: {name} is dimensionless: give a plain number, no unit", name)
+    try:
+        return convert_quantity(name, value.strip(), number, unit, KINDS[si]), True
+    except UnitError as exc:
+        raise QuantityError(f"{name} = {exc}", name) from None
+
+
+def quantity(name: str, value) -> float:
+    """SI value of ``value`` for input ``name``: a number (SI), or text ``"<number>[ <unit>]"``
+    (see the module docstring). :class:`QuantityError` (a ValueError) naming ``name`` otherwise."""
+    return _read(name, value)[0]
+
+
+def quantities(name: str, values, text=None) -> list[float]:
+    """SI values of ``values`` given together (a list, the ends of a range, a distribution's
+    parameters): either all with units or none (``"1,2,3mm"`` is refused, not read as 1 m, 2 m and
+    3 mm); a bare 0 goes with either. ``text`` is the whole value, for the message."""
+    read = [_read(name, v) for v in values]
+    with_unit = [v for v, (_, unit) in zip(values, read) if unit]
+    bare = [v for v, (si, unit) in zip(values, read) if not unit and si != 0]
+    if with_unit and bare:
+        shown = text if text is not None else list(values)
+        raise QuantityError(f"{name} = {shown!r}: give every value its unit or none ({bare[0]!r} has none and "
+                            f"would be {bare[0]} {unit_of(name)}, {with_unit[0]!r} has one)", name)
+    return [si for si, _ in read]
+
+
+def _format(value: float) -> str:
+    return f"{value:.15g}"
+
+
+def _hint(name: str, value: float) -> str | None:
+    """``"114 GPa"`` where ``value`` (SI, outside the range) lands in it with a slipped SI prefix: of the
+    prefixed units of :data:`PREFIXED` that bring it in, the one nearest (in decades) the input's
+    start value; None where none does."""
+    row, unit = ROWS[name], unit_of(name)
+    start = float(row.start)
+    best = None
+    for factor, prefixed in PREFIXED.get(unit, {}).items():
+        meant = value * factor
+        if meant > 0 < start and row.accepts(meant):
+            distance = abs(math.log10(meant / start))
+            if best is None or distance < best[0]:
+                best = (distance, prefixed)
+    return None if best is None else f"{_format(value)} {best[1]}"
+
+
+def outside(name: str, value: float) -> str | None:
+    """The message refusing ``value`` (SI) for input ``name`` when it lies outside the input's declared
+    range (``v_approach = -1 m/s is outside 0 <= value <= 10000 m/s``, with ``: did you mean 114 GPa?``
+    where a slipped prefix explains it); None when it lies inside, or ``name`` is a code (checked when
+    read) or not an input."""
+    row = ROWS.get(name)
+    if row is None or row.interval is None or row.choices is not None:
+        return None
+    try:
+        if row.accepts(value):
+            return None
+    except (ValueError, OverflowError):
+        pass
+    unit = unit_of(name)
+    suffix = f" {unit}" if unit else ""
+    message = f"{name} = {_format(value)}{suffix} is outside {row.allowed_text()}{suffix}"
+    hint = _hint(name, value) if unit and math.isfinite(value) else None
+    return f"{message}: did you mean {hint}?" if hint else message
+
+
+# --- value lists, ranges and distributions --------------------------------------------------
+def _codes(name: str) -> dict | None:
+    """word -> code of an integer-coded input, else None."""
+    row = ROWS.get(name)
+    return row.codes if row is not None and row.choices is not None else None
+
+
+def _code(name: str, value):
+    """An integer-coded parameter's code from a number or a word ('exact', 'e45', 'auto', ...)."""
+    if isinstance(value, str):
+        words = _codes(name)
+        if value.strip() in words:
+            return words[value.strip()]
+        try:
+            text = value.strip()
+            value = int(text) if text.lstrip("+-").isdigit() and text.isascii() else float(text)
+        except ValueError:
+            raise ValueError(f"{name} = {value!r}: use one of {sorted(words)} or a code "
+                             f"{sorted(words.values())}") from None
+    try:
+        integral = float(value) == int(value)
+    except (OverflowError, ValueError):
+        integral = False
+    if not integral:
+        raise ValueError(f"{name} = {value!r} is not an integer code")
+    code = int(value)
+    if code not in _codes(name).values():  # checked here: an FMU back end would wrap it to int32
+        raise ValueError(f"{name} = {value!r} is out of range: use one of {sorted(_codes(name))} or a code "
+                         f"{sorted(_codes(name).values())}")
+    return code
+
+
+def _numbers(name: str, items, text) -> np.ndarray:
+    """SI values of ``items`` given together (codes for an integer-coded ``name``); ``text``: the whole value."""
+    if _codes(name) is not None:
+        return np.array([float(_code(name, v)) for v in items], dtype=float)
+    return np.array(quantities(name, list(items), text), dtype=float)
+
+
+def _plain(name: str, value, what: str) -> float:
+    """A dimensionless number of a range or a distribution (a count, an exponent, a relative spread)."""
+    try:
+        return float(value)
+    except (TypeError, ValueError):
+        raise QuantityError(f"{name} = {value!r}: {what}", name) from None
+
+
+#: Largest grid axis [values]: an axis is materialised (8 bytes a value) where the cases are built.
+MAX_AXIS_VALUES = 10**8
+
+
+def _range_args(name: str, kind: str, args: list, text) -> list:
+    """A range's numbers in SI: its ends (and arange's step) quantities, given all with units or none;
+    a count and logspace's exponents plain numbers."""
+    if kind == "logspace":
+        return [_plain(name, a, "logspace takes exponents of ten and a count: plain numbers") for a in args]
+    if kind == "arange":
+        return quantities(name, args, text)
+    return quantities(name, args[:2], text) + [_plain(name, a, f"the count of {kind} is a plain number")
+                                               for a in args[2:]]
+
+
+def _range_form(name: str, spec):
+    """``(kind, args)`` of a linspace/geomspace/logspace/arange value range (args in SI), else None."""
+    if isinstance(spec, str):
+        kind, _, rest = spec.strip().partition(":")
+        if rest and kind in ("linspace", "geomspace", "logspace", "arange"):
+            return kind, _range_args(name, kind, rest.split(":"), spec)
+        return None
+    if isinstance(spec, dict):
+        if len(spec) != 1:
+            raise ValueError(f"{name}: a value range has exactly one key, got {sorted(spec)}")
+        (kind, args), = spec.items()
+        if kind not in ("linspace", "geomspace", "logspace", "arange"):
+            raise ValueError(f"{name}: unknown value range {kind!r} (linspace, geomspace, logspace, arange)")
+        return kind, _range_args(name, kind, list(args) if isinstance(args, (list, tuple)) else [args], spec)
+    return None
+
+
+def axis_size(name: str, spec) -> int:
+    """Number of values :func:`parse_values` gives for ``spec``, without building them (a Python int)."""
+    form = _range_form(name, spec)
+    if form is None:
+        if isinstance(spec, str):
+            return len([x for x in spec.strip().split(",") if x.strip()])
+        return len(spec) if isinstance(spec, (list, tuple, np.ndarray)) else 1
+    return range_size(name, *form)
+
+
+def range_size(name: str, kind: str, args: list) -> int:
+    """Number of values of a range ``(kind, args)`` (args in SI), checked, without building it."""
+    if not all(math.isfinite(a) for a in args):
+        raise ValueError(f"{name}: {kind} needs finite numbers, got {args!r}")
+    if kind == "arange":
+        if len(args) not in (1, 2, 3):
+            raise ValueError(f"{name}: arange needs [stop], [start, stop] or [start, stop, step]")
+        start, stop, step = (0.0, args[0], 1.0) if len(args) == 1 else (*args, 1.0)[:3]
+        if step == 0:
+            raise ValueError(f"{name}: arange step = 0: the step must be non-zero")
+        return max(0, math.ceil((stop - start) / step))
+    if len(args) != 3 or int(args[2]) != args[2] or args[2] < 1:
+        raise ValueError(f"{name}: {kind} needs [first, last, count] with an integer count >= 1")
+    if kind == "geomspace" and (args[0] == 0 or args[1] == 0 or (args[0] < 0) != (args[1] < 0)):
+        raise ValueError(f"{name}: geomspace needs first and last non-zero and of the same sign, got {args[:2]!r}")
+    return int(args[2])
+
+
+def range_values(name: str, kind: str, args: list) -> np.ndarray:
+    """The values of a range ``(kind, args)``, at most :data:`MAX_AXIS_VALUES`."""
+    size = range_size(name, kind, args)
+    if size > MAX_AXIS_VALUES:
+        raise ValueError(f"{name}: {kind} gives {size:,} values; at most {MAX_AXIS_VALUES:,} per axis")
+    if kind == "arange":
+        return np.arange(*args)
+    fn = {"linspace": np.linspace, "geomspace": np.geomspace, "logspace": np.logspace}[kind]
+    return fn(args[0], args[1], int(args[2]))
+
+
+def range_ends(name: str, kind: str, args: list) -> list:
+    """The first and last values of a range, without building it."""
+    n = range_size(name, kind, args)
+    if n == 0:
+        return []
+    if kind == "arange":
+        start, _stop, step = (0.0, args[0], 1.0) if len(args) == 1 else (*args, 1.0)[:3]
+        first, last = start, start + (n - 1) * step
+    else:
+        first, last = (10.0 ** args[0], 10.0 ** args[1]) if kind == "logspace" else (args[0], args[1])
+    return [first] if n == 1 else [first, last]
+
+
+def parse_values(name: str, spec) -> np.ndarray:
+    """Grid values in SI: a number, a list, ``{"linspace": [a, b, n]}``, ``{"geomspace": [a, b, n]}``,
+    ``{"arange": [a, b, step]}``, or the CLI forms ``"a,b,c"``, ``"linspace:a:b:n"``, ``"geomspace:a:b:n"``;
+    each value a number (SI) or text with a unit (``"3mm"``, ``"linspace:1mm:5mm:5"``)."""
+    form = _range_form(name, spec)
+    if form is not None:
+        values = range_values(name, *form)
+    elif isinstance(spec, str):
+        values = _numbers(name, [v for v in spec.strip().split(",") if v.strip()], spec)
+    elif isinstance(spec, (list, tuple, np.ndarray)):
+        values = _numbers(name, spec, spec)
+    else:
+        values = _numbers(name, [spec], spec)
+    if values.size == 0:
+        raise ValueError(f"{name}: no values")
+    return values
+
+
+#: distribution -> number of parameters.
+DISTRIBUTIONS = {"uniform": 2, "loguniform": 2, "normal": 2, "normal_rel": 1, "uniform_rel": 1, "choice": None}
+
+
+def parse_distribution(name: str, spec) -> tuple[str, tuple]:
+    """A random parameter's distribution: ``{"uniform": [lo, hi]}``, ``{"loguniform": [lo, hi]}``,
+    ``{"normal": [mean, sd]}``, ``{"normal_rel": sd}`` (base value x (1 + sd N(0,1))),
+    ``{"uniform_rel": h}`` (base value x U(1-h, 1+h)), ``{"choice": [values]}``, or the CLI
+    form ``"uniform:lo:hi"``, ``"normal_rel:0.02"``, ``"choice:a,b,c"``. The base value of the
+    relative forms is what the case has without the draw (material pair, grid, fixed or start value).
+    The parameters of the absolute forms take units (``"uniform:1mm:5mm"``; bare numbers are SI), the
+    relative spreads are plain numbers."""
+    text = spec
+    if isinstance(spec, str):
+        kind, _, rest = spec.strip().partition(":")
+        if kind == "choice":
+            args = [x for x in rest.split(",") if x.strip()]
+        else:
+            args = [x for x in rest.split(":") if x.strip()]
+        spec = {kind: args}
+    if not isinstance(spec, dict) or len(spec) != 1:
+        raise ValueError(f"{name}: a distribution is one of {sorted(DISTRIBUTIONS)} with its parameters, got {spec!r}")
+    (kind, args), = spec.items()
+    if kind not in DISTRIBUTIONS:
+        raise ValueError(f"{name}: unknown distribution {kind!r} (one of {sorted(DISTRIBUTIONS)})")
+    args = list(args) if isinstance(args, (list, tuple)) else [args]
+    if kind == "choice":
+        if not args:
+            raise ValueError(f"{name}: choice needs at least one value")
+        return kind, tuple(float(a) for a in _numbers(name, args, text))
+    if len(args) != DISTRIBUTIONS[kind]:
+        raise ValueError(f"{name}: {kind} takes {DISTRIBUTIONS[kind]} parameter(s), got {args!r}")
+    if kind.endswith("_rel"):
+        args = tuple(_plain(name, a, f"{kind} takes a relative spread, a plain number (0.03 is 3 %)") for a in args)
+    else:
+        args = tuple(quantities(name, args, text))
+    if kind in ("uniform", "loguniform") and not args[0] < args[1]:
+        raise ValueError(f"{name}: {kind} needs low < high, got {args!r}")
+    if kind == "loguniform" and args[0] <= 0:
+        raise ValueError(f"{name}: loguniform needs low > 0, got {args!r}")
+    if kind != "uniform" and kind != "loguniform" and min(args[1:] if kind == "normal" else args) < 0:
+        raise ValueError(f"{name}: {kind} needs a spread >= 0, got {args!r}")
+    if _codes(name) is not None and kind != "choice":
+        raise ValueError(f"{name} is integer-coded: only 'choice' can draw it")
+    return kind, args
+
+
+def draw(rng: np.random.Generator, kind: str, args: tuple, n: int) -> np.ndarray:
+    """``n`` draws of a distribution from :func:`parse_distribution` (the factor, for a relative one)."""
+    if kind == "uniform":
+        return rng.uniform(args[0], args[1], n)
+    if kind == "loguniform":
+        return np.exp(rng.uniform(math.log(args[0]), math.log(args[1]), n))
+    if kind == "normal":
+        return args[0] + args[1] * rng.standard_normal(n)
+    if kind == "normal_rel":
+        return 1.0 + args[0] * rng.standard_normal(n)
+    if kind == "uniform_rel":
+        return rng.uniform(1.0 - args[0], 1.0 + args[0], n)
+    return np.asarray(args, dtype=float)[rng.integers(0, len(args), n)]
+
+
+def axis_form(name: str, spec) -> tuple:
+    """``(kind, args)`` of a grid axis in SI: a range's kind and numbers (checked, not built), or
+    ``("values", array)`` for a list and an integer-coded parameter (small: checked now)."""
+    form = _range_form(name, spec)
+    if form is not None and _codes(name) is None:
+        range_size(name, *form)
+        return form
+    size = axis_size(name, spec)
+    if size > 1000:
+        raise ValueError(f"{name}: {size:,} listed values; give a range (linspace, geomspace, arange) for long axes")
+    return "values", parse_values(name, spec)
