@@ -188,9 +188,11 @@ def _remove(path: Path) -> None:
         os.unlink(path)
 
 
-def atomic_write(path, write, what: str = "output") -> Path:
+def atomic_write(path, write, what: str = "output", durable: bool = True) -> Path:
     """``write(tmp)`` to a new file beside ``path`` (``tmp`` keeps ``path``'s suffix), fsynced and
-    renamed over ``path`` (over the target of a symlink) once whole; returns ``path``.
+    renamed over ``path`` (over the target of a symlink) once whole; returns ``path``. ``durable=False``
+    skips the two fsyncs, for a file whose reader verifies it (a sweep part's checksum): a power loss
+    may then leave it cut short, never a half-written file from a failed or killed process.
 
     A failure removes the temporary file and leaves ``path`` as it was: an I/O error raises
     :class:`OutputWriteError` naming ``path``; ``path`` turned into something other than a regular
@@ -206,14 +208,16 @@ def atomic_write(path, write, what: str = "output") -> Path:
     try:
         os.close(fd)
         write(tmp)
-        fd = os.open(tmp, os.O_RDONLY)
-        try:
-            os.fsync(fd)
-        finally:
-            os.close(fd)
+        if durable:
+            fd = os.open(tmp, os.O_RDONLY)
+            try:
+                os.fsync(fd)
+            finally:
+                os.close(fd)
         _refuse_special(dest, what)  # again, right before the rename: nothing but a regular file is replaced
         os.replace(tmp, dest)
-        _fsync_dir(dest.parent)
+        if durable:
+            _fsync_dir(dest.parent)
     except OSError as exc:
         _remove(tmp)
         raise OutputWriteError(path, exc) from None

@@ -3,7 +3,8 @@ from), and the result whose table stays there (streamed chunk by chunk when writ
 
 A part file, ``chunk-<start>-<stop>.npz``, holds the chunk's columns and a record of what it is: its
 case range, the sweep it belongs to (a fingerprint of the manifest) and the sha256 of its columns.
-It is written under a temporary name, fsynced and renamed (:func:`restitution.output_files.atomic_write`).
+It is written under a temporary name and renamed (:func:`restitution.output_files.atomic_write`); not
+fsynced, since --resume checks it.
 On resume every part is checked before it is used: a file that is not a regular file, not a readable
 .npz, holds other cases than its name says (two parts swapped), belongs to another sweep, or whose
 columns do not match their checksum is removed and its cases are computed again (one line on stderr
@@ -233,12 +234,14 @@ class PartStore:
 
     def write(self, a: int, b: int, part) -> None:
         """The chunk ``a`` ... ``b - 1`` as a part file, with its range and checksum; written under a
-        temporary name, fsynced and renamed (an I/O error: OutputWriteError naming the part)."""
+        temporary name and renamed (an I/O error: OutputWriteError naming the part). Not fsynced: --resume
+        verifies every part's checksum and computes a bad one again, so a part that a power loss cut
+        short is never used, and a streamed run does not wait for the disk chunk by chunk."""
         columns, info = part
         record = {"range": [int(a), int(b)], "sweep": self.sweep, "sha256": part_digest(columns, a, b, self.sweep)}
         text = np.array(json.dumps({**info, "part": record}, default=str))
         atomic_write(self.file(a, b), lambda tmp: np.savez(tmp, info=text, **{f"c:{k}": v for k, v in columns.items()}),
-                     "chunk file")
+                     "chunk file", durable=False)
 
     def remove(self) -> None:
         shutil.rmtree(self.path, ignore_errors=True)
