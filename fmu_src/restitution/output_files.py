@@ -140,12 +140,7 @@ def check_output_dir(path, what: str = "--out") -> Path:
     if st is not None and not stat.S_ISDIR(st.st_mode):
         kind = "a regular file" if stat.S_ISREG(st.st_mode) else file_kind(st.st_mode)
         raise OutputPathError(f"{what} {path}: exists and is {kind}, not a directory")
-    try:
-        path.mkdir(parents=True, exist_ok=True)
-        with tempfile.TemporaryFile(dir=path):
-            pass
-    except OSError as exc:
-        raise OutputPathError(f"{what} {path}: cannot write there: {os_reason(exc)}") from None
+    _probe_dir(path, what, path)
     return path
 
 

@@ -343,8 +343,8 @@ report(accepted=accepted)
 @pytest.mark.parametrize("model", MODELS)
 def test_pythonfmus_binary_does_not_compare_the_guid(built_fmus, model, tmp_path):
     """pythonfmu 0.7.0's binary (kept in the FMU behind the guard as ``<id>_pythonfmu.so``) instantiates
-    with any GUID, the one pythonfmu wrote into the file included (../shared/reference/FMI-NOTES.md: "no
-    GUID check"): the build may replace that GUID by the token, and the guard, which forwards the token
+    with any GUID, the one pythonfmu wrote into the file included (it has no GUID check of its own):
+    the build may replace that GUID by the token, and the guard, which forwards the token
     to it, is what checks a host's GUID."""
     from fmpy import extract
     from fmi_child import run_child
