@@ -192,7 +192,7 @@ def run(show_plot: bool = False, steps=(1e-2, 1e-3, 1e-4, 1e-5), fmu_dir=None, d
     """Run every master (``masters``: default, every one that can load the FMUs, :func:`masters_for`) at
     every communication step; write the PNG; return rows and results.
 
-    ``fmu_dir``: the folder with both FMUs (FMI 2.0: ``DIR`` or ``DIR/native``; FMI 3.0: ``DIR/fmi3``).
+    ``fmu_dir``: the folder with both FMUs (FMI 2.0: ``DIR`` or ``DIR/fmi2``; FMI 3.0: ``DIR/fmi3``).
     ``osp_dir``: where the OspSystemStructure.xml files go (default: ``out_dir/osp``).
     ``repeat``: runs per master and step; the wall time reported is the shortest.
     """
@@ -277,7 +277,7 @@ if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--fmu-dir", type=Path, default=None,
                         help="folder with BouncingBall.fmu and SpherePlateImpact.fmu: dist/ (the default, "
-                             "built if missing), dist/native or dist/fmi3")
+                             "built if missing), dist/fmi2 or dist/fmi3")
     parser.add_argument("--steps", type=float, nargs="+", default=[1e-2, 1e-3, 1e-4, 1e-5])
     parser.add_argument("--show", action="store_true", help="show the plot window")
     args = parser.parse_args()

@@ -92,5 +92,5 @@ CASES = st.fixed_dictionaries({
 
 def runs_ode(fmu) -> bool:
     """Whether the FMU at path ``fmu`` (a fixture's) computes zener_method = 4 (ode): the pythonfmu FMU
-    does, the native ones (FMI 2.0 in native/, FMI 3.0 in fmi3/) refuse it (docs/implementations.md)."""
-    return not ({"native", "fmi3"} & set(fmu.parts))
+    does, the native ones (FMI 2.0 in fmi2/, FMI 3.0 in fmi3/) refuse it (docs/implementations.md)."""
+    return not ({"fmi2", "fmi3"} & set(fmu.parts))

@@ -25,7 +25,7 @@ for _folder in (MODELS / "sphere_plate_impact", MODELS / "bouncing_ball", MODELS
 def built_fmus(tmp_path_factory) -> Path:
     """Every FMU of the project built from the current sources (and validated) into one temp dir:
     SpherePlateImpact.fmu and BouncingBall.fmu (pythonfmu, behind the C guard), and their native
-    twins, FMI 2.0 in native/ and FMI 3.0 in fmi3/, where a C compiler is available."""
+    twins, FMI 2.0 in fmi2/ and FMI 3.0 in fmi3/, where a C compiler is available."""
     from restitution.fmu.build import build_all
 
     out = tmp_path_factory.mktemp("fmu")
@@ -46,7 +46,7 @@ def ball_fmu(built_fmus) -> Path:
 
 
 #: The folder of each native FMU of the build: FMI 2.0 and FMI 3.0.
-NATIVE_FOLDERS = {"native": "native", "fmi3": "FMI 3.0"}
+NATIVE_FOLDERS = {"fmi2": "FMI 2.0", "fmi3": "FMI 3.0"}
 
 
 def _built_native(built_fmus, folder, model):
@@ -59,13 +59,13 @@ def _built_native(built_fmus, folder, model):
 @pytest.fixture(scope="session")
 def native_impact_fmu(built_fmus) -> Path:
     """The native SpherePlateImpact.fmu (C front and C physics, no Python)."""
-    return _built_native(built_fmus, "native", "SpherePlateImpact")
+    return _built_native(built_fmus, "fmi2", "SpherePlateImpact")
 
 
 @pytest.fixture(scope="session")
 def native_ball_fmu(built_fmus) -> Path:
     """The native BouncingBall.fmu."""
-    return _built_native(built_fmus, "native", "BouncingBall")
+    return _built_native(built_fmus, "fmi2", "BouncingBall")
 
 
 @pytest.fixture(scope="session")
@@ -81,16 +81,16 @@ def fmi3_ball_fmu(built_fmus) -> Path:
 
 
 def _implementation(built_fmus, model, which) -> Path:
-    """``model``.fmu as ``which``: "python" (pythonfmu), "native" (FMI 2.0 C) or "fmi3" (FMI 3.0 C)."""
+    """``model``.fmu as ``which``: "python" (pythonfmu), "fmi2" (FMI 2.0 C) or "fmi3" (FMI 3.0 C)."""
     return built_fmus / f"{model}.fmu" if which == "python" else _built_native(built_fmus, which, model)
 
 
 #: The two FMI 2.0 implementations of each FMU: tests that hold for both take these fixtures
 #: (any_impact_fmu, any_ball_fmu), the tests that make raw fmi2 calls among them.
-IMPLEMENTATIONS = ("python", "native")
+IMPLEMENTATIONS = ("python", "fmi2")
 #: Every FMU an fmpy host runs through restitution.cosim.FmuInstance: the two FMI 2.0 implementations
 #: and the FMI 3.0 one (any_version_impact_fmu, any_version_ball_fmu).
-VERSIONS = ("python", "native", "fmi3")
+VERSIONS = ("python", "fmi2", "fmi3")
 
 
 @pytest.fixture(scope="session", params=IMPLEMENTATIONS)
@@ -119,7 +119,7 @@ def any_version_ball_fmu(request, built_fmus) -> Path:
 
 @pytest.fixture(scope="session", params=VERSIONS)
 def any_version_fmu_dir(request, built_fmus) -> Path:
-    """The folder with both FMUs: the pythonfmu ones, the native FMI 2.0 ones (native/), the FMI 3.0
+    """The folder with both FMUs: the pythonfmu ones, the native FMI 2.0 ones (fmi2/), the FMI 3.0
     ones (fmi3/)."""
     return _implementation(built_fmus, "SpherePlateImpact", request.param).parent
 

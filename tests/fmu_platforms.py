@@ -7,7 +7,7 @@ missing compiler where the build did not produce that binary (mingw-w64 absent),
 compiler is on PATH but the binary is not in the archive (the build lost it).
 
 As a script, ``python tests/fmu_platforms.py DIR`` prints the binary platforms of every FMU a build wrote
-into DIR (``DIR/*.fmu``, ``DIR/native/``, ``DIR/fmi3/``) and exits 1 when :func:`platform_problems`
+into DIR (``DIR/*.fmu``, ``DIR/fmi2/``, ``DIR/fmi3/``) and exits 1 when :func:`platform_problems`
 finds any (.ci/run runs it on a build made without a cross compiler).
 """
 from __future__ import annotations
@@ -128,7 +128,7 @@ def skip_unless_built(fmu: Path, platform: str = "win64") -> str:
     """The binaries/ folder of ``platform`` (a key of build_native.COMPILERS) in ``fmu``, which the build
     produced; skips, naming the compiler, where the archive has no binary there because that compiler is
     not installed; fails where the compiler is on PATH and the binary is still missing."""
-    from restitution.fmu.build_native import COMPILERS, PLATFORM_FOLDERS
+    from restitution.fmu.build.native import COMPILERS, PLATFORM_FOLDERS
 
     version = fmi_version(fmu)
     folder = PLATFORM_FOLDERS[version][platform]
@@ -149,7 +149,7 @@ def summary(out_dir: Path) -> tuple[list[str], list[str]]:
     sources, the problems found)."""
     out_dir = Path(out_dir)
     lines, problems = [], []
-    for fmu in sorted(out_dir.glob("*.fmu")) + sorted(out_dir.glob("native/*.fmu")) + sorted(out_dir.glob("fmi3/*.fmu")):
+    for fmu in sorted(out_dir.glob("*.fmu")) + sorted(out_dir.glob("fmi2/*.fmu")) + sorted(out_dir.glob("fmi3/*.fmu")):
         name = fmu.relative_to(out_dir).as_posix()
         sources = any(n.startswith("sources/") and n.endswith(".c") for n in _names(fmu))
         lines.append(f"{name}: binaries {', '.join(sorted(binary_folders(fmu))) or 'none'}"

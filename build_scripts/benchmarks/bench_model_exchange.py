@@ -30,10 +30,10 @@ sys.path.insert(0, str(ROOT / "fmu_src"))
 
 from bench_native_build import compile_host  # noqa: E402
 from restitution.fmu.build import build_all  # noqa: E402
-from restitution.fmu.build_native import fmi_include_dir  # noqa: E402
+from restitution.fmu.build.native import fmi_include_dir  # noqa: E402
 
 HOST = HERE / "bench_c" / "exchange_timing.c"
-VERSIONS = {"2.0": ("native", "linux64", 2), "3.0": ("fmi3", "x86_64-linux", 3)}
+VERSIONS = {"2.0": ("fmi2", "linux64", 2), "3.0": ("fmi3", "x86_64-linux", 3)}
 OPERATIONS = ("rhs", "indicators", "event")
 
 
@@ -84,7 +84,7 @@ def page(results: dict, seconds: float) -> str:
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[1])
-    parser.add_argument("--fmu-dir", type=Path, help="built FMUs (DIR/native, DIR/fmi3); default: build them")
+    parser.add_argument("--fmu-dir", type=Path, help="built FMUs (DIR/fmi2, DIR/fmi3); default: build them")
     parser.add_argument("--seconds", type=float, default=0.2, help="CPU seconds per batch (default 0.2)")
     parser.add_argument("--out", type=Path, default=ROOT / "docs" / "model_exchange_cost.md")
     args = parser.parse_args(argv)

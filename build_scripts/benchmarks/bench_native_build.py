@@ -1,7 +1,7 @@
 """What build_scripts/benchmarks/bench_native.py times, built into a scratch directory.
 
 * the pythonfmu ``SpherePlateImpact.fmu`` (behind the project's C guard), the native one
-  (``native/SpherePlateImpact.fmu``, FMI 2.0) and the native FMI 3.0 one (``fmi3/SpherePlateImpact.fmu``: the
+  (``fmi2/SpherePlateImpact.fmu``, FMI 2.0) and the native FMI 3.0 one (``fmi3/SpherePlateImpact.fmu``: the
   same core behind the FMI 3.0 layer), by the project's own build functions;
 * the *floor*: an FMU with the native FMU's modelDescription, compiled from the same C front
   (``fmu_src/restitution/fmu/cfront``), the same generated interface table and the same compiler and
@@ -86,7 +86,7 @@ class Built:
 
 
 def _unzip(fmu: Path, directory: Path, label: str, guid: str | None = None, version: int = 2) -> Unzipped:
-    from restitution.fmu.interface import model_info
+    from restitution.fmu.describe.c_header import model_info
 
     with zipfile.ZipFile(fmu) as z:
         z.extractall(directory)
@@ -100,8 +100,9 @@ def build_floor(work: Path, model_description: str) -> Path:
     """The floor FMU, unzipped in ``work/floor``: the C front, the generated interface table and
     model info, ``bench_c/floor_fmu.c``, compiled by ``build_native.compile_binary`` (gcc, the native FMU's
     flags); its modelDescription is the native FMU's."""
-    from restitution.fmu.interface import c_header, model_info_header
-    from restitution.fmu import build_native as bn
+    from restitution.fmu.build import native as bn
+    from restitution.fmu.describe import fmi2
+    from restitution.fmu.describe.c_header import c_header, model_info, model_info_header
 
     stage = work / "floor"
     sources = stage / "sources"
@@ -109,11 +110,11 @@ def build_floor(work: Path, model_description: str) -> Path:
     for path in bn.front_files():
         shutil.copyfile(path, sources / path.name)
     (sources / bn.INTERFACE_HEADER.format(model=MODEL)).write_text(c_header(MODEL), encoding="utf-8")
-    (sources / bn.MODEL_INFO_HEADER).write_text(model_info_header(model_description), encoding="ascii")
+    (sources / bn.MODEL_INFO_HEADER).write_text(model_info_header(*model_info(model_description)), encoding="ascii")
     shutil.copyfile(FLOOR_GLUE, sources / "rst_floor_fmu.c")
     c_files = sorted(p.name for p in sources.glob("*.c"))
     bn.compile_binary(MODEL, sources, c_files, "linux64", stage)
-    (stage / "modelDescription.xml").write_text(bn.native_model_description(model_description, c_files),
+    (stage / "modelDescription.xml").write_text(fmi2.model_description(MODEL, native=True, c_files=c_files),
                                                 encoding="utf-8")
     (stage / "resources").mkdir()
     return stage
@@ -122,7 +123,7 @@ def build_floor(work: Path, model_description: str) -> Path:
 def compile_host(out: Path, sources: list[Path], includes: list[Path], libs: list[str], defines=()) -> Path:
     """gcc with the native build's flags (C99, -Wall -Wextra -Werror -pedantic, -O2, no FMA contraction);
     ``defines``: ``NAME=VALUE`` texts for -D."""
-    from restitution.fmu.compile import CFLAGS
+    from restitution.fmu.build.compile import CFLAGS
 
     cmd = ["gcc", *CFLAGS, *(f"-D{d}" for d in defines), *(f"-I{p}" for p in includes), "-o", str(out),
            *map(str, sources), *libs]
@@ -135,16 +136,16 @@ def compile_host(out: Path, sources: list[Path], includes: list[Path], libs: lis
 def build_all(work: Path, log=None) -> Built:
     """Build everything the benchmark times into ``work`` (an empty scratch directory)."""
     from restitution.fmu.build import build_one
-    from restitution.fmu.build_native import build_native_one, fmi_include_dir
-    from restitution.fmu.compile import prepare_sources
+    from restitution.fmu.build.native import build_native_one, fmi_include_dir
+    from restitution.fmu.build.compile import prepare_sources
 
     log = log or (lambda message: None)
     if shutil.which("gcc") is None:
         raise RuntimeError("gcc not found: the native FMU, the floor and the C hosts need it")
     fmus = work / "fmus"
     python_fmu = build_one(MODEL, fmus, log=log)
-    native_fmu = build_native_one(MODEL, fmus, python_fmu, log=log)
-    fmi3_fmu = build_native_one(MODEL, fmus, python_fmu, log=log, fmi_version="3.0")
+    native_fmu = build_native_one(MODEL, fmus, log=log)
+    fmi3_fmu = build_native_one(MODEL, fmus, log=log, fmi_version="3.0")
     with zipfile.ZipFile(python_fmu) as z:
         xml = z.read("modelDescription.xml").decode("utf-8")
     python = _unzip(python_fmu, work / "python", "pythonfmu")

@@ -1,4 +1,4 @@
-"""The FMI 3.0 description files of the native FMUs (restitution.fmu.model_description3), written from the
+"""The FMI 3.0 description files of the native FMUs (restitution.fmu.describe.fmi3), written from the
 interface table alone: they validate against the FMI 3.0 schemas fmpy ships (and fmpy's own checks:
 exactly one independent variable, structured names, a complete ModelStructure), reading them back with
 fmpy gives the table back, and every unit's <BaseUnit> is its SI dimension as pint computes it from the
@@ -13,7 +13,7 @@ import pytest
 from fmpy.model_description import ValidationError, read_build_description, read_model_description
 from fmpy.validation import validate_fmu
 
-from restitution.fmu.model_description3 import (LOG_CATEGORIES, TIME_NAME, build_description, enumeration_type,
+from restitution.fmu.describe.fmi3 import (TIME_NAME, build_description, enumeration_type,
                                                 model_description)
 from restitution.fmu.models import FOLDERS, native_sources, table
 
@@ -96,7 +96,10 @@ def test_table_round_trips_through_the_fmi3_model_description(fmu_dir):
     assert cs.canHandleVariableCommunicationStepSize and cs.canGetAndSetFMUstate and cs.canSerializeFMUstate
     assert not (cs.needsExecutionTool or cs.canBeInstantiatedOnlyOncePerProcess or cs.hasEventMode
                 or cs.providesIntermediateUpdate or cs.canReturnEarlyAfterIntermediateUpdate)
-    assert [(c.name, c.description) for c in md.logCategories] == list(LOG_CATEGORIES)
+    # the categories the C front answers to (rst_log.c), described with FMI 3.0's status names
+    assert [(c.name, c.description) for c in md.logCategories] == [
+        (f"logStatus{status}", f"Log messages with fmi3{status} status.") for status in ("Warning", "Discard", "Error", "Fatal")
+    ] + [("logAll", "Log all messages.")]
 
     variables = md.modelVariables
     assert [v.name for v in variables] == [row.name for row in rows] + [TIME_NAME]

@@ -29,7 +29,7 @@ import pytest
 ROOT = Path(__file__).resolve().parents[2]
 INDEX = "documentation/index.html"
 XHTML = "{http://www.w3.org/1999/xhtml}"
-#: fixture -> (model, FMI version, native), the arguments of restitution.fmu.documentation.index_html
+#: fixture -> (model, FMI version, native), the arguments of restitution.fmu.describe.documentation.index_html
 FMUS = {
     "impact_fmu": ("SpherePlateImpact", "2.0", False),
     "ball_fmu": ("BouncingBall", "2.0", False),
@@ -184,12 +184,12 @@ def _citation_titles() -> list[str]:
 def test_the_built_page_is_the_render_and_every_render_is_the_same(fmu):
     """The page in the FMU is index_html's; it is the same in another process (another string hashing),
     so two builds write the same file."""
-    from restitution.fmu.documentation import index_html
+    from restitution.fmu.describe.documentation import index_html
 
     _path, model, version, native, data, _names = fmu
     assert index_html(model, version, native) == index_html(model, version, native)
     assert index_html(model, version, native).encode("utf-8") == data
-    code = ("import hashlib, sys; from restitution.fmu.documentation import index_html; "
+    code = ("import hashlib, sys; from restitution.fmu.describe.documentation import index_html; "
             "print(hashlib.sha256(index_html(sys.argv[1], sys.argv[2], sys.argv[3] == 'True').encode()).hexdigest())")
     for seed in ("1", "2"):
         done = subprocess.run([sys.executable, "-c", code, model, version, str(native)], capture_output=True,
@@ -204,7 +204,8 @@ def test_the_pythonfmu_fmus_link_pythonfmus_license_and_the_native_ones_do_not(f
 
 
 def test_prose_text_is_escaped_and_code_marked():
-    from restitution.fmu.documentation import Rows, _block
+    from restitution.fmu.describe.documentation import _block
+    from restitution.fmu.models.text import Rows
 
     assert _block("a < b & `x<y`") == ["<p>a &lt; b &amp; <code>x&lt;y</code></p>"]
     assert _block(("one", "`two`")) == ["<ul>", "<li>one</li>", "<li><code>two</code></li>", "</ul>"]

@@ -37,7 +37,7 @@ from fmpy import extract
 
 import restitution as r
 from restitution.agreement import disagreements, tolerances
-from restitution.fmu.interface import variables
+from restitution.fmu.describe.c_header import variables
 
 from fmi_child import run_child
 from toy_fmu import build_toy_fmu

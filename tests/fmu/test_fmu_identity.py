@@ -26,15 +26,15 @@ import pytest
 
 import restitution
 from restitution.about import VERSION
-from restitution.fmu.model_description3 import generation_date_and_time
+from restitution.fmu.describe.common import generation_date_and_time
 from restitution.fmu.models import FOLDERS, table
 from restitution.fmu.table import Table
 
 ROOT = Path(__file__).resolve().parents[2]
-FMUS = ["SpherePlateImpact.fmu", "BouncingBall.fmu", "native/SpherePlateImpact.fmu", "native/BouncingBall.fmu"]
+FMUS = ["SpherePlateImpact.fmu", "BouncingBall.fmu", "fmi2/SpherePlateImpact.fmu", "fmi2/BouncingBall.fmu"]
 MODELS = list(FOLDERS)
 #: Where each implementation of a model is in a build directory.
-PLACES = {"python": "{model}.fmu", "native": "native/{model}.fmu", "fmi3": "fmi3/{model}.fmu"}
+PLACES = {"python": "{model}.fmu", "fmi2": "fmi2/{model}.fmu", "fmi3": "fmi3/{model}.fmu"}
 ALL_FMUS = [place.format(model=model) for model in MODELS for place in PLACES.values()]
 #: 2025-11-25T10:00:00Z, as SOURCE_DATE_EPOCH writes it.
 EPOCH, EPOCH_DATE = "1764064800", "2025-11-25T10:00:00Z"
@@ -189,7 +189,7 @@ def test_every_implementation_of_a_model_carries_its_token(built_fmus, model):
     token = _token(table(model))
     for place in PLACES.values():
         assert _identity(_built(built_fmus, place, model)) == token, place
-    for place in ("native/{model}.fmu", "fmi3/{model}.fmu"):  # the header the native front is compiled with
+    for place in ("fmi2/{model}.fmu", "fmi3/{model}.fmu"):  # the header the native front is compiled with
         with zipfile.ZipFile(_built(built_fmus, place, model)) as z:
             header = z.read("sources/rst_model_info.h").decode("ascii")
         assert f'#define RST_MODEL_GUID "{token}"' in header, place

@@ -336,7 +336,7 @@ report(ifaces=IFACES, layout=layout, genuine=genuine, outcome=outcome, crossed=c
        scribbled=scribbled, fatal=[m for _, s_, m in LOG if s_ >= 4])
 '''
 
-FMUS = {("native", "BouncingBall"): "native_ball_fmu", ("native", "SpherePlateImpact"): "native_impact_fmu",
+FMUS = {("fmi2", "BouncingBall"): "native_ball_fmu", ("fmi2", "SpherePlateImpact"): "native_impact_fmu",
         ("fmi3", "BouncingBall"): "fmi3_ball_fmu", ("fmi3", "SpherePlateImpact"): "fmi3_impact_fmu",
         ("python", "BouncingBall"): "ball_fmu", ("python", "SpherePlateImpact"): "impact_fmu"}
 

@@ -25,7 +25,7 @@ from pathlib import Path
 
 import pytest
 
-from restitution.fmu.interface import variables
+from restitution.fmu.describe.c_header import variables
 
 from script_host import BALL_ME, build_host, interface
 
@@ -39,7 +39,7 @@ pytestmark = [
 
 
 def _fmi_headers(version: int):
-    from restitution.fmu.build_native import fmi_include_dir
+    from restitution.fmu.build.native import fmi_include_dir
 
     return fmi_include_dir(f"{version}.0")
 
@@ -78,8 +78,8 @@ def _sanitized_native(fmu, model, dest):
 
 def _sanitized_guard(fmu, model, dest):
     """The pythonfmu FMU unpacked, its guard rebuilt with the sanitizers."""
-    from restitution.fmu.interface import c_header
-    from restitution.fmu import build_guard as ms
+    from restitution.fmu.describe.c_header import c_header
+    from restitution.fmu.build import guard as ms
 
     unpacked = _unpack(fmu, dest)
     real = unpacked / "binaries" / "linux64" / f"{model}{ms.REAL_SUFFIX}.so"
@@ -244,7 +244,7 @@ def genuine_states(built_fmus, tmp_path_factory):
     out = tmp_path_factory.mktemp("states")
     paths = {}
     for model in ("SpherePlateImpact", "BouncingBall"):
-        fmu = built_fmus / "native" / f"{model}.fmu"
+        fmu = built_fmus / "fmi2" / f"{model}.fmu"
         if not fmu.is_file():
             pytest.skip("native FMUs not built here")
         paths[model] = _serialized_state(_unpack(fmu, out / model), model, out)
@@ -276,10 +276,10 @@ def _assert_clean(proc, script, kinds, model_exchange=False):
     assert set(bad) == expected and len(bad) == len(kinds), bad
 
 
-@pytest.mark.parametrize("folder", ["native", "fmi3"])
+@pytest.mark.parametrize("folder", ["fmi2", "fmi3"])
 @pytest.mark.parametrize("model", ["SpherePlateImpact", "BouncingBall"])
 def test_native_fmu_hostile_calls_under_sanitizers(built_fmus, hosts, genuine_states, model, folder, tmp_path):
-    """The native FMU of each FMI version (native/: FMI 2.0, fmi3/: FMI 3.0). The hostile states are made
+    """The native FMU of each FMI version (fmi2/: FMI 2.0, fmi3/: FMI 3.0). The hostile states are made
     from states the FMI 2.0 FMU serialized: both versions share one state format (the core's rst_state.c),
     so the genuine one restores in either and its damaged versions must be refused by both."""
     fmu = built_fmus / folder / f"{model}.fmu"

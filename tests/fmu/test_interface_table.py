@@ -8,7 +8,7 @@ from xml.etree import ElementTree as ET
 
 import pytest
 
-from restitution.fmu.interface import c_header, variables_from_model_description
+from restitution.fmu.describe.c_header import c_header, variables_from_model_description
 from conftest import NATIVE_FOLDERS
 from restitution.fmu.models import FOLDERS, table
 
@@ -19,7 +19,7 @@ def _model_description(fmu):
 
 
 def _assert_round_trip(fmu, model):
-    native = fmu.parent.name in NATIVE_FOLDERS  # built under native/ or fmi3/
+    native = fmu.parent.name in NATIVE_FOLDERS  # built under fmi2/ or fmi3/
     text = _model_description(fmu)
     rows = table(model).rows
     back = variables_from_model_description(text)

@@ -1,4 +1,4 @@
-"""Model exchange of the native FMUs, FMI 2.0 (``native/``) and FMI 3.0 (``fmi3/``): one archive offers
+"""Model exchange of the native FMUs, FMI 2.0 (``fmi2/``) and FMI 3.0 (``fmi3/``): one archive offers
 co-simulation and model exchange from the same binary. BouncingBall has the continuous states h and v,
 one event indicator, and a contact is a state event that the host's solver locates; SpherePlateImpact
 has no states and its outputs are a function of its inputs."""

@@ -1,7 +1,7 @@
 """The native backend (rst_native_impact.c) maps the FMU's generated interface table onto the C physics:
 every output the interface declares is written, from the right inputs, with the package's values.
 
-Compiled with the generated headers (restitution.fmu.interface.c_header, the Zener table) into a
+Compiled with the generated headers (restitution.fmu.describe.c_header.c_header, the Zener table) into a
 shared library and driven through ctypes on a value store indexed by value reference, as the C
 front drives it. Values are compared with restitution.agreement's per-case tolerances (conditioning),
 never bit for bit.
@@ -19,10 +19,10 @@ import pytest
 
 import restitution as r
 from restitution.agreement import disagreements, tolerances
-from restitution.fmu.interface import variables
+from restitution.fmu.describe.c_header import variables
 from restitution.model import published
-from restitution.fmu.build_native import write_backend
-from restitution.fmu.compile import CFLAGS, prepare_sources
+from restitution.fmu.build.native import write_backend
+from restitution.fmu.build.compile import CFLAGS, prepare_sources
 
 from cases import FMU_FLAGS, FMU_REALS, NAMES, random_cases
 

@@ -17,9 +17,9 @@ import subprocess
 import numpy as np
 import pytest
 
-from restitution.fmu.interface import variables
-from restitution.fmu.build_native import write_backend
-from restitution.fmu.compile import CFLAGS
+from restitution.fmu.describe.c_header import variables
+from restitution.fmu.build.native import write_backend
+from restitution.fmu.build.compile import CFLAGS
 
 pytestmark = pytest.mark.skipif(shutil.which("gcc") is None, reason="gcc is needed to compile the native backend")
 

@@ -21,8 +21,9 @@ from hypothesis import strategies as st
 import restitution as r
 from restitution.agreement import disagreements, tolerances
 from restitution.model import published
-from restitution.fmu.build_native import (GENERATION_TOOL, NativeBuildSkipped, front_files,
-                                                 native_model_description)
+from restitution.fmu.build.native import NativeBuildSkipped, front_files
+from restitution.fmu.describe import fmi2
+from restitution.fmu.models import table
 
 from cases import CASES, FMU_FLAGS, FMU_REALS, params_for  # CASES: the declared domain, drawn log-uniformly
 
@@ -48,17 +49,28 @@ def _interface(root):
 
 def test_model_description_has_the_same_interface(impact_fmu):
     """Every variable (name, vr, type, causality, variability, initial, unit, start, min/max, description),
-    the ModelStructure and the units equal the pythonfmu FMU's; the C sources are declared."""
+    the ModelStructure and the units of the native FMI 2.0 description equal the pythonfmu FMU's, but for
+    the limits of the rows the native FMUs accept less of (``native_interval``: their own); the C sources
+    are declared in both interfaces, and nothing of it is pythonfmu's."""
     python_xml = _model_description(impact_fmu)
-    native_xml = native_model_description(python_xml, ["a.c", "b.c"])
+    native_xml = fmi2.model_description("SpherePlateImpact", native=True, c_files=["a.c", "b.c"])
     py, nat = ET.fromstring(python_xml), ET.fromstring(native_xml)
-    assert _interface(nat) == _interface(py)
+    narrower = {row.name for row in table("SpherePlateImpact") if row.native_interval is not None}
+    assert narrower  # zener_method: ode is the pythonfmu FMU's only
+
+    def without_narrowed_limits(interface):
+        rows, structure, units = interface
+        return [(attrs, tag, typed[:2] + (None, None) + typed[4:] if attrs[0] in narrower else typed)
+                for attrs, tag, typed in rows], structure, units
+
+    assert without_narrowed_limits(_interface(nat)) == without_narrowed_limits(_interface(py))
+    assert _interface(nat) != _interface(py)
     assert nat.get("guid") == py.get("guid") and nat.get("modelName") == py.get("modelName")
-    cosim = nat.find("CoSimulation")
-    assert cosim.get("modelIdentifier") == "SpherePlateImpact"
-    assert cosim.get("needsExecutionTool") == "false"
-    assert [f.get("name") for f in cosim.find("SourceFiles")] == ["a.c", "b.c"]
-    assert nat.get("generationTool") == GENERATION_TOOL
+    for part in ("CoSimulation", "ModelExchange"):
+        node = nat.find(part)
+        assert node.get("modelIdentifier") == "SpherePlateImpact" and node.get("needsExecutionTool") == "false"
+        assert [f.get("name") for f in node.find("SourceFiles")] == ["a.c", "b.c"]
+    assert "pythonfmu" not in nat.get("generationTool").lower() and "PythonFMU" not in python_xml  # written by us, both
 
 
 def _front_missing():
@@ -145,7 +157,7 @@ def test_binaries_need_no_python_and_no_extra_dll(native_fmu, tmp_path):
 
 @needs_front
 @pytest.mark.skipif(shutil.which("cmake") is None, reason="cmake is needed by fmpy's build_platform_binary")
-@pytest.mark.parametrize("folder, model", [("native", "SpherePlateImpact"), ("fmi3", "SpherePlateImpact"),
+@pytest.mark.parametrize("folder, model", [("fmi2", "SpherePlateImpact"), ("fmi3", "SpherePlateImpact"),
                                            ("fmi3", "BouncingBall")])
 def test_rebuilt_from_sources_by_fmpy(built_fmus, folder, model, tmp_path):
     """The Linux binary removed and rebuilt from sources/ by fmpy's build_platform_binary (its CMake project),
@@ -162,7 +174,7 @@ def test_rebuilt_from_sources_by_fmpy(built_fmus, folder, model, tmp_path):
         pytest.skip(f"{folder}/{model}.fmu not built here")
     unzip = tmp_path / "unzipped"
     extract(str(fmu), str(unzip))
-    binary = unzip / "binaries" / ("linux64" if folder == "native" else "x86_64-linux") / f"{model}.so"
+    binary = unzip / "binaries" / ("linux64" if folder == "fmi2" else "x86_64-linux") / f"{model}.so"
     binary.unlink()
     (tmp_path / "build").mkdir()
     build_platform_binary(unzip, build_dir=tmp_path / "build")
@@ -229,7 +241,7 @@ def test_serialized_states_move_between_the_two_implementations(impact_fmu, nati
     from restitution.cosim import FmuInstance
 
     with FmuInstance(impact_fmu, "python", parameters={"plate.t": 3e-3}) as python, \
-            FmuInstance(native_fmu, "native") as native:
+            FmuInstance(native_fmu, "fmi2") as native:
         python.set(v_approach=2.3)
         python.do_step(step_size=0.1)
         native.slave.setFMUstate(native.slave.deSerializeFMUstate(

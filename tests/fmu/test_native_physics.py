@@ -26,8 +26,8 @@ import pytest
 
 import restitution as r
 from restitution.agreement import disagreements, tolerances
-from restitution.fmu.compile import CFLAGS, compile_shared, prepare_sources
-from restitution.fmu.physics_c.physics_ctypes import METHOD_CODE, MODE_CODE, MODEL_CODE, UNSUPPORTED, NativePhysics
+from restitution.fmu.build.compile import CFLAGS, compile_shared, prepare_sources
+from physics_ctypes import METHOD_CODE, MODE_CODE, MODEL_CODE, UNSUPPORTED, NativePhysics
 
 from cases import NAMES, PAIRS, SPEEDS, T_OVER_D, params_for, random_cases
 

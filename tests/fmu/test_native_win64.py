@@ -36,7 +36,7 @@ import pytest
 
 import restitution as r
 from restitution.agreement import disagreements, tolerances
-from restitution.fmu.compile import CFLAGS, prepare_sources
+from restitution.fmu.build.compile import CFLAGS, prepare_sources
 
 from cases import FMU_FLAGS, FMU_REALS, NAMES, params_for, random_cases
 from script_host import ball_me_script, ball_run, build_host, check_ball_run, interface
@@ -216,7 +216,7 @@ def _groups(values, n_groups):
 
 
 @pytest.mark.parametrize("interface_type", ["cs", "me"])
-@pytest.mark.parametrize("folder", ["native", "fmi3"])
+@pytest.mark.parametrize("folder", ["fmi2", "fmi3"])
 def test_win64_fmu_dll_under_wine_equals_the_linux_fmu(built_fmus, folder, interface_type, script_hosts, wine_env,
                                                        tmp_path):
     """The Windows DLL of the native FMU (FMI 2.0: binaries/win64/, FMI 3.0: binaries/x86_64-windows/) in a
@@ -280,7 +280,7 @@ def test_win64_fmu_dll_under_wine_equals_the_linux_fmu(built_fmus, folder, inter
 
 
 @pytest.mark.parametrize("dt, tol", [(1e-3, 1e-10), (1e-4, 0.0)], ids=["bisected", "step"])
-@pytest.mark.parametrize("folder", ["native", "fmi3"])
+@pytest.mark.parametrize("folder", ["fmi2", "fmi3"])
 def test_win64_ball_model_exchange_under_wine_equals_the_linux_fmu(built_fmus, folder, dt, tol, script_hosts,
                                                                    wine_env, tmp_path):
     """BouncingBall's Windows DLL as model exchange, integrated by the host's own solver (fmi_script_host.c:

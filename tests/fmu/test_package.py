@@ -14,7 +14,7 @@ from pathlib import Path
 import pytest
 
 import restitution as r
-from restitution.fmu import build as fmu_build
+from restitution.fmu.build import products as fmu_build
 
 ROOT = Path(__file__).resolve().parents[2]
 LOCK = ROOT / "requirements" / "dev.lock"
@@ -158,3 +158,21 @@ def test_installed_package_builds_the_fmus_and_runs_a_scene_outside_the_checkout
                            "--no-progress"], cwd=work, capture_output=True, text=True)
     assert proc.returncode == 0, proc.stderr
     assert any(p.suffix == ".csv" for p in (work / "scene").iterdir())
+
+
+def test_the_build_refuses_a_slave_that_registers_unlike_the_table(built):
+    """pythonfmu's binary numbers variables in the order the slave registers them, and the build replaces
+    pythonfmu's modelDescription with the table's: a slave registering two variables the other way round
+    (as pythonfmu would then describe them) stops the build, naming the first difference."""
+    from restitution.fmu.build import python_fmu
+
+    _out, fmu = built
+    with zipfile.ZipFile(fmu) as z:
+        xml = z.read("modelDescription.xml").decode("utf-8")
+    python_fmu._check_registration("SpherePlateImpact", xml)  # the table's own order passes
+    first, second = 'name="sphere.E" valueReference="1"', 'name="sphere.nu" valueReference="2"'
+    assert first in xml and second in xml
+    swapped = xml.replace(first, "\0").replace(second, 'name="sphere.E" valueReference="2"').replace(
+        "\0", 'name="sphere.nu" valueReference="1"')
+    with pytest.raises(fmu_build.BuildError, match=r"first difference at position 1.*sphere\.nu"):
+        python_fmu._check_registration("SpherePlateImpact", swapped)

@@ -69,11 +69,11 @@ def host(hosts):
     return hosts[2]
 
 
-@pytest.fixture(scope="module", params=["python", "native", "fmi3"])
+@pytest.fixture(scope="module", params=["python", "fmi2", "fmi3"])
 def host_impact_fmu(request):
     """SpherePlateImpact.fmu as pythonfmu (FMI 2.0), native FMI 2.0 and native FMI 3.0 (the native ones
     skip, saying so, where gcc did not build them)."""
-    fixture = {"python": "impact_fmu", "native": "native_impact_fmu", "fmi3": "fmi3_impact_fmu"}[request.param]
+    fixture = {"python": "impact_fmu", "fmi2": "native_impact_fmu", "fmi3": "fmi3_impact_fmu"}[request.param]
     return request.getfixturevalue(fixture)
 
 
@@ -131,7 +131,7 @@ def test_the_fmu_runs_in_a_plain_c_host_and_matches_the_package(hosts, host_impa
     -DFMI_VERSION: FMI 3.0 gives the start time to fmi3EnterInitializationMode, sets the Enumerations
     with fmi3SetInt64 and reads the Booleans as C bool)."""
     fmu = interface(host_impact_fmu)
-    native = fmu.version == 3 or "native" in host_impact_fmu.parts
+    native = fmu.version == 3 or "fmi2" in host_impact_fmu.parts
     vr = fmu.vr
     script, expected = [], []  # expected: ("real"/"bool", reference value, context) per value printed
     clock = [0.0, 0.0]  # each instance's communication point
@@ -207,7 +207,7 @@ def test_the_fmu_runs_in_a_plain_c_host_and_matches_the_package(hosts, host_impa
         assert (got == want or tol) if kind == "bool" else same(got, want, tol), (context, got, want, tol)
 
 
-@pytest.mark.parametrize("folder", ["native", "fmi3"])
+@pytest.mark.parametrize("folder", ["fmi2", "fmi3"])
 def test_model_exchange_in_a_plain_c_host(hosts, built_fmus, folder, tmp_path):
     """The native FMUs as model exchange in the plain C host (env -i, dlopen RTLD_LOCAL), FMI 2.0 and 3.0.
 

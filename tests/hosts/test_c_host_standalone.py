@@ -1,11 +1,10 @@
-"""A pythonfmu FMU post-processed by restitution/fmu/build_guard.py
+"""A pythonfmu FMU post-processed by restitution/fmu/build/guard.py
 must run in a plain C FMI host (no LD_PRELOAD, no PYTHONPATH/PYTHONHOME, no
 venv, PATH=/usr/bin:/bin), must keep running in Python hosts (fmpy), and must
 fail cleanly (log message + NULL instance) when its interpreter is missing.
 """
 from __future__ import annotations
 
-import importlib.util
 import math
 import shutil
 import subprocess
@@ -21,7 +20,6 @@ from script_host import build_host
 from toy_fmu import build_plain_toy
 
 ROOT = Path(__file__).resolve().parents[2]
-MAKE_STANDALONE = ROOT / "fmu_src" / "restitution" / "fmu" / "build_guard.py"
 
 pytestmark = [
     pytest.mark.skipif(not sys.platform.startswith("linux"), reason="Linux-only (linux64 guard)"),
@@ -35,10 +33,9 @@ CLEAN_ENV = {"PATH": "/usr/bin:/bin"}
 
 
 def _load_make_standalone():
-    spec = importlib.util.spec_from_file_location("make_standalone", MAKE_STANDALONE)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    from restitution.fmu.build import guard
+
+    return guard
 
 
 def _unpack(fmu: Path, dest: Path) -> Path:

@@ -1,4 +1,4 @@
-"""The native FMUs (C only, no Python: DIR/native/*.fmu) in real hosts, each test skipping
+"""The native FMUs (C only, no Python: DIR/fmi2/*.fmu) in real hosts, each test skipping
 with the reason where its tool is missing. (The win64 DLL under Wine: tests/fmu/test_native_win64.py.)
 
 1. OSP libcosim (libcosimpy): BouncingBall + SpherePlateImpact from the OspSystemStructure.xml that
@@ -176,7 +176,7 @@ def _libcosim(fmu_dir: Path, system, work_dir: Path) -> dict:
 def libcosim_runs(built_fmus, native_ball_fmu, native_impact_fmu, system, tmp_path_factory):
     pytest.importorskip("libcosimpy", reason="libcosimpy (OSP libcosim) not installed")
     work = tmp_path_factory.mktemp("libcosim")
-    return {"native": _libcosim(native_impact_fmu.parent, system, work / "native"),
+    return {"fmi2": _libcosim(native_impact_fmu.parent, system, work / "fmi2"),
             "python": _libcosim(built_fmus, system, work / "python")}
 
 
@@ -185,7 +185,7 @@ def test_libcosim_runs_the_native_pair_from_the_examples_system_structure(libcos
                                                                            h):
     from xml.etree import ElementTree as ET
 
-    res = libcosim_runs["native"][h]
+    res = libcosim_runs["fmi2"][h]
     structure = ET.parse(res.extra["structure"]).getroot()
     ns = {"osp": "http://opensimulationplatform.com/MSMI/OSPSystemStructure"}
     sources = {s.get("name"): (Path(res.extra["structure"]).parent / s.get("source")).resolve()
@@ -202,7 +202,7 @@ def test_libcosim_native_pair_agrees_with_the_pythonfmu_pair(libcosim_runs, syst
     """Same libcosim, same OspSystemStructure.xml, the two implementations: the pythonfmu pair passes the
     same checks, rebounds at the same communication points, and the first five bounce times and heights
     agree within what the CORs may differ by (restitution.agreement), carried from flight to flight."""
-    native = ball_bounces(libcosim_runs["native"][h], G)
+    native = ball_bounces(libcosim_runs["fmi2"][h], G)
     python = _assert_coupled_like_the_reference(libcosim_runs["python"][h], system, h)
     assert native["t_rebound"].size == python["t_rebound"].size >= N_BOUNCES
     np.testing.assert_allclose(native["t_rebound"], python["t_rebound"], rtol=0, atol=1e-12)  # communication points
@@ -376,9 +376,9 @@ def fmpy_like_ecos_runs(ecos_exe, native_ball_fmu, native_impact_fmu, system):
     return {h: run_fmpy_like_ecos(native_ball_fmu, native_impact_fmu, system["fmu_params"], h, T_END) for h in STEPS}
 
 
-@pytest.fixture(scope="module", params=["native", "fmi3"])
+@pytest.fixture(scope="module", params=["fmi2", "fmi3"])
 def ecos_runs(request, ecos_exe, built_fmus, fmpy_like_ecos_runs, system, tmp_path_factory):
-    """ecos running the native pair of one FMI version (native/: FMI 2.0, fmi3/: FMI 3.0) from an SSP."""
+    """ecos running the native pair of one FMI version (fmi2/: FMI 2.0, fmi3/: FMI 3.0) from an SSP."""
     folder = request.param
     ball, impact = (built_fmus / folder / f"{m}.fmu" for m in ("BouncingBall", "SpherePlateImpact"))
     if not (ball.is_file() and impact.is_file()):
@@ -511,18 +511,18 @@ def _without_a_start_value(fmu: Path, out: Path) -> Path:
     return out
 
 
-@pytest.mark.parametrize("folder", ["native", "fmi3"])
+@pytest.mark.parametrize("folder", ["fmi2", "fmi3"])
 @pytest.mark.parametrize("model", ["SpherePlateImpact", "BouncingBall"])
 def test_fmutool_and_fmpy_find_no_problem_in_the_native_fmu(built_fmus, native_impact_fmu, native_ball_fmu, model,
                                                             folder, tmp_path):
-    """Each native FMU, FMI 2.0 (native/) and FMI 3.0 (fmi3/): fmutool's conformity and semantic checks of
+    """Each native FMU, FMI 2.0 (fmi2/) and FMI 3.0 (fmi3/): fmutool's conformity and semantic checks of
     its version and fmpy's validation find nothing; both flag the FMU with one start value removed. The
     platforms fmutool lists are the binaries/ folders in the archive, the Linux one among them (the
     Windows one where mingw-w64 built it: test_fmutool_lists_the_windows_binary_platform)."""
     from fmpy.validation import validate_fmu
 
     fmu = _native_fmu(built_fmus, folder, model)
-    version, linux = ("2", "linux64") if folder == "native" else ("3", "x86_64-linux")
+    version, linux = ("2", "linux64") if folder == "fmi2" else ("3", "x86_64-linux")
     code, report = fmutool_report(fmu)
     assert code == 0, report[-3000:]
     assert f"fmiVersion = {version}.0" in report, report[-3000:]
@@ -541,7 +541,7 @@ def test_fmutool_and_fmpy_find_no_problem_in_the_native_fmu(built_fmus, native_i
     assert validate_fmu(str(broken)) != []
 
 
-@pytest.mark.parametrize("folder", ["native", "fmi3"])
+@pytest.mark.parametrize("folder", ["fmi2", "fmi3"])
 @pytest.mark.parametrize("model", ["SpherePlateImpact", "BouncingBall"])
 def test_fmutool_lists_the_windows_binary_platform(built_fmus, model, folder):
     """Where the build produced the Windows x64 binary (mingw-w64 installed; skipped, naming it, where not),
@@ -549,5 +549,5 @@ def test_fmutool_lists_the_windows_binary_platform(built_fmus, model, folder):
     fmu = _native_fmu(built_fmus, folder, model)
     windows = skip_unless_built(fmu, "win64")
     code, report = fmutool_report(fmu)
-    linux = "linux64" if folder == "native" else "x86_64-linux"
+    linux = "linux64" if folder == "fmi2" else "x86_64-linux"
     assert code == 0 and fmutool_platforms(report) == {linux, windows}, report[-3000:]

@@ -1,7 +1,7 @@
 """The examples (examples/*.py), run with show_plot=False, and the statements they illustrate.
 
 Each example is imported and its ``run`` called with the FMUs built from the working tree, once
-with the pythonfmu FMUs, once with the native ones (DIR/native/) and once with the native FMI 3.0
+with the pythonfmu FMUs, once with the native ones (DIR/fmi2/) and once with the native FMI 3.0
 ones (DIR/fmi3/); the numbers it returns are
 checked against the event-exact master, the package, and the paper's statements (Green,
 Nonlinear Dyn 2022, Sec. 6-7).
@@ -246,14 +246,14 @@ def _readme_blocks() -> list[tuple[str, str]]:
     return [(m.group(1), m.group(2)) for m in re.finditer(r"(?ms)^```(\w*)\n(.*?)^```", text)]
 
 
-@pytest.mark.parametrize("implementation", ["python", "native"])
+@pytest.mark.parametrize("implementation", ["python", "fmi2"])
 def test_readme_python_blocks_run_as_printed(built_fmus, implementation, capsys):
     """Every Python block of README runs against a built FMU (its dist/ path replaced), and where a
     text block follows it, prints exactly that. The fmpy example chooses the materials by name: the
     plate is brass, so the modulus used is brass's 103 GPa (Table 3) and e is the package's for
     chrome steel on brass (the native C physics agrees with the package to far better than 1e-9 on
     so well-conditioned a case)."""
-    fmu = built_fmus / ("SpherePlateImpact.fmu" if implementation == "python" else "native/SpherePlateImpact.fmu")
+    fmu = built_fmus / ("SpherePlateImpact.fmu" if implementation == "python" else "fmi2/SpherePlateImpact.fmu")
     if not fmu.is_file():
         pytest.skip(f"{fmu} not built here")
     blocks = _readme_blocks()
@@ -283,7 +283,7 @@ def test_the_demo_reuses_up_to_date_fmus_and_rebuilds_stale_ones(built_fmus, tmp
     used as they are (no build), a stale one (another recorded source hash) is rebuilt."""
     import shutil
 
-    from restitution.fmu import build as fmu_build
+    from restitution.fmu.build import products as fmu_build
 
     script = (ROOT / "build_scripts" / "quickstart.sh").read_text()
     demo = script[script.index("demo)"):script.index(";;", script.index("demo)"))]

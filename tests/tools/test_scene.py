@@ -329,7 +329,7 @@ def test_report_with_ode_on_the_table(instance):
 
 
 def test_command_line_run_and_report(any_version_impact_fmu, tmp_path, capsys):
-    """Through every FMU: --fmu DIR/SpherePlateImpact.fmu, DIR/native/SpherePlateImpact.fmu (FMI 2.0) and
+    """Through every FMU: --fmu DIR/SpherePlateImpact.fmu, DIR/fmi2/SpherePlateImpact.fmu (FMI 2.0) and
     DIR/fmi3/SpherePlateImpact.fmu (FMI 3.0)."""
     impact_fmu = any_version_impact_fmu
     path = SCENES / "glass_marble_glass_plate.toml"

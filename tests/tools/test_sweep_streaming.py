@@ -494,9 +494,9 @@ def cli_built_fmus(tmp_path_factory):
     return out
 
 
-@pytest.mark.parametrize("native_dir", ["native", "fmi3"])
+@pytest.mark.parametrize("native_dir", ["fmi2", "fmi3"])
 def test_cli_fmu_back_end_on_the_built_fmus_python_and_native(tmp_path, cli_built_fmus, native_dir):
-    """--fmu DIR/SpherePlateImpact.fmu and DIR/native/SpherePlateImpact.fmu (C only: the sweep refused it
+    """--fmu DIR/SpherePlateImpact.fmu and DIR/fmi2/SpherePlateImpact.fmu (C only: the sweep refused it
     with a traceback, looking for the bundled Python package), or DIR/fmi3/SpherePlateImpact.fmu (FMI 3.0,
     the same C), give the same table, refused cases too."""
     native = cli_built_fmus / native_dir / "SpherePlateImpact.fmu"
@@ -506,13 +506,13 @@ def test_cli_fmu_back_end_on_the_built_fmus_python_and_native(tmp_path, cli_buil
             "--random", "sphere.E=normal_rel:0.6", "--samples", "3", "--seed", "4", "--backend", "fmu",
             "--scheduler", "serial", "--no-plot"]
     tables = {}
-    for name, fmu in (("python", cli_built_fmus / "SpherePlateImpact.fmu"), ("native", native)):
+    for name, fmu in (("python", cli_built_fmus / "SpherePlateImpact.fmu"), ("fmi2", native)):
         proc = _cli(*args, "--fmu", str(fmu), "--out", str(tmp_path / f"{name}.csv"))
         assert proc.returncode == 0 and "Traceback" not in proc.stderr, proc.stderr
         tables[name] = read_table(tmp_path / f"{name}.csv")
     assert np.count_nonzero(~tables["python"]["ok"]) > 0  # sphere.E drawn negative: refused by both
-    assert np.array_equal(tables["python"]["ok"], tables["native"]["ok"])
-    assert all(v <= 1e-12 for v in compare_results(tables["native"], tables["python"]).values())
+    assert np.array_equal(tables["python"]["ok"], tables["fmi2"]["ok"])
+    assert all(v <= 1e-12 for v in compare_results(tables["fmi2"], tables["python"]).values())
 
 
 def test_fmu_back_end_refuses_codes_that_would_wrap(impact_fmu):

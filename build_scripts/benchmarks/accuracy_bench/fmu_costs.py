@@ -62,7 +62,7 @@ def build_fmus(work: Path) -> dict:
     from pythonfmu.builder import FmuBuilder
     from restitution.fmu.build import FMUS, build_one
     from restitution.fmu.models import table
-    from restitution.fmu.build_guard import make_standalone
+    from restitution.fmu.build.guard import make_standalone
 
     out = {"SpherePlateImpact": build_one("SpherePlateImpact", work)}
     if "BouncingBall" in FMUS:

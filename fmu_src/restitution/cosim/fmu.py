@@ -5,7 +5,8 @@ import shutil
 import weakref
 from pathlib import Path
 
-__all__ = ["FmuInstance", "FmiStatusError", "build_default_fmu", "impact_fmu_parameters", "quiet_instantiate"]
+__all__ = ["FmuInstance", "FmiStatusError", "build_default_fmu", "check_impact_fmu", "impact_fmu_parameters",
+           "quiet_instantiate"]
 
 
 class FmiStatusError(RuntimeError):
@@ -22,6 +23,31 @@ def build_default_fmu(out_dir: str | Path | None = None, model: str = "SpherePla
     from ..fmu.build import default_fmu
 
     return default_fmu(out_dir, model=model, rebuild=rebuild, log=log)
+
+
+def check_impact_fmu(path, option: str = "--fmu") -> Path:
+    """``path`` if it is a SpherePlateImpact FMU (a file, an FMU archive with a co-simulation interface and
+    every input, parameter and output of the model's interface table, which sweeps and scenes use); else
+    ValueError, one line naming ``option`` and the path."""
+    from ..fmu.models import table
+
+    path = Path(path)
+    if not path.is_file():
+        raise ValueError(f"{option} {path}: {'not a file' if path.exists() else 'no such file'}")
+    try:
+        from fmpy import read_model_description
+
+        md = read_model_description(str(path))
+    except Exception as exc:  # noqa: BLE001 - whatever the archive is, it is not an FMU we can read
+        raise ValueError(f"{option} {path}: not an FMU ({type(exc).__name__}: {exc})") from None
+    names = {v.name for v in md.modelVariables}
+    missing = [row.name for row in table("SpherePlateImpact")
+               if row.causality in ("input", "parameter", "output") and row.name not in names]
+    if missing or md.coSimulation is None:
+        what = f"no variable(s) {', '.join(missing[:4])}{' ...' if len(missing) > 4 else ''}" if missing else \
+            "no co-simulation interface"
+        raise ValueError(f"{option} {path}: not a SpherePlateImpact FMU ({md.modelName}: {what})")
+    return path
 
 
 def impact_fmu_parameters(sphere, plate) -> dict:

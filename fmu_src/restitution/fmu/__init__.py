@@ -8,8 +8,8 @@ same FMUs as a source checkout:
 * ``cfront/``: the C FMI front (the FMI 2.0 plumbing, written once for every model and both
   implementations); ``physics_c/``: the physics in C99; ``pythonfmu_guard/``: the guard's backend that
   forwards checked calls to pythonfmu, and its Python loader for plain C hosts;
-* the build, here: ``build.py`` (the pythonfmu FMUs, and the entry points), ``build_native.py``,
-  ``build_guard.py``, ``interface.py`` (the C headers from the tables), ``compile.py``, ``sources.py``.
+* ``describe/``: every description, header and page written from the tables (pure text);
+* ``build/``: the builders, one per product (pythonfmu, native, the guard), and the entry points.
 
 The build is imported on first use: the pythonfmu FMUs bundle the interface tables, never the build.
 """

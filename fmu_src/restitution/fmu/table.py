@@ -1,7 +1,7 @@
 """The FMUs' interface as data: one row per variable, one table per model (``models/<model>/variables.py``).
 
 Pure data and lookups (no pythonfmu, no fmpy): the pythonfmu slaves register their variables from
-it, the build writes the modelDescription from it, :mod:`restitution.fmu.interface` generates the C
+it, the build writes the modelDescription from it, :mod:`restitution.fmu.describe.c_header` generates the C
 headers from it, and the host tools (sweeps, scenes, co-simulation helpers, the ctypes binding,
 benchmarks) read names, package keywords and codes from it. Adding a variable is one row here plus
 its physics. Shipped inside the pythonfmu FMUs with the physics (the slaves read it at run time).

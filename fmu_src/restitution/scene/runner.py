@@ -59,7 +59,7 @@ def ensure_fmu(fmu=None, rebuild: bool = False, log=None) -> Path:
     (dist/ of a source checkout, a per-user cache otherwise), (re)built when missing, built from
     other sources, or when ``rebuild`` is true (:func:`restitution.fmu.default_fmu`)."""
     if fmu is not None:  # ValueError (one line naming --fmu) unless it is a SpherePlateImpact FMU
-        from ..sweep.backends import check_impact_fmu
+        from ..cosim.fmu import check_impact_fmu
 
         return check_impact_fmu(fmu)
     from ..cosim.fmu import build_default_fmu

@@ -284,7 +284,7 @@ def _main(parser, args) -> int:
         return _error(str(exc), EXIT_REFUSED)
     try:
         if backend in ("fmu", "both") and fmu is not None:
-            from .backends import check_impact_fmu
+            from ..cosim.fmu import check_impact_fmu
             fmu = check_impact_fmu(fmu)
     except ValueError as exc:
         parser.error(str(exc))

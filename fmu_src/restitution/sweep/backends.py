@@ -37,8 +37,7 @@ from ..fmu.models.sphere_plate_impact.variables import TABLE
 from ..model import PARAMETERS
 from .spec import CODES, INPUTS, INTEGER_INPUTS, OUTPUTS, SETTABLE
 
-__all__ = ["Backend", "PackageBackend", "FmuBackend", "get_backend", "code_fingerprint", "release_fmus",
-           "check_impact_fmu"]
+__all__ = ["Backend", "PackageBackend", "FmuBackend", "get_backend", "code_fingerprint", "release_fmus"]
 
 _REAL_OUT = [name for name, _f, t in OUTPUTS if t == "Real"]
 _BOOL_OUT = [name for name, _f, t in OUTPUTS if t == "Boolean"]
@@ -424,28 +423,6 @@ class FmuBackend(Backend):
 
     def describe(self) -> str:
         return f"fmu ({self.path.name}, sha256 {self.sha[:12]})"
-
-
-def check_impact_fmu(path, option: str = "--fmu") -> Path:
-    """``path`` if it is a SpherePlateImpact FMU (a file, an FMU archive, with every input and output
-    a sweep or a scene uses); else ValueError, one line naming ``option`` and the path."""
-    path = Path(path)
-    if not path.is_file():
-        raise ValueError(f"{option} {path}: {'not a file' if path.exists() else 'no such file'}")
-    try:
-        from fmpy import read_model_description
-
-        md = read_model_description(str(path))
-    except Exception as exc:  # noqa: BLE001 - whatever the archive is, it is not an FMU we can read
-        raise ValueError(f"{option} {path}: not an FMU ({type(exc).__name__}: {exc})") from None
-    names = {v.name for v in md.modelVariables}
-    missing = [name for name, _kw, _t, _s in INPUTS if name not in names]
-    missing += [name for name, _f, _t in OUTPUTS if name not in names]
-    if missing or md.coSimulation is None:
-        what = f"no variable(s) {', '.join(missing[:4])}{' ...' if len(missing) > 4 else ''}" if missing else \
-            "no co-simulation interface"
-        raise ValueError(f"{option} {path}: not a SpherePlateImpact FMU ({md.modelName}: {what})")
-    return path
 
 
 def get_backend(name: str = "package", fmu=None) -> Backend:

@@ -5,7 +5,6 @@ package (the package is authoritative; tests/fmu/test_native_*.py keep the two t
   Eqs. (17)-(20) of I. Green, Nonlinear Dyn (2022), in the package's well-conditioned forms.
 * :mod:`.zener_table_header`: writes the C header with the ``exact`` method's Hermite pieces, generated
   at build time from ``restitution/data/zener_table.npz`` (never edited by hand, never committed).
-* :mod:`.physics_ctypes`: calls the compiled physics from Python (equivalence tests, benchmarks).
 
-:mod:`restitution.fmu.compile` compiles it.
+:mod:`restitution.fmu.build.compile` compiles it; the tests call it through ctypes (tests/physics_ctypes.py).
 """

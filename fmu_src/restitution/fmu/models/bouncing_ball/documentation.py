@@ -1,11 +1,11 @@
 """BouncingBall's documentation beyond its interface table: free flight, contacts, the rest rule,
 ``contact_mode`` and model exchange (``documentation/index.html`` of every BouncingBall FMU, written by
-:func:`restitution.fmu.documentation.index_html`). The facts are those of the slave's docstring
+:func:`restitution.fmu.describe.documentation.index_html`). The facts are those of the slave's docstring
 (``bouncing_ball_slave.py``) and of docs/host_contract.md ("FMI 3.0 and model exchange"); plain text,
 variable names between backticks."""
 from __future__ import annotations
 
-from ...documentation import Section
+from ..text import Section
 
 DOCUMENTATION = (
     Section("What it computes", (

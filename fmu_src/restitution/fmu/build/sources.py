@@ -1,7 +1,7 @@
 """What each FMU is built from: which files of the package an FMU bundles, and the hash of its sources
 recorded inside it (``resources/build_info.json``), which decides whether a built FMU is stale.
 
-Read by the builds (:mod:`.build`, :mod:`.build_native`); imports nothing of them.
+Read by the builders (:mod:`.python_fmu`, :mod:`.native`, :mod:`.guard`); imports nothing of them.
 """
 from __future__ import annotations
 
@@ -11,9 +11,11 @@ import shutil
 import zipfile
 from pathlib import Path
 
-from .models import HERE as MODELS, SLAVE_SUPPORT, native_sources, slave_script
+from ..models import HERE as MODELS, SLAVE_SUPPORT, native_sources, slave_script
 
-FMU_DIR = Path(__file__).resolve().parent
+FMU_DIR = Path(__file__).resolve().parent.parent
+BUILD_DIR = Path(__file__).resolve().parent
+DESCRIBE_DIR = FMU_DIR / "describe"
 PACKAGE = FMU_DIR.parent  # the restitution package the FMUs bundle
 FRONT = FMU_DIR / "cfront"
 GUARD = FMU_DIR / "pythonfmu_guard"
@@ -62,12 +64,11 @@ def _table_files() -> list[Path]:
 
 def source_files(model: str) -> list[Path]:
     """Every file the pythonfmu ``<model>.fmu`` is built from: the slave, the bundled physics modules,
-    tables and data, the builds, the C header generator, the guard (C front and loader) and the
+    tables and data, the builders and describers (build/, describe/), the guard (C front and loader) and the
     license it carries."""
     files = [slave_script(model), SLAVE_SUPPORT, *_table_files()]
-    files += [FMU_DIR / name for name in ("build.py", "build_guard.py", "sources.py", "interface.py",
-                                          "documentation.py")]
-    files += [PACKAGE / "LICENSE.txt"] + sorted(MODELS.glob("*/documentation.py"))  # documentation/index.html
+    files += sorted(BUILD_DIR.glob("*.py")) + sorted(DESCRIBE_DIR.glob("*.py"))  # the builders and describers
+    files += [PACKAGE / "LICENSE.txt", MODELS / "text.py"] + sorted(MODELS.glob("*/documentation.py"))  # documentation/
     files += sorted(FRONT.glob("*.[ch]")) + sorted(GUARD.glob("*.[ch]"))
     files += sorted(PACKAGE.glob("*.py"))
     for sub in sorted(BUNDLED_SUBDIRS):
@@ -90,7 +91,7 @@ def native_source_hash(model: str) -> str:
     every C file and generator the native ``<model>.fmu`` is built from."""
     digest = hashlib.sha256(source_hash(model).encode())
     paths = (sorted(FRONT.glob("*.[ch]")) + sorted(PHYSICS_C.glob("*.[ch]")) + sorted(PHYSICS_C.glob("*.py"))
-             + native_sources(model) + [FMU_DIR / name for name in ("build_native.py", "compile.py", "model_description3.py")])
+             + native_sources(model))
     for path in paths:
         digest.update(path.name.encode() + b"\0" + path.read_bytes() + b"\0")
     return digest.hexdigest()

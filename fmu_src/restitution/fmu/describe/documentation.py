@@ -6,99 +6,36 @@
   model's equations, assumptions and validity, how to cite it and a link to the license. Written by
   :func:`index_html` from the model's interface table (``models/<model>/variables.py``: the same rows
   the modelDescription is written from) and the model's prose (``models/<model>/documentation.py``:
-  ``DOCUMENTATION``, a tuple of :class:`Section`), for one implementation: the pythonfmu FMU (FMI 2.0
+  ``DOCUMENTATION``, a tuple of
+  :class:`restitution.fmu.models.text.Section`), for one implementation: the pythonfmu FMU (FMI 2.0
   co-simulation) or a native one (FMI 2.0 or 3.0, co-simulation and model exchange, the native ranges
   where the table gives ``native_interval``). Self-contained XHTML (inline CSS, no script, nothing
   fetched), every text escaped, and nothing that changes between builds (no date), so two builds write
   the same file.
-* the license files (``documentation/licenses/``, entry point ``license.txt``): the project's MIT
-  license, which asks that its notice travel with every copy, and, in the pythonfmu FMUs, which bundle
-  pythonfmu's Python runtime and its binary behind the guard, pythonfmu's own MIT license taken from
-  the installed distribution.
 
-The builds add both with :func:`documentation_files`.
+The license files beside it (``documentation/licenses/``) are the build's
+(:mod:`restitution.fmu.build.licenses`). Pure data in, text out.
 """
 from __future__ import annotations
 
 import html
 import importlib
 import re
-from dataclasses import dataclass
-from importlib import metadata
 
-from ..about import COPYRIGHT, LICENSE, LICENSE_FILE, VERSION
-from .model_description3 import ELEMENTS as FMI3_TYPES, TIME_NAME, TIME_UNIT
-from .models import FOLDERS, table as _table
+from ...about import COPYRIGHT, LICENSE, VERSION
+from ..models import FOLDERS, table as _table
+from ..models.text import Rows, Section
+from .fmi3 import ELEMENTS as FMI3_TYPES, TIME_NAME, TIME_UNIT
 
-__all__ = ["LICENSES", "INDEX", "license_files", "documentation_files", "index_html", "Section", "Rows",
-           "model_documentation", "CITATIONS"]
+__all__ = ["INDEX", "index_html", "model_documentation", "CITATIONS"]
 
-LICENSES = "documentation/licenses/"
 #: The entry point of an FMU's documentation (FMI 2.0 and 3.0).
 INDEX = "documentation/index.html"
 
 
-def _pythonfmu_license() -> tuple[str, str]:
-    """(version, license text) of the installed pythonfmu."""
-    dist = metadata.distribution("pythonfmu")
-    names = [str(f) for f in dist.files or () if f.name.upper().startswith(("LICENSE", "COPYING"))]
-    if not names:
-        raise FileNotFoundError(f"pythonfmu {dist.version} is installed without its license file; "
-                                "reinstall it from a wheel (pip install --force-reinstall pythonfmu)")
-    return dist.version, dist.locate_file(names[0]).read_text(encoding="utf-8")
-
-
-def license_files(bundles_pythonfmu: bool) -> dict[str, bytes]:
-    """Archive name -> content of the license files of one FMU."""
-    entry = [f"restitution {VERSION}", "", LICENSE_FILE.read_text(encoding="utf-8")]
-    files = {}
-    if bundles_pythonfmu:
-        version, text = _pythonfmu_license()
-        entry += ["", f"This FMU also contains pythonfmu {version} (its Python package in resources/pythonfmu/ "
-                      "and its binary behind the restitution guard), under the license in pythonfmu.txt."]
-        files[LICENSES + "pythonfmu.txt"] = text.encode("utf-8")
-    files[LICENSES + "license.txt"] = ("\n".join(entry).rstrip("\n") + "\n").encode("utf-8")
-    return files
-
-
-def documentation_files(model: str, fmi_version: str = "2.0", native: bool = False) -> dict[str, bytes]:
-    """Archive name -> content of everything below ``documentation/`` of one FMU of ``model``: the
-    license files and ``index.html``. ``native``: the native C FMU of ``fmi_version`` (co-simulation and
-    model exchange, its own ranges); else the pythonfmu FMU (FMI 2.0 co-simulation, bundles pythonfmu)."""
-    files = license_files(bundles_pythonfmu=not native)
-    files[INDEX] = index_html(model, fmi_version, native).encode("utf-8")
-    return files
-
-
-# --- what a model's prose is made of (models/<model>/documentation.py) ---
-
-@dataclass(frozen=True)
-class Rows:
-    """A small table in a model's prose (its equations, say): a header and rows of cells, plain text."""
-
-    header: tuple[str, ...]
-    rows: tuple[tuple[str, ...], ...]
-
-
-@dataclass(frozen=True)
-class Section:
-    """One part of a model's documentation beyond its interface table.
-
-    ``blocks``: each a paragraph (``str``), a bullet list (``tuple`` of ``str``) or a :class:`Rows`. All
-    text is plain (escaped when written); a variable name or a piece of code between backticks is set as
-    code. ``model_exchange``: True to show the section only in the FMUs that offer model exchange (the
-    native ones), False only in those that do not, None in every FMU."""
-
-    title: str
-    blocks: tuple
-    model_exchange: bool | None = None
-
-
 def model_documentation(model: str) -> tuple[Section, ...]:
     """The prose of ``model``: ``DOCUMENTATION`` of ``models/<model>/documentation.py``."""
-    from . import models
-
-    return importlib.import_module(f"{models.__name__}.{FOLDERS[model]}.documentation").DOCUMENTATION
+    return importlib.import_module(f"{_table.__module__}.{FOLDERS[model]}.documentation").DOCUMENTATION
 
 
 #: The citation of every FMU: the software, then the paper it implements (the preferred citation) and
@@ -282,7 +219,7 @@ def _variables(model_table, fmi_version: str, native: bool) -> list[str]:
             out.append(_cells(row.name, f"{row.causality} ({row.variability})", _fmi_type(row, fmi_version), unit,
                               _start(row), allowed, description))
         out.append("</table>")
-    if fmi_version == "3.0":  # every FMI 3.0 FMU has one independent variable (model_description3)
+    if fmi_version == "3.0":  # every FMI 3.0 FMU has one independent variable (describe/fmi3.py)
         out += ['<h3 id="independent-variable">Independent variable</h3>', '<table class="variables">', header,
                 _cells(TIME_NAME, "independent (continuous)", FMI3_TYPES["Real"], TIME_UNIT, "", "",
                        "Simulation time: the start time until initialization ends, then the end of the last step "

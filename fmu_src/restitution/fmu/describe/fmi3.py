@@ -22,31 +22,20 @@ Pure data in, text out: no compiler, no fmpy (tests validate the result against 
 """
 from __future__ import annotations
 
-import math
-import os
 import re
-from datetime import datetime, timezone
 from xml.etree import ElementTree as ET
 
-from ..about import AUTHOR, COPYRIGHT, LICENSE, VERSION
-from .models import table as _table
-from .table import UNITS, Table, Variable
+from ...about import VERSION
+from ..models import table as _table
+from ..table import Table, Variable
+from .common import (GENERATION_TOOL, PARAMETER_CAUSALITIES, limit_text, log_categories, model_attributes,
+                     start_text, unit_definitions, xml_text)
 
-__all__ = ["model_description", "build_description", "enumeration_type", "generation_date_and_time", "TIME_NAME",
-           "GENERATION_TOOL"]
+__all__ = ["model_description", "build_description", "enumeration_type", "TIME_NAME", "ELEMENTS"]
 
-GENERATION_TOOL = "restitution native build (C99 front + native physics)"
 #: The independent variable every FMI 3.0 FMU must have (its value reference: ``len(table)``).
 TIME_NAME = "time"
 TIME_UNIT = "s"
-#: The log categories the C front answers to (the FMI 2.0 files' names), in their order.
-LOG_CATEGORIES = (
-    ("logStatusWarning", "Log messages with fmi3Warning status."),
-    ("logStatusDiscard", "Log messages with fmi3Discard status."),
-    ("logStatusError", "Log messages with fmi3Error status."),
-    ("logStatusFatal", "Log messages with fmi3Fatal status."),
-    ("logAll", "Log all messages."),
-)
 #: The co-simulation capabilities of the native front. Each flag is spelled out, false ones too, so a
 #: reader sees what the FMU does not offer without knowing the schema's defaults: no event mode, no
 #: intermediate update, no early return (fmi3DoStep always completes the step or fails).
@@ -72,7 +61,6 @@ MODEL_EXCHANGE = {
 }
 #: Table type -> FMI 3.0 element (an Integer with choices becomes an Enumeration instead).
 ELEMENTS = {"Real": "Float64", "Integer": "Int32", "Boolean": "Boolean"}
-PARAMETER_CAUSALITIES = ("parameter", "input")
 
 
 def enumeration_type(row: Variable) -> str:
@@ -99,45 +87,6 @@ def _enumeration_types(table: Table) -> dict[str, Variable]:
     return types
 
 
-def generation_date_and_time(environ=None) -> str | None:
-    """The ``generationDateAndTime`` of every modelDescription the build writes (FMI 2.0 and 3.0): the
-    time in ``SOURCE_DATE_EPOCH`` (seconds since 1970-01-01 UTC, https://reproducible-builds.org/specs/source-date-epoch/)
-    in the form the standard recommends (UTC, whole seconds, "Z": ``2026-11-25T10:00:00Z``); None where
-    it is unset or empty, and the attribute (optional) is then left out, so that two builds of the same
-    sources write the same files. ValueError for a value that is not a whole number of seconds."""
-    text = (os.environ if environ is None else environ).get("SOURCE_DATE_EPOCH", "").strip()
-    if not text:
-        return None
-    if not re.fullmatch(r"[0-9]+", text):
-        raise ValueError(f"SOURCE_DATE_EPOCH={text!r} is not a whole number of seconds since 1970-01-01 UTC")
-    try:
-        return datetime.fromtimestamp(int(text), timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
-    except (OverflowError, OSError, ValueError):
-        raise ValueError(f"SOURCE_DATE_EPOCH={text} is beyond the dates a modelDescription can state") from None
-
-
-def _float(value) -> str:
-    """A Float64 attribute: the shortest text that reads back as the same double (Python's repr, the
-    'minimal printer' the standard recommends), so a start value survives the XML exactly."""
-    value = float(value)
-    if not math.isfinite(value):
-        raise ValueError(f"{value!r} is not a finite start value")
-    return repr(value)
-
-
-def _start(row: Variable) -> str:
-    if row.type == "Boolean":
-        return "true" if row.start else "false"
-    if row.type == "Integer":
-        return str(int(row.start))
-    return _float(row.start)
-
-
-def _limit(row: Variable, text: str) -> str:
-    # xml_limits formats with %g, which writes 1e+06 for a large integer: not an xs:long
-    return str(int(float(text))) if row.type == "Integer" else text
-
-
 def _variable(parent: ET.Element, row: Variable, table: Table) -> None:
     element = "Enumeration" if row.is_enumeration else ELEMENTS[row.type]
     attrs = {"name": row.name, "valueReference": str(row.vr), "description": row.description,
@@ -151,23 +100,13 @@ def _variable(parent: ET.Element, row: Variable, table: Table) -> None:
     if row.derivative is not None:
         attrs["derivative"] = str(table[row.derivative].vr)
     if row.causality in PARAMETER_CAUSALITIES:
-        low, high = row.xml_limits(native=True)  # every FMI 3.0 FMU is native
+        low, high = limit_text(row, native=True)  # every FMI 3.0 FMU is native
         if low is not None:
-            attrs["min"] = _limit(row, low)
+            attrs["min"] = low
         if high is not None:
-            attrs["max"] = _limit(row, high)
-        attrs["start"] = _start(row)
+            attrs["max"] = high
+        attrs["start"] = start_text(row)
     ET.SubElement(parent, element, attrs)
-
-
-def _unit_definitions(table: Table) -> ET.Element:
-    used = {row.unit for row in table if row.type == "Real" and row.unit is not None} | {TIME_UNIT}
-    node = ET.Element("UnitDefinitions")
-    for unit in sorted(used):
-        unit_node = ET.SubElement(node, "Unit", name=unit)
-        if UNITS[unit]:  # "1" has no BaseUnit: all exponents 0 is the schema's default anyway
-            ET.SubElement(unit_node, "BaseUnit", {k: str(v) for k, v in UNITS[unit].items()})
-    return node
 
 
 def _type_definitions(table: Table) -> ET.Element | None:
@@ -210,11 +149,6 @@ def _model_structure(table: Table) -> ET.Element:
     return node
 
 
-def _text(root: ET.Element) -> str:
-    ET.indent(root, "  ")
-    return '<?xml version="1.0" encoding="UTF-8"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
-
-
 def model_description(model: str, instantiation_token: str | None = None) -> str:
     """The FMI 3.0 ``modelDescription.xml`` of ``model``'s native co-simulation FMU, from its interface
     table (:func:`restitution.fmu.models.table`).
@@ -222,35 +156,22 @@ def model_description(model: str, instantiation_token: str | None = None) -> str
     ``instantiation_token`` is the string a host passes to fmi3InstantiateCoSimulation and the binary
     compares with its own (the FMI 2.0 guid's role); by default the table's
     (:meth:`restitution.fmu.table.Table.instantiation_token` of this version), the GUID of the model's
-    FMI 2.0 FMUs. ``generationDateAndTime`` is :func:`generation_date_and_time` (absent without
+    FMI 2.0 FMUs. ``generationDateAndTime`` is :func:`~restitution.fmu.describe.common.generation_date_and_time` (absent without
     SOURCE_DATE_EPOCH). Element order is the schema's:
     CoSimulation, UnitDefinitions, TypeDefinitions, LogCategories, ModelVariables, ModelStructure (no
     DefaultExperiment: the FMI 2.0 files have none; the host chooses start, stop and step).
     """
     table = _table(model)
-    date = generation_date_and_time()
+    token = instantiation_token or table.instantiation_token(VERSION)
     root = ET.Element("fmiModelDescription", {
-        "fmiVersion": "3.0",
-        "modelName": model,
-        "instantiationToken": instantiation_token or table.instantiation_token(VERSION),
-        "description": table.description,
-        "author": AUTHOR,
-        "version": VERSION,
-        "copyright": COPYRIGHT,
-        "license": LICENSE,
-        "generationTool": GENERATION_TOOL,
-        **({"generationDateAndTime": date} if date is not None else {}),
-        "variableNamingConvention": "structured",
-    })
+        "fmiVersion": "3.0", **model_attributes(table, "instantiationToken", token, GENERATION_TOOL)})
     ET.SubElement(root, "ModelExchange", {"modelIdentifier": model, **MODEL_EXCHANGE})
     ET.SubElement(root, "CoSimulation", {"modelIdentifier": model, **CO_SIMULATION})
-    root.append(_unit_definitions(table))
+    root.append(unit_definitions(table, extra=(TIME_UNIT,)))
     types = _type_definitions(table)
     if types is not None:
         root.append(types)
-    categories = ET.SubElement(root, "LogCategories")
-    for name, description in LOG_CATEGORIES:
-        ET.SubElement(categories, "Category", name=name, description=description)
+    root.append(log_categories("fmi3"))
     variables = ET.SubElement(root, "ModelVariables")
     for row in table:
         _variable(variables, row, table)
@@ -260,7 +181,7 @@ def model_description(model: str, instantiation_token: str | None = None) -> str
         "name": TIME_NAME, "valueReference": str(len(table)), "description": "Simulation time",
         "causality": "independent", "variability": "continuous", "unit": TIME_UNIT})
     root.append(_model_structure(table))
-    return _text(root)
+    return xml_text(root)
 
 
 def build_description(model: str, c_files: list[str], defines: dict | None = None) -> str:
@@ -287,4 +208,4 @@ def build_description(model: str, c_files: list[str], defines: dict | None = Non
         ET.SubElement(files, "PreprocessorDefinition", attrs)
     ET.SubElement(files, "IncludeDirectory", name=".")
     ET.SubElement(config, "Library", name="m", external="true", description="the C math library (libm)")
-    return _text(root)
+    return xml_text(root)

@@ -7,8 +7,8 @@ from types import SimpleNamespace
 
 import numpy as np
 
-from ...agreement import FLAGS, REALS
-from ..models.sphere_plate_impact.variables import TABLE
+from restitution.agreement import FLAGS, REALS
+from restitution.fmu.models.sphere_plate_impact.variables import TABLE
 
 _INPUT_REALS = ("v", "sphere_E", "sphere_nu", "sphere_Sy", "sphere_rho", "sphere_d",
                 "plate_E", "plate_nu", "plate_Sy", "plate_rho", "plate_t")

@@ -20,10 +20,10 @@ FMU rebuilds the guard and the configuration file.
 
 Usage::
 
-    from restitution.fmu.build_guard import make_standalone
+    from restitution.fmu.build.guard import make_standalone
     make_standalone(Path("build/Model.fmu"))            # this interpreter / venv
 
-    python -m restitution.fmu.build_guard build/Model.fmu \
+    python -m restitution.fmu.build.guard build/Model.fmu \
         [--python /path/to/venv/bin/python] [--require numpy --require scipy]
 """
 from __future__ import annotations
@@ -42,7 +42,8 @@ from pathlib import Path
 from typing import Iterable, Optional, Sequence
 from xml.etree import ElementTree
 
-from restitution.fmu.sources import FRONT, GUARD, front_files
+from .compile import NativeBuildSkipped, fmi_include_dir
+from .sources import FRONT, GUARD, front_files
 
 #: The guard's C sources: the front, then the guard's backend (forwarding to pythonfmu) and Python loader.
 GUARD_SOURCES = (*(p for p in front_files("2.0") if p.suffix == ".c"), GUARD / "pythonfmu_backend.c",
@@ -155,7 +156,7 @@ def _detect_requirements(entries: dict[str, bytes]) -> set[str]:
 
 def _config_text(info: dict, requires: Sequence[str]) -> str:
     lines = [
-        "# Written by restitution.fmu.build_guard.",
+        "# Written by restitution.fmu.build.guard.",
         "# Read by the FMU's binaries/linux64 guard when the host process has no Python",
         "# (plain C/C++ FMI hosts). Edit the paths to move the FMU to another Python",
         f"# {'.'.join(info['version'].split('.')[:2])} installation; ignored inside Python hosts (fmpy, libcosimpy).",
@@ -205,8 +206,6 @@ GUARD_CFLAGS = ("-std=gnu99", "-O2", "-Wall", "-Wextra", "-Werror", "-shared", "
 
 
 def _fmi2_headers() -> Path:
-    from restitution.fmu.build_native import NativeBuildSkipped, fmi_include_dir
-
     try:
         return fmi_include_dir("2.0")
     except NativeBuildSkipped as exc:
@@ -229,13 +228,13 @@ def guard_command(output: Path, generated: Path, real_name: str, compiler: str =
 def write_guard_headers(directory: Path, model_description: str, interface_header: Optional[str] = None) -> None:
     """rst_interface.h (``interface_header``, or one made from the modelDescription for an FMU without an
     interface table of its own) and rst_model_info.h into ``directory``."""
-    from restitution.fmu.interface import c_header, model_info, model_info_header, variables_from_model_description
+    from ..describe.c_header import c_header, model_info, model_info_header, variables_from_model_description
 
     if interface_header is None:
         identifier = model_info(model_description)[0]
         interface_header = c_header(identifier, variables_from_model_description(model_description))
     (directory / "rst_interface.h").write_text(interface_header, encoding="utf-8")
-    (directory / "rst_model_info.h").write_text(model_info_header(model_description), encoding="ascii")
+    (directory / "rst_model_info.h").write_text(model_info_header(*model_info(model_description)), encoding="ascii")
 
 
 def _compile_guard(output: Path, real_name: str, include_dir: str, compiler: str, real_binary: bytes,
@@ -264,7 +263,7 @@ def make_standalone(
     recorded. ``required_modules`` are checked at instantiation for a clear
     error message; by default they are the non-stdlib top-level modules
     imported by the FMU's Python files that are importable at build time.
-    ``interface_header`` is the guard's variable table (:func:`restitution.fmu.interface.c_header`
+    ``interface_header`` is the guard's variable table (:func:`restitution.fmu.describe.c_header.c_header`
     of the model's interface table); without it the table is made from the FMU's modelDescription.xml.
     """
     fmu_path = Path(fmu_path)
