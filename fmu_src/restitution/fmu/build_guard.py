@@ -46,7 +46,9 @@ from restitution.fmu.sources import FRONT, GUARD, front_files
 
 #: The guard's C sources: the front, then the guard's backend (forwarding to pythonfmu) and Python loader.
 GUARD_SOURCES = (*(p for p in front_files("2.0") if p.suffix == ".c"), GUARD / "pythonfmu_backend.c",
-                 GUARD / "python_loader.c")
+                 GUARD / "python_loader.c", GUARD / "pyloader_api.c", GUARD / "pyloader_config.c",
+                 GUARD / "pyloader_start.c", GUARD / "pyloader_preflight.c", GUARD / "pyloader_threads.c",
+                 GUARD / "pyloader_lifetime.c", GUARD / "pyloader_signals.c")
 CONFIG_NAME = "python_env.txt"  # must match PYLOADER_CONFIG_NAME in python_loader.c
 REAL_SUFFIX = "_pythonfmu"
 
