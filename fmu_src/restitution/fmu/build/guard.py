@@ -8,7 +8,7 @@ post-processes a built FMU, in place:
 * ``binaries/linux64/<id>.so`` (pythonfmu) is renamed ``<id>_pythonfmu.so``;
 * the guard takes its place: the project's C FMI front (``cfront/``: state machine, argument and
   range checks from the interface table, FMU states, logging) with ``pythonfmu_backend.c``, which
-  forwards the checked calls to the pythonfmu binary, and ``python_loader.c``. In a process without
+  forwards the checked calls to the pythonfmu binary, and the loader (``python_loader.c`` and its ``pyloader_*.c`` parts). In a process without
   Python the latter loads the libpython recorded below (RTLD_GLOBAL), starts the interpreter on the
   build environment (venv) and checks the required modules; in a Python host (fmpy, libcosimpy) it
   uses the running interpreter;
@@ -47,7 +47,9 @@ from .sources import FRONT, GUARD, front_files
 
 #: The guard's C sources: the front, then the guard's backend (forwarding to pythonfmu) and Python loader.
 GUARD_SOURCES = (*(p for p in front_files("2.0") if p.suffix == ".c"), GUARD / "pythonfmu_backend.c",
-                 GUARD / "python_loader.c")
+                 GUARD / "python_loader.c", GUARD / "pyloader_api.c", GUARD / "pyloader_config.c",
+                 GUARD / "pyloader_start.c", GUARD / "pyloader_preflight.c", GUARD / "pyloader_threads.c",
+                 GUARD / "pyloader_lifetime.c", GUARD / "pyloader_signals.c")
 CONFIG_NAME = "python_env.txt"  # must match PYLOADER_CONFIG_NAME in python_loader.c
 REAL_SUFFIX = "_pythonfmu"
 
@@ -173,7 +175,7 @@ def _config_text(info: dict, requires: Sequence[str]) -> str:
 
 
 #: pythonfmu's ``(anonymous namespace)::pyState`` (a std::shared_ptr, two words): see
-#: arm_pystate_exit_fix in python_loader.c, which empties it before pythonfmu's exit-time double release.
+#: pyloader_arm_pystate_exit_fix in pyloader_lifetime.c, which empties it before pythonfmu's exit-time double release.
 PYSTATE_SYMBOL = b"_ZN12_GLOBAL__N_17pyStateE"
 
 

@@ -2,19 +2,19 @@
  * code runs, shared by the guard in front of pythonfmu (pythonfmu_guard/) and by the native FMUs
  * (models/<model>/rst_native_*_fmu.c), whatever the FMI version.
  *
- * The core (rst_front.c: life cycle, values, steps; rst_log.c: messages; rst_state.c: FMU states)
- * knows no FMI version. It checks each call against the co-simulation state machine and its arguments
- * against the interface table (generated from the model's interface table): unknown value references,
- * wrong types, variables that may not be set in the current mode, values outside their declared range
- * or non-finite, NULL pointers, a wrong GUID or instantiation token, a step whose time does not
- * continue the previous one. Anything wrong is answered with an error status and a log message naming
- * the variable, its value and what is allowed, and changes nothing. It keeps the value store (every
- * variable as a double, indexed by value reference), the FMU states (versioned, checksummed and
- * validated on restore) and logging. A thin layer per FMI version exports that version's functions
- * and translates its types (rst_fmi2.c, rst_fmi3.c); one FMU binary is built with one of them.
- * A backend (the glue file compiled with the front defines RST_MODEL) supplies the model: it is only
- * ever called with checked arguments, in a legal mode. There is no global mutable state here; each
- * instance is independent.
+ * The core (rst_front.c: life cycle, steps; rst_values.c: values; rst_log.c: messages; rst_state.c:
+ * FMU states) knows no FMI version. It checks each call against the co-simulation state machine and
+ * its arguments against the interface table (generated from the model's interface table): unknown
+ * value references, wrong types, variables that may not be set in the current mode, values outside
+ * their declared range or non-finite, NULL pointers, a wrong GUID or instantiation token, a step whose
+ * time does not continue the previous one. Anything wrong is answered with an error status and a log
+ * message naming the variable, its value and what is allowed, and changes nothing. It keeps the value
+ * store (every variable as a double, indexed by value reference), the FMU states (versioned,
+ * checksummed and validated on restore) and logging. A thin layer per FMI version exports that
+ * version's functions and translates its types (rst_fmi2.c, rst_fmi3.c); one FMU binary is built with
+ * one of them. A backend (the glue file compiled with the front defines RST_MODEL) supplies the model:
+ * it is only ever called with checked arguments, in a legal mode. There is no global mutable state
+ * here; each instance is independent.
  */
 #ifndef RST_FRONT_H
 #define RST_FRONT_H

@@ -23,10 +23,12 @@
 #define front_lock RST_PREFIXED(front_lock)
 #define front_unlock RST_PREFIXED(front_unlock)
 #define front_allowed RST_PREFIXED(front_allowed)
+#define front_mode_name RST_PREFIXED(front_mode_name)
 #define front_backend_status RST_PREFIXED(front_backend_status)
 #define front_in_range RST_PREFIXED(front_in_range)
 #define front_describe_value RST_PREFIXED(front_describe_value)
 #define front_type_name RST_PREFIXED(front_type_name)
+#define front_reset_store RST_PREFIXED(front_reset_store)
 #define front_take_messages RST_PREFIXED(front_take_messages)
 #define front_deliver_messages RST_PREFIXED(front_deliver_messages)
 #define front_free_states RST_PREFIXED(front_free_states)
@@ -182,9 +184,12 @@ rst_instance *front_instance(void *c); /* NULL unless c is one of our live insta
 void front_lock(rst_instance *inst);
 void front_unlock(rst_instance *inst); /* then delivers the messages the call logged */
 int front_allowed(rst_instance *inst, const char *function, unsigned int modes); /* logs why not */
+/* The mode as messages name it; `buffer` holds the text of the modes that name a function. */
+const char *front_mode_name(const rst_instance *inst, rst_mode mode, char *buffer, size_t size);
 rst_status front_backend_status(rst_instance *inst, rst_status status);       /* Error, Fatal: change mode */
 
-/* Values (rst_front.c). */
+/* Values (rst_values.c). */
+void front_reset_store(rst_instance *inst); /* every variable back to its start value */
 /* Reads `n` variables of `kinds` as a get call does (the instance locked, the mode checked), handing each
  * value to `write`: inputs and parameters from the store, what the model computes from the backend. */
 rst_status front_read(rst_instance *inst, const char *function, unsigned int kinds, const rst_vr vr[], size_t n,
@@ -193,8 +198,9 @@ int front_in_range(const rst_variable *var, double value);
 void front_describe_value(rst_type type, double value, char *out, size_t size);
 const char *front_type_name(rst_type type);
 
-/* The version-neutral FMI functions (rst_front.c): each checks its instance, locks it, checks the mode
- * and its arguments, logs under the name `function` and returns the status the host sees. */
+/* The version-neutral FMI functions (rst_front.c; get and set: rst_values.c): each checks its instance,
+ * locks it, checks the mode and its arguments, logs under the name `function` and returns the status the
+ * host sees. */
 /* A new instance (not yet one the host may use): NULL when out of memory (logged). */
 rst_instance *front_new_instance(const rst_api *api, void (*host_logger)(void), void *environment,
                                  rst_allocate_fn allocate, rst_release_fn release, const char *function,

@@ -1,4 +1,4 @@
-/* Python for pythonfmu's binary, in any host: see python_loader.c. */
+/* Python for pythonfmu's binary, in any host: see python_loader.c (and the pyloader_*.c it names). */
 #ifndef PYTHON_LOADER_H
 #define PYTHON_LOADER_H
 

@@ -30,7 +30,7 @@
  *   or in ctypes or the front before the handler was set aside) is still pending, and the slave's first
  *   line would run its handler (this gave fmi2Fatal for 5-10 % of SIGINTs in a set/get loop,
  *   tests/fmu/test_fmu_interrupt.py): with the GIL taken and the handlers set aside, the pending handlers run
- *   first (python_loader.c: pyloader_enter_call), and what they raise is raised again in the host's code
+ *   first (pyloader_signals.c: pyloader_enter_call), and what they raise is raised again in the host's code
  *   once the call returns. Either way the host sees its exception between two FMI calls (fmpy:
  *   KeyboardInterrupt in fmpy's code right after the call) and the instance goes on. A single long call
  *   is not interrupted. Cost: one more system call per call (the SIGTERM disposition), about 0.4 us in
