@@ -7,7 +7,7 @@ from types import SimpleNamespace
 
 import numpy as np
 
-from restitution.agreement import FLAGS, REALS
+from restitution.agreement import FLAGS, REALS  # the result record: the C struct is generated from it, in this order
 from restitution.fmu.models.sphere_plate_impact.variables import TABLE
 
 _INPUT_REALS = ("v", "sphere_E", "sphere_nu", "sphere_Sy", "sphere_rho", "sphere_d",
@@ -17,11 +17,6 @@ MODEL_CODE = TABLE["restitution_model"].codes
 METHOD_CODE = TABLE["zener_method"].codes
 MODE_CODE = TABLE["plasticity"].codes
 OK, BAD_CODE, UNSUPPORTED = 0, 1, 2
-_RESULT_REALS = ("e", "v_rebound", "e_ep", "V_c", "V_star", "eps_y", "e_ze", "lam", "tau0", "T", "t_contact",
-                 "m_a", "m_eff", "mass_ratio", "v_plate")
-_RESULT_FLAGS = ("plasticity_used", "plate_waves_used", "lambda_in_range", "vstar_in_range", "e_negative",
-                 "contact_ends", "valid")
-assert set(_RESULT_REALS) == set(REALS) and set(_RESULT_FLAGS) == set(FLAGS)
 
 
 class Inputs(ctypes.Structure):
@@ -31,7 +26,7 @@ class Inputs(ctypes.Structure):
 
 
 class Result(ctypes.Structure):
-    _fields_ = [(n, ctypes.c_double) for n in _RESULT_REALS] + [(n, ctypes.c_int) for n in _RESULT_FLAGS]
+    _fields_ = [(n, ctypes.c_double) for n in REALS] + [(n, ctypes.c_int) for n in FLAGS]
 
 
 class NativePhysics:
@@ -58,15 +53,15 @@ class NativePhysics:
                                                                    for n in _INPUT_REALS[1:]))
         shape = arrays[0].shape
         flat = [a.ravel() for a in arrays]
-        reals = {n: np.empty(flat[0].size) for n in _RESULT_REALS}
-        flags = {n: np.empty(flat[0].size, dtype=bool) for n in _RESULT_FLAGS}
+        reals = {n: np.empty(flat[0].size) for n in REALS}
+        flags = {n: np.empty(flat[0].size, dtype=bool) for n in FLAGS}
         for i in range(flat[0].size):
             status, out = self.call(flat[0][i], {n: flat[j + 1][i] for j, n in enumerate(_INPUT_REALS[1:])},
                                     **options)
             if status != OK:
                 raise RuntimeError(f"rst_impact returned {status} for case {i}")
-            for n in _RESULT_REALS:
+            for n in REALS:
                 reals[n][i] = getattr(out, n)
-            for n in _RESULT_FLAGS:
+            for n in FLAGS:
                 flags[n][i] = bool(getattr(out, n))
         return SimpleNamespace(**{n: a.reshape(shape) for n, a in {**reals, **flags}.items()})

@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .model import PARAMETERS, impact
+from .model import PARAMETERS, RECORD_FLAGS, RECORD_REALS, impact
 
 __all__ = ["ULPS", "STEP", "ABSOLUTE", "REALS", "FLAGS", "tolerances", "disagreements"]
 
@@ -35,11 +35,8 @@ STEP = 1e-6
 EPS = float(np.finfo(float).eps)
 #: Outputs compared in absolute terms (bounded, may be 0 or change sign); v_rebound = e v in m/s.
 ABSOLUTE = ("e", "e_ep", "v_rebound")
-#: The real outputs of :class:`restitution.ImpactResult`.
-REALS = ("e", "v_rebound", "e_ep", "V_c", "V_star", "eps_y", "e_ze", "lam", "tau0", "T", "t_contact",
-         "m_a", "m_eff", "mass_ratio", "v_plate")
-FLAGS = ("plasticity_used", "plate_waves_used", "lambda_in_range", "vstar_in_range", "e_negative", "contact_ends",
-         "valid")
+#: The real outputs and the flags of :class:`restitution.ImpactResult` (its result record).
+REALS, FLAGS = RECORD_REALS, RECORD_FLAGS
 _INPUTS = ("v",) + tuple(name for name, _unit, _kind in PARAMETERS)
 
 

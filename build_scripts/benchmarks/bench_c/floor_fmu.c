@@ -2,7 +2,7 @@
  * that does nothing. Same hooks as the native glue; outputs are constants. */
 #include "rst_front.h"
 
-#include "rst_SpherePlateImpact_interface.h" /* generated: restitution.fmu.interface.c_header */
+#include "rst_SpherePlateImpact_interface.h" /* generated: restitution.fmu.describe.c_header */
 #include "rst_model_info.h"                  /* generated: identifier and GUID of modelDescription.xml */
 
 static rst_status instantiate(rst_instance *inst, const char *resource_dir, int visible)

@@ -11,6 +11,7 @@ import shutil
 import subprocess
 from pathlib import Path
 
+from ..physics_c.result_header import RESULT_HEADER, result_header
 from ..physics_c.zener_table_header import zener_table_header
 from .sources import FRONT, PHYSICS_C
 
@@ -48,13 +49,15 @@ def fmi_include_dir(fmi_version: str = "2.0") -> Path:
 
 
 def prepare_sources(directory: Path) -> Path:
-    """Copy the physics sources into ``directory`` and generate the table header there; returns it."""
+    """Copy the physics sources into ``directory`` and generate the Zener table and result record headers
+    there; returns it."""
     directory = Path(directory)
     directory.mkdir(parents=True, exist_ok=True)
     for name in PHYSICS_SOURCES:
         shutil.copyfile(PHYSICS_C / name, directory / name)
     shutil.copyfile(FRONT / PREFIX_HEADER, directory / PREFIX_HEADER)
     (directory / TABLE_HEADER).write_text(zener_table_header(), encoding="ascii")
+    (directory / RESULT_HEADER).write_text(result_header(), encoding="ascii")
     return directory
 
 

@@ -1,7 +1,7 @@
 /* One row of an FMU's interface table: what the C front knows about each variable.
  *
  * The tables themselves (rst_<Model>_interface.h) are generated at build time by
- * restitution.fmu.interface.c_header from the model's interface table; no C code parses XML at run time
+ * restitution.fmu.describe.c_header from the model's interface table; no C code parses XML at run time
  * and no table is edited by hand. Bump RST_VARIABLE_LAYOUT (and interface.TABLE_VERSION) together
  * whenever this struct changes: a generated header of another layout then fails to compile. */
 #ifndef RST_VARIABLE_H

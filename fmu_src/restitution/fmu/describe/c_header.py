@@ -127,6 +127,22 @@ def _c_enums(upper: str, rows) -> list[str]:
     return lines + ["};"]
 
 
+def _c_outputs(upper: str, rows) -> list[str]:
+    """The outputs of each type as X-macros, ``RST_<MODEL>_<TYPE>_OUTPUTS(X)`` expanding ``X(value reference,
+    key)`` for each, ``key`` being the field of the model's result the output publishes (the row's ``key``):
+    the glue publishes every output of the table with one line, and a key that is no field of the C
+    record is a compiler error naming it."""
+    lines = ["/* the outputs of each type and the result field each publishes: X(value reference, key) */"]
+    for vtype in ("Real", "Integer", "Boolean"):
+        outputs = [v for v in rows if v.causality == "output" and v.type == vtype]
+        bad = [v.key for v in outputs if not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", v.key)]
+        if bad:
+            raise RuntimeError(f"{upper}: output keys {bad} are not C identifiers")
+        lines.append(f"#define RST_{upper}_{vtype.upper()}_OUTPUTS(X)"
+                     + "".join(f" \\\n    X(RST_{upper}_VR_{c_identifier(v.name)}, {v.key})" for v in outputs))
+    return lines
+
+
 def _c_model_exchange(upper: str, rows) -> list[str]:
     """The model-exchange vectors by value reference: the continuous states and their derivatives (in
     the state vector's order) and the event indicators; ``RST_MODEL_*_VRS`` is NULL where there are none."""
@@ -184,6 +200,7 @@ def c_header(model: str, rows: list[Variable] | None = None) -> str:
     lines += _c_model_exchange(upper, rows)
     if enums:
         lines += _c_enums(upper, rows)
+        lines += _c_outputs(upper, rows)
         for name, values in table(model).constants.items():
             lines += [f"/* {name}, by code */",
                       f"static const double RST_{upper}_{name}[{len(values)}] = {{"

@@ -233,12 +233,15 @@ static double mass_ratio(double e_ze, double deficit) { return deficit / (1.0 + 
 /* v_b2 = (1 + e_ep)(1 - e_ze)/2 v_a1 [m/s], Eq. (17) with m_b of Eq. (19). */
 static double plate_velocity(double v_a1, double e_ep, double deficit) { return 0.5 * (1.0 + e_ep) * deficit * v_a1; }
 
+/* Every real of the record NaN, every flag 0 (the record's fields, rst_impact_result.h). */
 static void fail(rst_impact_result *out)
 {
-    out->e = out->v_rebound = out->e_ep = out->V_c = out->V_star = out->eps_y = NAN;
-    out->e_ze = out->lam = out->tau0 = out->T = out->t_contact = out->m_a = out->m_eff = out->mass_ratio = out->v_plate = NAN;
-    out->plasticity_used = out->plate_waves_used = out->lambda_in_range = 0;
-    out->vstar_in_range = out->e_negative = out->contact_ends = out->valid = 0;
+#define NOT_A_NUMBER(field) out->field = NAN;
+#define CLEARED(field) out->field = 0;
+    RST_IMPACT_RESULT_REALS(NOT_A_NUMBER)
+    RST_IMPACT_RESULT_FLAGS(CLEARED)
+#undef NOT_A_NUMBER
+#undef CLEARED
 }
 
 /* restitution.model._pipeline for one impact. */

@@ -47,11 +47,9 @@ typedef struct {
     double ode_rtol;         /* [1] tolerance of zener_method = 4 (unused here: rejected) */
 } rst_impact_inputs;
 
-/* Everything one impact produces: the fields of restitution.ImpactResult, same names and units. */
-typedef struct {
-    double e, v_rebound, e_ep, V_c, V_star, eps_y, e_ze, lam, tau0, T, t_contact, m_a, m_eff, mass_ratio, v_plate;
-    int plasticity_used, plate_waves_used, lambda_in_range, vstar_in_range, e_negative, contact_ends, valid;
-} rst_impact_result;
+/* Everything one impact produces (rst_impact_result): the fields of restitution.ImpactResult, same names
+ * and units, generated from the package's result record at build time. */
+#include "rst_impact_result.h"
 
 /* Evaluate the model; RST_PHYSICS_OK, or an error code with every real output NaN and every flag 0. */
 int rst_impact(const rst_impact_inputs *in, rst_impact_result *out);

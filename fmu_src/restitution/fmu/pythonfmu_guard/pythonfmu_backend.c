@@ -53,7 +53,7 @@
 
 #include "python_loader.h"
 #include "rst_front.h"
-#include "rst_interface.h"  /* generated: restitution.fmu.interface.c_header */
+#include "rst_interface.h"  /* generated: restitution.fmu.describe.c_header */
 #include "rst_model_info.h" /* generated: identifier and GUID of modelDescription.xml */
 
 /* One pythonfmu instance, kept for the process's lifetime. */

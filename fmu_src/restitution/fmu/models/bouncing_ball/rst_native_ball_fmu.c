@@ -6,7 +6,7 @@
  * update rebounds the ball with the COR on its input (or brings it to rest). */
 #include "rst_front.h"
 
-#include "rst_BouncingBall_interface.h" /* generated: restitution.fmu.interface.c_header */
+#include "rst_BouncingBall_interface.h" /* generated: restitution.fmu.describe.c_header */
 #include "rst_model_info.h"             /* generated: identifier and GUID of modelDescription.xml */
 #include "rst_native_ball.h"
 

@@ -1,6 +1,6 @@
 /* The native SpherePlateImpact backend: the physics of rst_physics.h on a value store that holds
  * every variable of the FMU by value reference, as the generated interface header names them
- * (restitution.fmu.interface.c_header: RST_SPHEREPLATEIMPACT_VR_*, and the codes of the choices).
+ * (restitution.fmu.describe.c_header: RST_SPHEREPLATEIMPACT_VR_*, and the codes of the choices).
  *
  * Front-independent on purpose: the C FMI front (cfront/) owns the state machine, the argument and
  * range checks, logging and the value store; it calls rst_impact_evaluate whenever an input or

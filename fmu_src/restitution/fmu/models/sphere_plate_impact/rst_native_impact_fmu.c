@@ -6,7 +6,7 @@
 
 #include <stdio.h>
 
-#include "rst_SpherePlateImpact_interface.h" /* generated: restitution.fmu.interface.c_header */
+#include "rst_SpherePlateImpact_interface.h" /* generated: restitution.fmu.describe.c_header */
 #include "rst_model_info.h"                  /* generated: identifier and GUID of modelDescription.xml */
 #include "rst_native_impact.h"
 
