@@ -1,0 +1,127 @@
+"""``restitution cor``: one coefficient of restitution, from the command line.
+
+    restitution cor --sphere chrome_steel --d "6.35 mm" --plate al_6061 --t "3 mm" --v "2 m/s" [--json FILE]
+
+prints e and what lies behind it (e_ep, e_ze, v_rebound, V*, lambda, the contact time and the validity
+flags), each with its unit. Lengths and the speed take any unit (a bare number is SI); a value outside
+the model's domain (the ranges the FMUs declare) is refused in one line naming the quantity, with the
+likely slip ("did you mean 3 mm?"); an unknown material names the close ones. ``--json FILE`` writes the
+inputs and every field of the result in SI units.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+
+from .materials import MATERIALS, Material, suggest_material
+from .model import ZENER_METHODS, impact, published
+from .output_files import EXIT_IO_ERROR, EXIT_REFUSED, OutputPathError, atomic_write, check_output
+
+__all__ = ["main", "evaluate"]
+
+#: The options with a unit: option -> (FMU input name whose unit and range apply, impact keyword).
+QUANTITIES = {"d": ("sphere.d", "sphere_d"), "t": ("plate.t", "plate_t"), "v": ("v_approach", "v")}
+#: Units of the result's fields, as printed and in the JSON (SI).
+UNITS = {"e": "1", "e_ep": "1", "e_ze": "1", "v_rebound": "m/s", "V_c": "m/s", "V_star": "1", "eps_y": "1",
+         "lam": "1", "tau0": "1", "T": "s", "t_contact": "s", "m_a": "kg", "m_eff": "kg", "mass_ratio": "1",
+         "v_plate": "m/s"}
+
+
+class CorError(ValueError):
+    """A refused input: the message is one line."""
+
+
+def _material(option: str, key: str) -> Material:
+    if key not in MATERIALS:
+        raise CorError(f"--{option} {key!r}: unknown material{suggest_material(key, MATERIALS)}; "
+                       "`restitution materials` lists them")
+    return MATERIALS[key]
+
+
+def _quantity(option: str, text: str) -> float:
+    from .sweep.values import QuantityError, outside, quantity
+
+    name = QUANTITIES[option][0]
+    try:
+        value = quantity(name, text)
+    except QuantityError as exc:
+        raise CorError(f"--{option}: {exc}") from None
+    refusal = outside(name, value)
+    if refusal is not None:
+        raise CorError(f"--{option}: {refusal}")
+    return value
+
+
+def evaluate(sphere: str, d, plate: str, t, v, zener_method: str = "exact") -> tuple[dict, dict]:
+    """(inputs in SI, the published result as a dict) for the named materials, the diameter ``d``, the
+    thickness ``t`` and the approach speed ``v`` (each a number in SI or a text with its unit).
+    :class:`CorError` (one line) for an unknown material or a value outside the domain."""
+    bodies = {"sphere": _material("sphere", sphere), "plate": _material("plate", plate)}
+    values = {option: _quantity(option, str(text)) for option, text in (("d", d), ("t", t), ("v", v))}
+    params = {**bodies["sphere"].params("sphere"), **bodies["plate"].params("plate"),
+              "sphere_d": values["d"], "plate_t": values["t"]}
+    result = published(impact(values["v"], **params, zener_method=zener_method).as_dict())
+    inputs = {"sphere": sphere, "plate": plate, "v": values["v"], **params, "zener_method": zener_method}
+    return inputs, {key: (bool(value) if isinstance(value, bool) or key not in UNITS else float(value))
+                    for key, value in result.items()}
+
+
+def _line(name: str, value: float, what: str) -> str:
+    unit = UNITS[name]
+    return f"  {name} = {value:.6g}{'' if unit == '1' else ' ' + unit}  {what}"
+
+
+def report(inputs: dict, r: dict) -> str:
+    """What the command prints: e first, then its parts, the rebound and the validity."""
+    yes = {True: "yes", False: "no"}
+    return "\n".join([
+        f"e = {r['e']:.4f}  apparent COR of {inputs['sphere']} (d = {inputs['sphere_d'] * 1e3:.6g} mm) on "
+        f"{inputs['plate']} (t = {inputs['plate_t'] * 1e3:.6g} mm) at {inputs['v']:.6g} m/s (Eq. 20)",
+        _line("e_ep", r["e_ep"], "elastoplastic COR, JGM (Eq. 7/8)"),
+        _line("e_ze", r["e_ze"], "plate-wave COR, Zener (Eqs. 9-13a)"),
+        _line("v_rebound", r["v_rebound"], "rebound speed, e v"),
+        _line("V_star", r["V_star"], f"impact speed over the critical speed V_c = {r['V_c']:.4g} m/s (Eq. 6)"),
+        _line("lam", r["lam"], "Zener's inelasticity parameter lambda (Eq. 12)"),
+        _line("t_contact", r["t_contact"], "contact duration"),
+        f"  valid = {yes[r['valid']]}  (lambda <= 1.5: {yes[r['lambda_in_range']]}, V* <= 1000: "
+        f"{yes[r['vstar_in_range']]}, e < 0: {yes[r['e_negative']]})",
+    ])
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(prog="restitution cor", description=__doc__.split("\n\n")[0],
+                                     epilog="Lengths and speeds take a unit (\"6.35 mm\", \"1/4 in\", \"2 m/s\"); "
+                                            "a bare number is SI.")
+    parser.add_argument("--sphere", required=True, metavar="KEY", help="sphere material (restitution materials)")
+    parser.add_argument("--d", required=True, metavar="LEN", help="sphere diameter, e.g. \"6.35 mm\"")
+    parser.add_argument("--plate", required=True, metavar="KEY", help="plate material")
+    parser.add_argument("--t", required=True, metavar="LEN", help="plate thickness, e.g. \"3 mm\"")
+    parser.add_argument("--v", required=True, metavar="SPEED", help="approach speed, e.g. \"2 m/s\"")
+    parser.add_argument("--zener-method", default="exact", choices=ZENER_METHODS,
+                        help="Zener's COR and contact time (default: exact)")
+    parser.add_argument("--json", metavar="FILE", help="write the inputs and every field of the result (SI)")
+    args = parser.parse_args(argv)
+    try:
+        if args.json:
+            check_output(args.json, "--json")
+        inputs, result = evaluate(args.sphere, args.d, args.plate, args.t, args.v, args.zener_method)
+    except (CorError, OutputPathError) as exc:
+        print(f"restitution cor: error: {exc}", file=sys.stderr)
+        return EXIT_REFUSED
+    print(report(inputs, result))
+    if args.json:
+        finite = {key: (None if isinstance(value, float) and not math.isfinite(value) else value)
+                  for key, value in result.items()}  # m_eff = +inf for a half-space: null, JSON has no inf
+        text = json.dumps({"inputs": inputs, "result": finite, "units": UNITS}, indent=1, allow_nan=False)
+        try:
+            atomic_write(args.json, lambda tmp: tmp.write_text(text + "\n", encoding="utf-8"), "--json")
+        except OSError as exc:
+            print(f"restitution cor: error: {exc}", file=sys.stderr)
+            return EXIT_IO_ERROR
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
