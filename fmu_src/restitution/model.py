@@ -306,8 +306,7 @@ def _pipeline(v, params, scalar, restitution_model, zener_method, plasticity, pl
 _TAU0_AT_LAMBDA0 = {"exact": TAU0_HERTZ, "ode": TAU0_HERTZ, "paper_fit": zener_paper_fit(0.0)[1],
                     "linear": zener_linear(0.0)[1]}
 
-_FLAGS = frozenset({"plasticity_used", "plate_waves_used", "lambda_in_range", "vstar_in_range", "e_negative",
-                    "contact_ends"})
+_FLAGS = frozenset(f.name for f in fields(ImpactResult) if f.type == "Flag")
 _FIELD_NAMES = tuple(f.name for f in fields(ImpactResult))
 
 
