@@ -1,6 +1,7 @@
 """The ``restitution`` command: every tool of the package under one name.
 
     restitution cor ...          one COR from the command line (restitution.cor)
+    restitution fit ...          calibration from drop tests (restitution.fit)
     restitution sweep ...        design-space sweeps (restitution.sweep; the `sweep` extra)
     restitution scene ...        drop scenes through the FMUs (restitution.scene; the `scene` extra)
     restitution materials        the material presets
@@ -19,6 +20,7 @@ __all__ = ["main", "SUBCOMMANDS"]
 #: subcommand -> (module with ``main(argv)``, one line of help)
 SUBCOMMANDS = {
     "cor": ("restitution.cor", "one coefficient of restitution, e and what lies behind it"),
+    "fit": ("restitution.fit.command", "calibrate parameters from a drop test (rebound pairs, impact times, a recording)"),
     "sweep": ("restitution.sweep.__main__", "design-space sweeps on Dask (grids, random samples)"),
     "scene": ("restitution.scene.__main__", "drop scenes: balls bouncing on plates through the FMUs"),
     "materials": ("restitution.materials_table", "the material presets and their sources"),

@@ -15,8 +15,8 @@ import json
 import math
 import sys
 
-from .materials import MATERIALS, Material, suggest_material
 from .model import ZENER_METHODS, impact, published
+from .options import OptionError, input_quantity, material
 from .output_files import EXIT_IO_ERROR, EXIT_REFUSED, OutputPathError, atomic_write, check_output
 
 __all__ = ["main", "evaluate"]
@@ -29,37 +29,13 @@ UNITS = {"e": "1", "e_ep": "1", "e_ze": "1", "v_rebound": "m/s", "V_c": "m/s", "
          "v_plate": "m/s"}
 
 
-class CorError(ValueError):
-    """A refused input: the message is one line."""
-
-
-def _material(option: str, key: str) -> Material:
-    if key not in MATERIALS:
-        raise CorError(f"--{option} {key!r}: unknown material{suggest_material(key, MATERIALS)}; "
-                       "`restitution materials` lists them")
-    return MATERIALS[key]
-
-
-def _quantity(option: str, text: str) -> float:
-    from .sweep.values import QuantityError, outside, quantity
-
-    name = QUANTITIES[option][0]
-    try:
-        value = quantity(name, text)
-    except QuantityError as exc:
-        raise CorError(f"--{option}: {exc}") from None
-    refusal = outside(name, value)
-    if refusal is not None:
-        raise CorError(f"--{option}: {refusal}")
-    return value
-
-
 def evaluate(sphere: str, d, plate: str, t, v, zener_method: str = "exact") -> tuple[dict, dict]:
     """(inputs in SI, the published result as a dict) for the named materials, the diameter ``d``, the
     thickness ``t`` and the approach speed ``v`` (each a number in SI or a text with its unit).
-    :class:`CorError` (one line) for an unknown material or a value outside the domain."""
-    bodies = {"sphere": _material("sphere", sphere), "plate": _material("plate", plate)}
-    values = {option: _quantity(option, str(text)) for option, text in (("d", d), ("t", t), ("v", v))}
+    :class:`~restitution.options.OptionError` (one line) for an unknown material or a value outside the domain."""
+    bodies = {"sphere": material("sphere", sphere), "plate": material("plate", plate)}
+    values = {option: input_quantity(option, QUANTITIES[option][0], str(text))
+              for option, text in (("d", d), ("t", t), ("v", v))}
     params = {**bodies["sphere"].params("sphere"), **bodies["plate"].params("plate"),
               "sphere_d": values["d"], "plate_t": values["t"]}
     result = published(impact(values["v"], **params, zener_method=zener_method).as_dict())
@@ -107,7 +83,7 @@ def main(argv=None) -> int:
         if args.json:
             check_output(args.json, "--json")
         inputs, result = evaluate(args.sphere, args.d, args.plate, args.t, args.v, args.zener_method)
-    except (CorError, OutputPathError) as exc:
+    except (OptionError, OutputPathError) as exc:
         print(f"restitution cor: error: {exc}", file=sys.stderr)
         return EXIT_REFUSED
     print(report(inputs, result))
