@@ -3,4 +3,5 @@ import sys
 
 from .command import main
 
-sys.exit(main())
+if __name__ == "__main__":  # also imported by tools that load every module of the package
+    sys.exit(main())

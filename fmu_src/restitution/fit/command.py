@@ -11,7 +11,6 @@ matplotlib for ``--plot``) one line naming the extra, before any work.
 from __future__ import annotations
 
 import argparse
-import importlib.util
 import sys
 
 from ..options import OptionError, input_quantity, material, positive_quantity
@@ -23,8 +22,12 @@ PROG = "restitution fit"
 
 
 def _needs(module: str, extra: str, option: str) -> None:
-    if importlib.util.find_spec(module) is None:
-        raise OptionError(f"{option} needs {module}: pip install \"restitution[{extra}]\"")
+    from ..extras import MissingExtra, require
+
+    try:
+        require(option, {module: extra})
+    except MissingExtra as exc:
+        raise OptionError(str(exc)) from None
 
 
 def _parser() -> argparse.ArgumentParser:

@@ -14,6 +14,7 @@ import argparse
 import sys
 from pathlib import Path
 
+from ..extras import MissingExtra, require
 from ..fmu.build import BuildError
 from ..output_files import (EXIT_IO_ERROR, EXIT_REFUSED, OutputPathError, check_output, check_output_dir,
                             describe_os_error)
@@ -54,6 +55,7 @@ def _fmu(args) -> Path:
 
 
 def _run(args) -> int:
+    require("restitution scene run", {"fmpy": "scene", **({} if args.no_plot else {"matplotlib": "scene"})})
     from .results import DropWriter
     from .runner import SceneInterrupted, run_scene
 
@@ -97,6 +99,7 @@ def _run(args) -> int:
 
 
 def _report(args) -> int:
+    require("restitution scene report", {"fmpy": "scene"})
     from .report import write_report
 
     methods = [m.strip() for m in args.methods.split(",")] if args.methods else None
@@ -164,7 +167,7 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     try:
         return args.func(args)
-    except (SceneError, BuildError, UsageError, OutputPathError) as exc:
+    except (SceneError, BuildError, UsageError, OutputPathError, MissingExtra) as exc:
         print(f"error: {exc}", file=sys.stderr)
         return EXIT_REFUSED
     except OSError as exc:  # an I/O error (ENOSPC, EIO, EACCES, ...): nothing half written under an output's name

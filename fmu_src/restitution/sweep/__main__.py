@@ -7,6 +7,7 @@ import os
 import sys
 from pathlib import Path
 
+from ..extras import MissingExtra, require
 from ..materials_table import text as materials_text
 from ..output_files import (EXIT_IO_ERROR, EXIT_REFUSED, OutputPathError, OutputWriteError,
                             check_output, describe_os_error)
@@ -246,14 +247,17 @@ def _main(parser, args) -> int:
         except ModuleNotFoundError:
             out = "sweep.csv"
     out = Path(out)
+    plot_wanted = not (args.no_plot or run.get("plot") is False)
+    try:  # before any work: one line naming the extra, not a traceback after the cluster started
+        require("restitution sweep", {"distributed": "sweep", **({"fmpy": "fmu"} if backend != "package" else {}),
+                                      **({"matplotlib": "examples"} if plot_wanted else {}),
+                                      **({"pyarrow": "parquet"} if out.suffix.lower() == ".parquet" else {})})
+    except MissingExtra as exc:
+        hint = "; or --no-plot" if plot_wanted and "matplotlib" in str(exc) else ""
+        return _error(f"{exc}{hint}", EXIT_REFUSED)
     if out.name in ("", ".."):  # ".", "/", "..": no file name to write (nor to derive the map's from)
         return _error(f"--out {out}: is a directory, not a regular file; give the name of a file to write "
                       f"(.csv or .parquet)", EXIT_REFUSED)
-    if out.suffix.lower() == ".parquet":
-        try:
-            import pyarrow  # noqa: F401
-        except ModuleNotFoundError:
-            parser.error(f"--out {out}: writing Parquet needs pyarrow (pip install pyarrow); or write .csv")
     plot = None if (args.no_plot or run.get("plot") is False) else Path(
         args.plot or run.get("plot") or out.with_name(out.stem + "_cor_map.png"))
     parts = out.with_name(out.name + ".parts")
