@@ -90,7 +90,8 @@ def native_source_hash(model: str) -> str:
     every C file and generator the native ``<model>.fmu`` is built from."""
     digest = hashlib.sha256(source_hash(model).encode())
     paths = (sorted(FRONT.glob("*.[ch]")) + sorted(PHYSICS_C.glob("*.[ch]")) + sorted(PHYSICS_C.glob("*.py"))
-             + native_sources(model) + [FMU_DIR / name for name in ("build_native.py", "compile.py", "model_description3.py")])
+             + native_sources(model)
+             + [FMU_DIR / name for name in ("build_native.py", "compile.py", "model_description3.py", "toolchains.py")])
     for path in paths:
         digest.update(path.name.encode() + b"\0" + path.read_bytes() + b"\0")
     return digest.hexdigest()
