@@ -152,7 +152,7 @@ def zig_cache_dir(environ=None) -> Path:
     ``$XDG_CACHE_HOME/zig`` or ``~/.cache/zig``, or, where that cannot be written, a per-user folder in
     the temporary directory."""
     environ = os.environ if environ is None else environ
-    base = environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    base = environ.get("XDG_CACHE_HOME") or os.path.join(environ.get("HOME") or os.path.expanduser("~"), ".cache")
     preferred = Path(base) / "zig"
     if _writable(preferred):
         return preferred
@@ -161,13 +161,14 @@ def zig_cache_dir(environ=None) -> Path:
 
 
 def zig_environment(environ=None) -> dict:
-    """The environment zig runs in: ``environ`` (default this process's) with ZIG_GLOBAL_CACHE_DIR and
-    ZIG_LOCAL_CACHE_DIR set to :func:`zig_cache_dir` where they are not set already."""
+    """The environment zig runs in: ``environ`` (default this process's) with ZIG_GLOBAL_CACHE_DIR, where
+    it is not set, :func:`zig_cache_dir`, and ZIG_LOCAL_CACHE_DIR, where it is not set, the global one (as
+    zig cc does by default)."""
     env = dict(os.environ if environ is None else environ)
-    unset = [name for name in ("ZIG_GLOBAL_CACHE_DIR", "ZIG_LOCAL_CACHE_DIR") if not env.get(name)]
-    if unset:
-        cache = str(zig_cache_dir(env))
-        env.update((name, cache) for name in unset)
+    if not env.get("ZIG_GLOBAL_CACHE_DIR"):
+        env["ZIG_GLOBAL_CACHE_DIR"] = str(zig_cache_dir(env))
+    if not env.get("ZIG_LOCAL_CACHE_DIR"):
+        env["ZIG_LOCAL_CACHE_DIR"] = env["ZIG_GLOBAL_CACHE_DIR"]
     return env
 
 
