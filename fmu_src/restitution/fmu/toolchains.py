@@ -133,9 +133,11 @@ def folders(fmi_version: str) -> dict[str, tuple[Platform, ...]]:
 def zig_command() -> tuple[str, ...] | None:
     """The command that runs zig (``python -m ziglang``, this Python's), or None without the ziglang
     package."""
-    if importlib.util.find_spec(ZIG_PACKAGE) is None:
-        return None
-    return (sys.executable, "-m", ZIG_PACKAGE)
+    try:
+        found = importlib.util.find_spec(ZIG_PACKAGE)
+    except (ImportError, ValueError):  # a broken or blocked installation counts as none
+        found = None
+    return None if found is None else (sys.executable, "-m", ZIG_PACKAGE)
 
 
 def _writable(directory: Path) -> bool:
