@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # System packages some tests need beyond Python, gcc and the lock:
-#   gcc-mingw-w64-x86-64  the native FMUs' binaries/win64 (x86_64-w64-mingw32-gcc)
-#   wine64, wine          running win64 programs (tests/fmu/test_native_win64.py)
+#   gcc-mingw-w64-x86-64  the native FMUs' binaries/win64 (x86_64-w64-mingw32-gcc; else zig from the lock builds them)
+#   wine64, wine          running win64 programs (tests/fmu/test_native_win64.py, tests/fmu/test_cross_binaries.py)
+#   qemu-user             running the aarch64-linux binaries (tests/fmu/test_cross_binaries.py)
+#   libc6-arm64-cross     the aarch64 C library qemu-user loads them with
 #   libtbb12              the ecos engine of the ecospy wheel (tests/hosts/test_native_hosts.py)
 #   cmake                 fmpy's rebuild of a native FMU from its sources/ (tests/fmu/test_native_fmu.py)
 #
@@ -13,12 +15,14 @@
 set -u
 
 declare -A SKIPS=(
-    [gcc-mingw-w64-x86-64]="tests/fmu/test_native_win64.py skips, and the native FMUs are built without binaries/win64"
-    [wine64]="tests/fmu/test_native_win64.py skips (no Wine to run the win64 physics driver and FMU host)"
+    [gcc-mingw-w64-x86-64]="the native FMUs' Windows DLLs are built with zig (pip: ziglang, in the lock); without zig too, tests/fmu/test_native_win64.py skips and no binaries/win64 is built"
+    [wine64]="tests/fmu/test_native_win64.py and the Windows runs of tests/fmu/test_cross_binaries.py skip (no Wine to run the win64 programs)"
+    [qemu-user]="the aarch64-linux runs of tests/fmu/test_cross_binaries.py skip (no qemu-aarch64)"
+    [libc6-arm64-cross]="the aarch64-linux runs of tests/fmu/test_cross_binaries.py skip (no aarch64 C library for qemu)"
     [libtbb12]="the ecos tests of tests/hosts/test_native_hosts.py skip (ecos needs libtbb.so.12)"
     [cmake]="tests/fmu/test_native_fmu.py::test_rebuilt_from_sources_by_fmpy skips (fmpy's rebuild uses cmake)"
 )
-ORDER=(gcc-mingw-w64-x86-64 wine64 libtbb12 cmake)
+ORDER=(gcc-mingw-w64-x86-64 wine64 qemu-user libc6-arm64-cross libtbb12 cmake)
 
 have_lib() {
     local ldconfig
@@ -30,6 +34,8 @@ present() {  # what the tests look for, not the package database
     case "$1" in
         gcc-mingw-w64-x86-64) command -v x86_64-w64-mingw32-gcc >/dev/null ;;
         wine64) command -v wine64 >/dev/null || command -v wine >/dev/null || [ -x /usr/lib/wine/wine64 ] ;;
+        qemu-user) command -v qemu-aarch64 >/dev/null ;;
+        libc6-arm64-cross) [ -e /usr/aarch64-linux-gnu/lib/ld-linux-aarch64.so.1 ] ;;
         libtbb12) have_lib 'libtbb\.so\.12 ' ;;
         cmake) command -v cmake >/dev/null ;;
     esac

@@ -2,9 +2,10 @@
 this machine), what the FMI standard calls a binaries/ folder, what the FMU declares about its
 platforms, and why a platform's binary is missing.
 
-A test that needs the Windows binary calls :func:`skip_unless_built`: it skips with one line naming the
-missing compiler where the build did not produce that binary (mingw-w64 absent), and fails where the
-compiler is on PATH but the binary is not in the archive (the build lost it).
+A test that needs one platform's binary (Windows, macOS, Linux aarch64) calls :func:`skip_unless_built`:
+it skips with one line naming the missing compiler where the build did not produce that binary (neither
+mingw-w64 nor zig for Windows; zig, the ``ziglang`` package, for the others), and fails where the compiler
+is there but the binary is not in the archive (the build lost it).
 
 As a script, ``python tests/fmu_platforms.py DIR`` prints the binary platforms of every FMU a build wrote
 into DIR (``DIR/*.fmu``, ``DIR/fmi2/``, ``DIR/fmi3/``) and exits 1 when :func:`platform_problems`
@@ -13,7 +14,6 @@ finds any (.ci/run runs it on a build made without a cross compiler).
 from __future__ import annotations
 
 import json
-import shutil
 import sys
 import zipfile
 from pathlib import Path, PurePosixPath
@@ -27,8 +27,16 @@ FMI2_PLATFORMS = {"win32": ".dll", "win64": ".dll", "linux32": ".so", "linux64":
 #: optional -<abi> names a static library, which no build here writes).
 FMI3_ARCHITECTURES = ("aarch32", "aarch64", "riscv32", "riscv64", "x86", "x86_64", "ppc32", "ppc64")
 FMI3_SYSTEMS = {"darwin": ".dylib", "linux": ".so", "windows": ".dll"}
-#: How to get the compiler of each platform the native build targets (build_native.COMPILERS).
-INSTALL = {"linux64": "apt-get install gcc", "win64": "apt-get install gcc-mingw-w64-x86-64"}
+#: The binaries/ folders of every native FMU, by FMI version, where the build has every compiler (gcc and
+#: zig): FMI 3.0 x86_64 and aarch64 Linux, x86_64 Windows, x86_64 and aarch64 macOS; FMI 2.0 names only
+#: linux64, win64 and darwin64 of them (darwin64: one universal file for both macOS architectures).
+NATIVE_FOLDERS = {"2.0": ("darwin64", "linux64", "win64"),
+                  "3.0": ("aarch64-darwin", "aarch64-linux", "x86_64-darwin", "x86_64-linux", "x86_64-windows")}
+#: How to get the compiler of each platform the native build targets (restitution.fmu.build.toolchains).
+INSTALL = {"x86_64-linux": "apt-get install gcc",
+           "x86_64-windows": "apt-get install gcc-mingw-w64-x86-64, or pip install ziglang",
+           "aarch64-linux": "pip install ziglang", "x86_64-darwin": "pip install ziglang",
+           "aarch64-darwin": "pip install ziglang"}
 
 
 def library_suffix(fmi_version: str, folder: str) -> str | None:
@@ -125,23 +133,28 @@ def windows_folder(fmu: Path) -> str:
 
 
 def skip_unless_built(fmu: Path, platform: str = "win64") -> str:
-    """The binaries/ folder of ``platform`` (a key of build_native.COMPILERS) in ``fmu``, which the build
-    produced; skips, naming the compiler, where the archive has no binary there because that compiler is
-    not installed; fails where the compiler is on PATH and the binary is still missing."""
-    from restitution.fmu.build.native import COMPILERS, PLATFORM_FOLDERS
+    """The binaries/ folder of ``platform`` (a binaries/ folder of either FMI version: win64 or
+    x86_64-windows, darwin64, aarch64-linux, ...) in ``fmu``, which the build produced; skips, naming the
+    compiler, where the archive has no binary there because that compiler is not installed (see
+    restitution.fmu.build.toolchains); fails where the compiler is there and the binary is still missing."""
+    from restitution.fmu.build import toolchains
 
     version = fmi_version(fmu)
-    folder = PLATFORM_FOLDERS[version][platform]
+    folders = toolchains.folders(version)
+    folder = platform if platform in folders else toolchains.platform(platform).folder(version)
+    if folder is None:
+        raise ValueError(f"FMI {version} has no binaries/ folder for {platform}")
     suffix = library_suffix(version, folder)
     if all(f"{identifier}{suffix}" in binary_folders(fmu).get(folder, ()) for identifier in model_identifiers(fmu)):
         return folder
-    compiler = COMPILERS[platform][0]
-    if shutil.which(compiler) is None:
+    try:
+        compilers = [toolchains.compiler(p).name for p in folders[folder]]
+    except toolchains.ToolchainMissing as exc:
         import pytest
 
-        pytest.skip(f"{platform} binaries not built here: {compiler} not found ({INSTALL[platform]})")
-    raise AssertionError(f"{fmu.name} has no binaries/{folder}/ although {compiler} is on PATH: the build "
-                         "skipped it (see its warnings)")
+        pytest.skip(f"{folder} binaries not built here: {exc}")
+    raise AssertionError(f"{fmu.name} has no binaries/{folder}/ although {', '.join(compilers)} is there: the "
+                         "build skipped it (see its warnings)")
 
 
 def summary(out_dir: Path) -> tuple[list[str], list[str]]:

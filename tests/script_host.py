@@ -1,5 +1,5 @@
 """The scripted plain C host, tests/c_host/fmi_script_host.c, for the FMI 2.0 and the FMI 3.0 FMUs: its
-build (one source, ``-DFMI_VERSION=2|3``, for Linux with gcc or for win64 with mingw-w64) and what a
+build (one source, ``-DFMI_VERSION=2|3``, for Linux with gcc or for win64 with mingw-w64 or zig) and what a
 script needs to know of an FMU (its version, GUID or instantiation token, value references, which
 script command gets and sets each variable: ``real``, ``integer``, ``enumeration`` or ``boolean``, and
 for model exchange the sizes of its state and event-indicator vectors), and the model-exchange lines
@@ -23,12 +23,17 @@ KINDS = {"Real": "real", "Integer": "integer", "Float64": "real", "Int32": "inte
          "Boolean": "boolean"}
 
 
-def build_host(exe: Path, fmi_version: int = 2, cc: str = "gcc", flags=()) -> Path:
-    """Compile the host for ``fmi_version`` (2 or 3) with ``cc`` (gcc, or mingw-w64 for win64) into ``exe``;
-    a failed build raises with the compiler's messages."""
-    cmd = [cc, *WARNINGS, *flags, f"-DFMI_VERSION={fmi_version}", "-o", str(exe), str(HOST_SOURCE)]
-    cmd += ["-D__USE_MINGW_ANSI_STDIO=1", "-static", "-static-libgcc"] if cc == MINGW else ["-ldl"]
-    build = subprocess.run(cmd, capture_output=True, text=True, timeout=300)
+def build_host(exe: Path, fmi_version: int = 2, cc="gcc", flags=()) -> Path:
+    """Compile the host for ``fmi_version`` (2 or 3) with ``cc`` (gcc, or mingw-w64 for win64; or a
+    restitution.fmu.build.toolchains.Compiler, e.g. zig for win64) into ``exe``; a failed build raises with the
+    compiler's messages."""
+    command, env = ([cc], None) if isinstance(cc, str) else (list(cc.command), cc.env)
+    cmd = [*command, *WARNINGS, *flags, f"-DFMI_VERSION={fmi_version}", "-o", str(exe), str(HOST_SOURCE)]
+    if any("mingw32" in part or "windows" in part for part in command):
+        cmd += ["-D__USE_MINGW_ANSI_STDIO=1"] + (["-static", "-static-libgcc"] if cc == MINGW else [])
+    else:
+        cmd += ["-ldl"]
+    build = subprocess.run(cmd, capture_output=True, text=True, timeout=300, env=env)
     if build.returncode != 0:
         raise RuntimeError(f"{' '.join(cmd)}\n{build.stderr}")
     return exe

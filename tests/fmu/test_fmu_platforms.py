@@ -7,10 +7,15 @@ compiler on the machine.
   an FMI 3.0 ``sources/buildDescription.xml`` names only platform tuples and sources it ships; fmpy's
   ``supported_platforms`` (what a host reads) agrees with the folders (tests/fmu_platforms.py).
 * The checker finds each of those faults in an FMU doctored to have it.
-* A native build with mingw-w64 missing (whatever this machine has) writes no Windows folder, declares
-  none, and says which compiler was missing.
+* The native FMUs have binaries for every platform (FMI 3.0: x86_64 and aarch64 Linux, x86_64 Windows,
+  x86_64 and aarch64 macOS; FMI 2.0: linux64, win64, darwin64) where the build has gcc and zig; a platform
+  whose compiler is missing skips, naming it.
+* A native build with mingw-w64 missing (whatever this machine has) builds the Windows binaries with zig;
+  with zig missing too it writes no Windows, macOS or Linux aarch64 folder, declares none, and says which
+  compiler was missing and how to install it.
 * Where the build produced the Windows binaries they are PE32+ x86-64 DLLs; where it did not, that test
-  skips naming the compiler.
+  skips naming the compiler. (Every binary's format, architecture and exports:
+  tests/fmu/test_cross_binaries.py.)
 
 ``.ci/run`` runs this file (and the other platform tests) a second time with every cross compiler hidden
 from PATH.
@@ -26,12 +31,14 @@ from pathlib import Path
 import pytest
 
 from conftest import VERSIONS, _implementation
-from fmu_platforms import (binary_folders, declared_platforms, fmi_version, model_identifiers, platform_problems,
-                           skip_unless_built)
+from fmu_platforms import (INSTALL, NATIVE_FOLDERS, binary_folders, declared_platforms, fmi_version, model_identifiers,
+                           platform_problems, skip_unless_built)
 
 MODELS = ("SpherePlateImpact", "BouncingBall")
-#: fmpy.supported_platforms' name of each binaries/ folder the builds here can write.
-FMPY_NAMES = {"linux64": "linux64", "x86_64-linux": "linux64", "win64": "win64", "x86_64-windows": "win64"}
+#: fmpy.supported_platforms' name of each binaries/ folder the builds here can write (fmpy 0.3.32 lists no
+#: aarch64 Linux platform).
+FMPY_NAMES = {"linux64": "linux64", "x86_64-linux": "linux64", "win64": "win64", "x86_64-windows": "win64",
+              "darwin64": "darwin64", "x86_64-darwin": "darwin64", "aarch64-darwin": "darwin64", "aarch64-linux": None}
 
 
 @pytest.mark.parametrize("model", MODELS)
@@ -48,8 +55,22 @@ def test_every_declared_platform_has_its_binary_and_every_binary_platform_is_dec
     with zipfile.ZipFile(fmu) as z:
         has_sources = any(n.startswith("sources/") and n.endswith(".c") for n in z.namelist())
     assert has_sources == (which != "python")
-    assert sorted(supported_platforms(str(fmu))) == sorted({FMPY_NAMES[f] for f in folders}
+    assert sorted(supported_platforms(str(fmu))) == sorted({FMPY_NAMES[f] for f in folders if FMPY_NAMES[f]}
                                                            | ({"c-code"} if has_sources else set()))
+
+
+@pytest.mark.parametrize("model", MODELS)
+@pytest.mark.parametrize("which", ["fmi2", "fmi3"])
+def test_native_fmus_have_every_platform(built_fmus, which, model):
+    """Every platform of the issue, FMI 3.0: x86_64-linux, aarch64-linux, x86_64-windows, x86_64-darwin,
+    aarch64-darwin; FMI 2.0: linux64, win64, darwin64 (skipped, naming the compiler and how to install it,
+    where one is missing here), and nothing else."""
+    fmu = _implementation(built_fmus, model, which)
+    version = fmi_version(fmu)
+    for folder in NATIVE_FOLDERS[version]:
+        skip_unless_built(fmu, folder)
+    assert sorted(binary_folders(fmu)) == sorted(NATIVE_FOLDERS[version])
+    assert sorted(declared_platforms(fmu)) == sorted(NATIVE_FOLDERS[version])
 
 
 def _doctored(fmu: Path, out: Path, drop=(), add=None, build_info=None, build_description=None) -> Path:
@@ -95,26 +116,46 @@ def test_platform_checker_finds_each_fault(fmi3_ball_fmu, tmp_path):
         assert expected in platform_problems(doctored), (expected, platform_problems(doctored))
 
 
+@pytest.mark.parametrize("zig", ["zig", "no zig"])
 @pytest.mark.parametrize("fmi_version_", ["2.0", "3.0"])
-def test_native_platforms_without_mingw_are_the_built_ones(ball_fmu, fmi_version_, tmp_path, monkeypatch):
+def test_native_platforms_without_mingw_are_the_built_ones(ball_fmu, fmi_version_, zig, tmp_path, monkeypatch):
     """build_native_one with x86_64-w64-mingw32-gcc missing (hidden from the build, whatever this machine
-    has): the FMU has the Linux binary only, build_info.json declares that one only, and the build says
-    which compiler was missing."""
-    from restitution.fmu.build import native as build_native
+    has): with zig, the FMU has every platform, the Windows one built by zig; without zig too (hidden), it
+    has the Linux x86-64 binary only. build_info.json declares what was built, and the build says which
+    compiler was missing for each platform it skipped and how to install it."""
+    from restitution.fmu.build import native as build_native, toolchains
 
     if shutil.which("gcc") is None:
         pytest.skip("gcc not found: no native FMU is built here")
-    mingw = build_native.COMPILERS["win64"][0]
+    if zig == "zig" and toolchains.zig_command() is None:
+        pytest.skip(f"zig not found ({toolchains.ZIG_INSTALL})")
+    if zig == "no zig":
+        monkeypatch.setattr(toolchains, "zig_command", lambda: None)
     real_which = shutil.which
-    monkeypatch.setattr(build_native.shutil, "which", lambda cmd, *a, **k: None if cmd == mingw else real_which(cmd, *a, **k))
+    monkeypatch.setattr(toolchains.shutil, "which",
+                        lambda cmd, *a, **k: None if cmd == toolchains.MINGW else real_which(cmd, *a, **k))
     messages = []
     fmu = build_native.build_native_one("BouncingBall", tmp_path, log=messages.append, fmi_version=fmi_version_)
-    linux = build_native.PLATFORM_FOLDERS[fmi_version_]["linux64"]
-    windows = build_native.PLATFORM_FOLDERS[fmi_version_]["win64"]
-    assert sorted(binary_folders(fmu)) == [linux]
-    assert declared_platforms(fmu) == [linux]
+    linux = toolchains.platform("x86_64-linux").folder(fmi_version_)
+    windows = toolchains.platform("x86_64-windows").folder(fmi_version_)
+    expected = list(NATIVE_FOLDERS[fmi_version_]) if zig == "zig" else [linux]
+    assert sorted(binary_folders(fmu)) == expected
+    assert declared_platforms(fmu) == expected
     assert platform_problems(fmu) == []
-    assert any(mingw in m and f"binaries/{windows}" in m for m in messages), messages
+    with zipfile.ZipFile(fmu) as z:
+        compilers = json.loads(z.read("resources/build_info.json"))["compilers"]
+    assert compilers[linux] == "gcc"
+    if zig == "zig":
+        assert compilers[windows] == "zig cc" and messages == [], messages
+    else:
+        assert len(messages) == len(NATIVE_FOLDERS[fmi_version_]) - 1, messages
+        assert any(toolchains.MINGW in m and toolchains.ZIG_INSTALL in m and f"binaries/{windows}:" in m
+                   for m in messages), messages
+        for folder in set(NATIVE_FOLDERS[fmi_version_]) - {linux}:
+            message = next(m for m in messages if f"binaries/{folder}:" in m)
+            assert message.startswith(f"warning: native FMI {fmi_version_} BouncingBall.fmu: no binaries/{folder}: ")
+            platforms = toolchains.folders(fmi_version_)[folder]
+            assert all(INSTALL[p.name].split(", or ")[-1] in message for p in platforms), message
 
 
 def _pe_machine(dll: bytes) -> int:

@@ -3,12 +3,13 @@ bits: every comparison uses the per-case tolerances of restitution.agreement, fr
 conditioning, never bit identity).
 
 * The physics: the same stdin/stdout driver as the sanitizer test of tests/fmu/test_native_physics.py,
-  built with x86_64-w64-mingw32-gcc (static runtime), against restitution.impact.
+  built with x86_64-w64-mingw32-gcc (static runtime) or, where mingw-w64 is missing, with zig (the
+  compiler the build then uses for the FMUs' Windows DLLs), against restitution.impact.
 * The FMU, FMI 2.0 and FMI 3.0: binaries/win64/SpherePlateImpact.dll of the native SpherePlateImpact.fmu
   and binaries/x86_64-windows/SpherePlateImpact.dll of fmi3/SpherePlateImpact.fmu (as built by
   ``python -m restitution.fmu build``), loaded with LoadLibrary by the plain C host of the other host
-  tests (tests/c_host/fmi_script_host.c, built for the FMU's version) cross-compiled with mingw-w64,
-  and the same host built with gcc on the FMU's Linux binary: the same script of FMI calls on both,
+  tests (tests/c_host/fmi_script_host.c, built for the FMU's version) cross-compiled with mingw-w64 (or
+  zig), and the same host built with gcc on the FMU's Linux binary: the same script of FMI calls on both,
   every output compared; one refused value (NaN) is an error status with a log message, not a crash;
   no Python in either process. Co-simulation and model exchange (the same outputs after set_time, the
   parameters set in event mode).
@@ -16,7 +17,8 @@ conditioning, never bit identity).
   contacts as bisected state events) under Wine and on Linux, each against the closed-form free-fall
   contact times, and the two against each other within the event location's conditioning.
 
-Needs Debian's gcc-mingw-w64-x86-64 and wine64 (+ wine for the ``wine`` command; bash
+Needs a Windows C compiler, Debian's gcc-mingw-w64-x86-64 or zig (pip install ziglang; the DLLs are then
+zig's too: the tests run whichever the build wrote), and wine64 (+ wine for the ``wine`` command; bash
 build_scripts/system_packages.sh installs them); skips saying which is missing. Marked slow: the first
 Wine start creates a prefix (~5-30 s), shared by the tests of this file. Every Wine run is a child
 process with a timeout and its exit code is asserted.
@@ -36,12 +38,24 @@ import pytest
 
 import restitution as r
 from restitution.agreement import disagreements, tolerances
+from restitution.fmu.build import toolchains
 from restitution.fmu.build.compile import CFLAGS, prepare_sources
 
 from cases import FMU_FLAGS, FMU_REALS, NAMES, params_for, random_cases
 from script_host import ball_me_script, ball_run, build_host, check_ball_run, interface
 
 MINGW = "x86_64-w64-mingw32-gcc"
+
+
+def _windows_compiler():
+    """(the compiler of Windows programs here: mingw-w64 where on PATH, else zig; or None, why not)."""
+    try:
+        return toolchains.compiler("x86_64-windows"), None
+    except toolchains.ToolchainMissing as exc:
+        return None, str(exc)
+
+
+WINDOWS_CC, NO_WINDOWS_CC = _windows_compiler()
 WINE = shutil.which("wine64") or shutil.which("wine") or (
     "/usr/lib/wine/wine64" if os.access("/usr/lib/wine/wine64", os.X_OK) else None)
 PHYSICS_DRIVER = Path(__file__).resolve().parents[1] / "c_host" / "physics_driver.c"
@@ -52,7 +66,7 @@ FLAGS = ("plasticity_used", "plate_waves_used", "lambda_in_range", "vstar_in_ran
 
 pytestmark = [
     pytest.mark.slow,
-    pytest.mark.skipif(shutil.which(MINGW) is None, reason=f"{MINGW} missing (Debian: gcc-mingw-w64-x86-64)"),
+    pytest.mark.skipif(WINDOWS_CC is None, reason=f"no Windows C compiler: {NO_WINDOWS_CC}"),
     pytest.mark.skipif(WINE is None, reason="wine64 missing (Debian: wine64)"),
 ]
 
@@ -82,15 +96,17 @@ def _unpacked_with_dll(built_fmus, folder, model, tmp_path):
     with zipfile.ZipFile(fmu_path) as z:
         z.extractall(unpacked)
     if not (unpacked / "binaries" / windows_dir / f"{model}.dll").is_file():
-        pytest.skip(f"the {folder} FMU has no {windows_dir} binary ({MINGW} missing when it was built)")
+        pytest.skip(f"the {folder} FMU has no {windows_dir} binary (no Windows compiler when it was built)")
     return fmu, unpacked
 
 def test_win64_physics_under_wine_equals_the_package(tmp_path, wine_env):
     src = prepare_sources(tmp_path / "src")
     shutil.copyfile(PHYSICS_DRIVER, src / "driver.c")
     exe = tmp_path / "driver.exe"
-    subprocess.run([MINGW, *CFLAGS, "-D__USE_MINGW_ANSI_STDIO=1", "-static", "-static-libgcc", "-o", str(exe),
-                    str(src / "driver.c"), str(src / "rst_physics.c")], check=True, capture_output=True, text=True)
+    static = ["-static", "-static-libgcc"] if WINDOWS_CC.name == MINGW else []
+    subprocess.run([*WINDOWS_CC.command, *CFLAGS, "-D__USE_MINGW_ANSI_STDIO=1", *static, "-o", str(exe),
+                    str(src / "driver.c"), str(src / "rst_physics.c")], check=True, capture_output=True, text=True,
+                   env=WINDOWS_CC.env)
     rng = np.random.default_rng(64)
     v, params = random_cases(rng, 60)
     cases, lines = [], []
@@ -128,11 +144,12 @@ STEP = 1e-3  # [s] communication step of the script (the impact FMU does not dep
 @pytest.fixture(scope="module")
 def script_hosts(tmp_path_factory):
     """tests/c_host/fmi_script_host.c built for each FMI version, for Linux with gcc and for win64 with
-    mingw-w64: {version: (linux, win)}."""
+    mingw-w64 or zig: {version: (linux, win)}."""
     if shutil.which("gcc") is None:
         pytest.skip("gcc missing: the Linux build of the host is the reference")
     out = tmp_path_factory.mktemp("script_host")
-    return {v: (build_host(out / f"fmi{v}_script_host", v), build_host(out / f"fmi{v}_script_host.exe", v, MINGW))
+    return {v: (build_host(out / f"fmi{v}_script_host", v),
+                build_host(out / f"fmi{v}_script_host.exe", v, MINGW if WINDOWS_CC.name == MINGW else WINDOWS_CC))
             for v in (2, 3)}
 
 
@@ -220,7 +237,7 @@ def _groups(values, n_groups):
 def test_win64_fmu_dll_under_wine_equals_the_linux_fmu(built_fmus, folder, interface_type, script_hosts, wine_env,
                                                        tmp_path):
     """The Windows DLL of the native FMU (FMI 2.0: binaries/win64/, FMI 3.0: binaries/x86_64-windows/) in a
-    mingw-built C host under Wine and its Linux binary in the same host built with gcc, driven by the same
+    mingw- (or zig-) built C host under Wine and its Linux binary in the same host built with gcc, driven by the same
     script, as co-simulation (``cs``) and as model exchange (``me``: parameters set in event mode, the
     outputs read in continuous-time mode after set_time): every call OK but the refused NaN (an error status, logged, nothing crashes, the previous value
     kept); all 17 outputs of 504 evaluations agree within restitution.agreement's tolerances; Green
@@ -285,7 +302,7 @@ def test_win64_ball_model_exchange_under_wine_equals_the_linux_fmu(built_fmus, f
                                                                    wine_env, tmp_path):
     """BouncingBall's Windows DLL as model exchange, integrated by the host's own solver (fmi_script_host.c:
     integrate, Heun steps of ``dt``, each contact a state event bisected to ``tol``, or located to the step
-    without bisection) in the mingw-built host under Wine, and its Linux binary in the gcc-built host.
+    without bisection) in the mingw- (or zig-) built host under Wine, and its Linux binary in the gcc-built host.
     Each run on its own: every call OK, the 8 contacts at the closed-form free-fall times
     (script_host.check_ball_run: no earlier than the exact crossing, no later than the resolution carried
     through the flights), the ball at rest with the indicator held. Then the two against each other.

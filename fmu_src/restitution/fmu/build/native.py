@@ -11,15 +11,16 @@ sources declared, so a host on another platform can compile ``sources/`` (FMI 3.
 ``sources/buildDescription.xml``); its identity is the table's instantiation token, which the
 pythonfmu FMU of the same interface carries too.
 
-Binaries: ``binaries/linux64`` with gcc, ``binaries/win64`` with mingw-w64's ``x86_64-w64-mingw32-gcc``
-(runtime linked statically: the DLL needs only Windows' own DLLs). A missing compiler skips that
-binary with a message; with neither, no native FMU is written (and the build says why).
+Binaries: every platform of :mod:`restitution.fmu.build.toolchains` (FMI 2.0: linux64, win64, darwin64;
+FMI 3.0: x86_64-linux, aarch64-linux, x86_64-windows, x86_64-darwin, aarch64-darwin), Linux x86-64 with
+gcc, Windows with mingw-w64 where installed, the others with zig (the ``ziglang`` package from PyPI). A
+missing compiler skips that binary with a message; with none, no native FMU is written (and the build
+says why). ``resources/build_info.json`` lists the platforms built and the compiler of each.
 """
 from __future__ import annotations
 
 import json
 import shutil
-import subprocess
 import sys
 import tempfile
 from pathlib import Path
@@ -29,7 +30,8 @@ from ..describe import fmi2, fmi3
 from ..describe.c_header import c_header, model_info_header
 from ..models import FOLDERS, native_sources, table
 from . import sources
-from .compile import CFLAGS, PHYSICS_SOURCES, NativeBuildSkipped, fmi_include_dir, prepare_sources
+from . import toolchains
+from .compile import PHYSICS_SOURCES, NativeBuildSkipped, fmi_include_dir, prepare_sources
 from .files import place, zip_dir
 from .licenses import documentation_files
 from .sources import BUILD_INFO, FRONT, PHYSICS_C, native_source_hash
@@ -40,14 +42,6 @@ BACKENDS = tuple(FOLDERS)
 PHYSICS_MODELS = {"SpherePlateImpact"}
 INTERFACE_HEADER = "rst_{model}_interface.h"
 MODEL_INFO_HEADER = "rst_model_info.h"
-COMPILERS = {  # platform folder -> (compiler, extra flags, binary suffix)
-    # the front locks each instance (pthreads here, whatever the build command; -pthread for glibc < 2.34)
-    "linux64": ("gcc", ("-fPIC", "-fvisibility=hidden", "-pthread"), ".so"),
-    "win64": ("x86_64-w64-mingw32-gcc", ("-static", "-static-libgcc"), ".dll"),
-}
-#: The binaries/ folder of each platform, by FMI version (FMI 3.0 names platforms by architecture-OS).
-PLATFORM_FOLDERS = {"2.0": {"linux64": "linux64", "win64": "win64"},
-                    "3.0": {"linux64": "x86_64-linux", "win64": "x86_64-windows"}}
 #: Where the FMUs of each FMI version go, below the build's output directory.
 VERSION_DIRS = {"2.0": "fmi2", "3.0": "fmi3"}
 
@@ -90,23 +84,18 @@ def write_backend(model: str, directory: Path) -> None:
     (directory / INTERFACE_HEADER.format(model=model)).write_text(c_header(model), encoding="utf-8")
 
 
-def compile_binary(model: str, sources: Path, c_files: list[str], platform: str, out: Path,
-                   extra_flags=(), fmi_version: str = "2.0") -> Path:
-    """Compile ``out/binaries/<platform folder>/<model>.<so|dll>``; NativeBuildSkipped when the compiler
-    is missing."""
-    cc, flags, suffix = COMPILERS[platform]
-    folder = PLATFORM_FOLDERS[fmi_version][platform]
-    if shutil.which(cc) is None:
-        raise NativeBuildSkipped(f"{cc} not found: no binaries/{folder}"
-                                 + (" (Debian: apt-get install gcc-mingw-w64-x86-64)" if platform == "win64" else ""))
-    target = out / "binaries" / folder / f"{model}{suffix}"
-    target.parent.mkdir(parents=True, exist_ok=True)
-    cmd = [cc, *CFLAGS, *flags, *extra_flags, "-shared", f"-I{sources}", f"-I{fmi_include_dir(fmi_version)}",
-           "-o", str(target), *(str(sources / f) for f in c_files), "-lm"]
-    done = subprocess.run(cmd, capture_output=True, text=True)
-    if done.returncode != 0:
-        raise RuntimeError(f"{cc} failed for {model} ({platform}):\n{done.stderr}")
-    return target
+def compile_binary(model: str, sources: Path, c_files: list[str], folder: str, out: Path,
+                   extra_flags=(), fmi_version: str = "2.0") -> tuple[Path, str]:
+    """Compile ``out/binaries/<folder>/<model>.<so|dll|dylib>`` (``folder``: a binaries/ folder of
+    ``fmi_version``, see toolchains.folders) with the compiler toolchains picks; returns (the binary, the
+    compiler, e.g. "gcc" or "zig cc"); NativeBuildSkipped when there is none here."""
+    try:
+        binary, compilers = toolchains.build_binary(model, folder, fmi_version, sources, c_files, out / "binaries",
+                                                    system_include_dirs=[fmi_include_dir(fmi_version)],
+                                                    extra_flags=extra_flags)
+    except toolchains.ToolchainMissing as exc:
+        raise NativeBuildSkipped(str(exc)) from None
+    return binary, ", ".join(dict.fromkeys(compilers))
 
 
 def build_native_one(model: str, out_dir: Path, log=None, fmi_version: str = "2.0") -> Path:
@@ -132,16 +121,17 @@ def build_native_one(model: str, out_dir: Path, log=None, fmi_version: str = "2.
         (stage / "modelDescription.xml").write_text(description, encoding="utf-8")
         token = table(model).instantiation_token(VERSION)
         (sources / MODEL_INFO_HEADER).write_text(model_info_header(model, token), encoding="ascii")
-        built = []
-        for platform in COMPILERS:
+        built = {}
+        for folder in toolchains.folders(fmi_version):
             try:
-                built.append(compile_binary(model, sources, c_files, platform, stage, fmi_version=fmi_version))
+                binary, compilers = compile_binary(model, sources, c_files, folder, stage, fmi_version=fmi_version)
+                built[binary.parent.name] = compilers
             except NativeBuildSkipped as exc:
                 log(f"warning: native FMI {fmi_version} {model}.fmu: {exc}")
         if not built:
             raise NativeBuildSkipped(f"no C compiler for any platform: native FMI {fmi_version} {model}.fmu not built")
         info = {"model": model, "native": True, "fmi_version": fmi_version, "source_hash": native_source_hash(model),
-                "platforms": sorted(p.parent.name for p in built)}
+                "platforms": sorted(built), "compilers": dict(sorted(built.items()))}
         (stage / BUILD_INFO).parent.mkdir(parents=True, exist_ok=True)
         (stage / BUILD_INFO).write_text(json.dumps(info, indent=1), encoding="utf-8")
         for name, data in documentation_files(model, fmi_version, native=True).items():

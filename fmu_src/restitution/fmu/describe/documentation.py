@@ -61,13 +61,14 @@ IMPLEMENTATIONS = {
     ("2.0", True): (
         "The native FMI 2.0 FMU: co-simulation and model exchange from one binary, the project's C front and the "
         "model in C99 (the C library and libm only, no Python at run time). `binaries/` holds the platforms the "
-        "build had a compiler for (linux64 with gcc, win64 with mingw-w64); other platforms compile `sources/`.",
+        "build had a compiler for (linux64 with gcc; win64 with mingw-w64 or zig; darwin64, one file for Intel and "
+        "Apple silicon Macs, with zig); other platforms compile `sources/`.",
     ),
     ("3.0", True): (
         "The native FMI 3.0 FMU: co-simulation and model exchange from one binary, the project's C front and the "
         "model in C99 (the C library and libm only, no Python at run time). `binaries/` holds the platforms the "
-        "build had a compiler for (x86_64-linux with gcc, x86_64-windows with mingw-w64); other platforms compile "
-        "`sources/` (`sources/buildDescription.xml`).",
+        "build had a compiler for (x86_64-linux with gcc; x86_64-windows with mingw-w64 or zig; aarch64-linux, "
+        "x86_64-darwin and aarch64-darwin with zig); other platforms compile `sources/` (`sources/buildDescription.xml`).",
         "FMI 3.0 types: Reals are Float64; the choices are Enumerations with named items, got and set with "
         "fmi3GetInt64 and fmi3SetInt64; `time` is the independent variable, read-only.",
     ),
