@@ -3,7 +3,6 @@ and :func:`plot` (``--plot``: the data, the fitted e(v) or bounce train with its
 outside the model's validated range marked)."""
 from __future__ import annotations
 
-import itertools
 import json
 import math
 
@@ -83,9 +82,12 @@ def write_json(path, calibration) -> None:
     atomic_write(path, lambda tmp: tmp.write_text(text, encoding="utf-8"), "--json")
 
 
-def band_params(calibration) -> list[dict]:
-    """The parameter sets whose model curves bound the 95 % band: every corner of the identifiable
-    parameters' intervals (2^k sets), or posterior draws (at most 200) where a posterior was sampled."""
+def band_params(calibration, draws: int = 400) -> list[dict]:
+    """Parameter sets whose model curves span the 95 % band: posterior draws (at most 200) where a
+    posterior was sampled; else, for one parameter, the ends of its profile interval; for several, ``draws``
+    sets from the normal approximation at the optimum (the fitted coordinates, ln theta or nu, with their
+    standard errors and correlation), so that correlated parameters move together (the corners of their
+    separate intervals would draw a band far wider than the data allow). Seeded: the same picture each run."""
     fitted = calibration.fitted_params
     post = calibration.posterior
     if post is not None and post.names:
@@ -93,9 +95,34 @@ def band_params(calibration) -> list[dict]:
         pick = np.linspace(0, n - 1, min(n, 200)).astype(int)
         return [{**fitted, **{KEYS[name]: float(post.samples[name][i]) for name in post.names if name in KEYS}}
                 for i in pick]
-    ends = [(KEYS[p.name], p.ci95) for p in calibration.result.parameters.values() if p.ci95 is not None]
-    return [{**fitted, **dict(zip([key for key, _ in ends], corner))}
-            for corner in itertools.product(*[ci for _, ci in ends])] or [fitted]
+    result = calibration.result
+    known = [p for p in result.parameters.values() if p.ci95 is not None]
+    if len(known) <= 1:
+        return [{**fitted, KEYS[p.name]: end} for p in known for end in p.ci95] or [fitted]
+    names = [name for name in result.correlation_names if name in {p.name for p in known}]
+    index = [list(result.correlation_names).index(name) for name in names]
+    se = np.array([result.parameters[name].se for name in names])
+    corr = np.asarray(result.correlation_matrix)[np.ix_(index, index)]
+    if not (np.all(np.isfinite(se)) and np.all(np.isfinite(corr))):
+        return [{**fitted, KEYS[p.name]: end} for p in known for end in p.ci95]
+    z = np.random.default_rng(0).multivariate_normal(np.zeros(len(names)), corr * np.outer(se, se), size=draws,
+                                                     check_valid="ignore")
+    sets = []
+    for row in z:
+        values = {}
+        for name, dz in zip(names, row):
+            estimate = result.parameters[name].estimate
+            values[KEYS[name]] = estimate + dz if name.endswith(".nu") else estimate * math.exp(dz)
+        sets.append({**fitted, **values})
+    return sets
+
+
+def _band(curves) -> tuple[np.ndarray, np.ndarray]:
+    """The 2.5 and 97.5 percentiles of the curves at each point (the min and max of two profile ends)."""
+    curves = np.asarray(curves)
+    if len(curves) <= 2:
+        return curves.min(axis=0), curves.max(axis=0)
+    return np.percentile(curves, 2.5, axis=0), np.percentile(curves, 97.5, axis=0)
 
 
 def _pairs_axes(ax, calibration):
@@ -104,7 +131,7 @@ def _pairs_axes(ax, calibration):
     curves = np.array([restitution_at(v, params, calibration.result.options or None).e
                        for params in band_params(calibration)])
     e_fit = restitution_at(v, calibration.fitted_params, calibration.result.options or None).e
-    ax.fill_between(v, curves.min(axis=0), curves.max(axis=0), color="tab:blue", alpha=0.25, label="95 % band")
+    ax.fill_between(v, *_band(curves), color="tab:blue", alpha=0.25, label="95 % band")
     ax.plot(v, e_fit, color="tab:blue", label="fitted e(v)")
     out = np.asarray(result.flags["any"], dtype=bool)
     e_data = data.v_out / data.v_in
@@ -125,8 +152,8 @@ def _times_axes(ax, calibration):
               for params in band_params(calibration)]
     fit = bounce_train(v1, n, calibration.fitted_params, g=calibration.g, options=result.options or None).intervals
     k = np.arange(1, n)
-    ax.fill_between(k, np.min(trains, axis=0) * 1e3, np.max(trains, axis=0) * 1e3, color="tab:blue", alpha=0.25,
-                    label="95 % band")
+    low, high = _band(trains)
+    ax.fill_between(k, low * 1e3, high * 1e3, color="tab:blue", alpha=0.25, label="95 % band")
     ax.plot(k, fit * 1e3, color="tab:blue", label="fitted bounce train")
     measured = np.diff(times.t) * 1e3
     out = np.asarray(result.flags["any"], dtype=bool)[1:] if len(result.flags["any"]) == n else np.zeros(n - 1, bool)
