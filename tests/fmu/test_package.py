@@ -113,7 +113,7 @@ def test_no_fmu_and_none_buildable_is_one_line_naming_fmu_path(tmp_path):
     (blocker / "pythonfmu.py").write_text("raise ImportError('pythonfmu hidden by the test')\n")
     scene = ROOT / "examples" / "scenes" / "steel_ball_thin_aluminium.toml"
     env = dict(os.environ, PYTHONPATH=str(blocker), XDG_CACHE_HOME=str(tmp_path / "cache"))
-    code = ("import sys, restitution.fmu.build as b; b._checkout_dist = lambda: None; "
+    code = ("import sys, restitution.fmu.build.products as b; b._checkout_dist = lambda: None; "
             "from restitution.scene.__main__ import main; sys.exit(main(sys.argv[1:]))")
     proc = subprocess.run([sys.executable, "-c", code, "run", str(scene), "--out", str(tmp_path / "o")],
                           capture_output=True, text=True, env=env)

@@ -263,19 +263,38 @@ def test_readme_python_blocks_run_as_printed(built_fmus, implementation, capsys)
             continue
         scope = {}
         capsys.readouterr()
+        fmi3 = built_fmus / "fmi3" / "SpherePlateImpact.fmu"
+        if '"dist/fmi3/SpherePlateImpact.fmu"' in code and not fmi3.is_file():
+            continue  # the FMI 3.0 example needs the native FMI 3.0 FMU (gcc)
+        code = code.replace('"dist/fmi3/SpherePlateImpact.fmu"', repr(str(fmi3)))
         exec(compile(code.replace('"dist/SpherePlateImpact.fmu"', repr(str(fmu))), f"README.md block {k}", "exec"),
              scope)
         printed = capsys.readouterr().out
         if k + 1 < len(blocks) and blocks[k + 1][0] == "text":
             assert printed == blocks[k + 1][1], f"README block {k} prints:\n{printed}"
-        if "plate_E" in scope:  # the fmpy example
+        expected = r.impact_between(r.Sphere(r.MATERIALS["chrome_steel"], 4.76e-3),
+                                    r.Plate(r.MATERIALS["brass_260"], 3.18e-3), 2.3)
+        if "plate_E" in scope:  # the FMI 2.0 fmpy example
             assert scope["plate_E"] == 103e9
-            expected = r.impact_between(r.Sphere(r.MATERIALS["chrome_steel"], 4.76e-3),
-                                        r.Plate(r.MATERIALS["brass_260"], 3.18e-3), 2.3)
             assert scope["e"] == pytest.approx(expected.e, rel=1e-9)
             assert scope["v_rebound"] == pytest.approx(expected.v_rebound, rel=1e-9)
+        if "e3" in scope:  # the FMI 3.0 fmpy example: the native C physics, the same case
+            assert scope["e3"] == pytest.approx(expected.e, rel=1e-9)
+            assert scope["v_rebound3"] == pytest.approx(expected.v_rebound, rel=1e-9)
         ran += 1
-    assert ran >= 2
+    assert ran >= 3
+
+
+def test_readme_is_a_users_page():
+    """README stays a user's page: at most 200 lines, the two Quickstart commands, an FMI 2.0 and an FMI 3.0
+    fmpy example, and every docs/ page it links to exists."""
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    assert len(text.splitlines()) <= 200
+    assert "bash build_scripts/quickstart.sh demo" in text and "bash build_scripts/quickstart.sh test" in text
+    python = [code for language, code in _readme_blocks() if language == "python"]
+    assert any("FMU2Slave" in code for code in python) and any("FMU3Slave" in code for code in python)
+    for link in re.findall(r"\]\((docs/[^)#]+)", text):
+        assert (ROOT / link).is_file(), link
 
 
 def test_the_demo_reuses_up_to_date_fmus_and_rebuilds_stale_ones(built_fmus, tmp_path, monkeypatch, capsys):

@@ -1,6 +1,6 @@
 """SpherePlateImpact's documentation beyond its interface table: the equations, what each output is,
 the assumptions and the validity (``documentation/index.html`` of every SpherePlateImpact FMU,
-written by :func:`restitution.fmu.describe.documentation.index_html`). The facts are those of README.md ("What
+written by :func:`restitution.fmu.describe.documentation.index_html`). The facts are those of docs/model.md ("What
 the FMU computes") and of the docstrings of :mod:`restitution.jgm`, :mod:`restitution.zener` and
 :mod:`restitution.fusion`; plain text, variable names between backticks."""
 from __future__ import annotations
