@@ -451,6 +451,12 @@ def _bound_note(name: str, coord, side: str, bound_value: float, params_at_bound
     return note
 
 
+def _n_mean(lik, free) -> int:
+    """The quantities fitted to the mean: the free parameters, the nuisance coordinates (v_1 of a drop) and
+    a drop's profiled time origin."""
+    return len(free) + len(lik.nuisance) + (1 if lik.kind == "impact_times" else 0)
+
+
 def _setup(data, base, names, *, g, v1, h0, restitution_model, zener_method, model_options, start):
     """What a fit and a posterior share: (names, base, options, likelihood, the structural reason of each
     name (None: it enters e), the names fitted, the :class:`Problem`)."""
@@ -470,7 +476,7 @@ def _setup(data, base, names, *, g, v1, h0, restitution_model, zener_method, mod
     speeds = lik.speeds(base)
     reasons = {name: structural_reason(speeds, base, name, options) for name in names}
     free = [name for name in names if reasons[name] is None]
-    n_mean = len(free) + len(lik.nuisance) + (1 if lik.kind == "impact_times" else 0)
+    n_mean = _n_mean(lik, free)
     if lik.n < n_mean + (1 if lik.profiled else 0):  # a profiled noise level needs one degree of freedom
         raise DataError(f"{lik.n} data points for {n_mean} fitted quantities"
                         f"{' and the noise level' if lik.profiled else ''}: too few")
@@ -511,8 +517,7 @@ def fit_parameters(data, base: dict, names, *, g: float = G_STANDARD, v1: float 
     names, base, options, lik, reasons, free, problem = setup
     coords = problem.parameters
     fitter = _Fitter(problem)
-    n_mean = len(free) + len(lik.nuisance) + (1 if lik.kind == "impact_times" else 0)  # as _setup counts
-    threshold = profile_threshold(lik.n, n_mean, lik.profiled)
+    threshold = profile_threshold(lik.n, _n_mean(lik, free), lik.profiled)
     x_hat, d_min = _optimum(problem, grid)
 
     ends = {}

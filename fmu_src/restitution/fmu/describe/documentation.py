@@ -25,6 +25,7 @@ import re
 from ...about import COPYRIGHT, LICENSE, VERSION
 from ..models import FOLDERS, table as _table
 from ..models.text import Rows, Section
+from .common import limit_text
 from .fmi3 import ELEMENTS as FMI3_TYPES, TIME_NAME, TIME_UNIT
 
 __all__ = ["INDEX", "index_html", "model_documentation", "CITATIONS"]
@@ -132,14 +133,6 @@ def _fmi_type(row, fmi_version: str) -> str:
     return "Enumeration" if row.enumeration is not None else row.type
 
 
-def _limits(row, native: bool) -> tuple[str | None, str | None]:
-    """min and max as this FMU's modelDescription declares them (the native FMUs': their own range)."""
-    low, high = row.xml_limits(native=native)
-    if row.type == "Integer":  # written as whole numbers (%g would write 1e+06)
-        low, high = (None if text is None else str(int(float(text))) for text in (low, high))
-    return low, high
-
-
 def _range(row, low: str | None, high: str | None) -> str:
     """What this FMU accepts: the choices in range, or the interval, bounds as the modelDescription has them."""
     if row.choices is not None:
@@ -210,7 +203,7 @@ def _variables(model_table, fmi_version: str, native: bool) -> list[str]:
             continue
         out += [f'<h3 id="{_slug(heading)}">{_esc(heading)}</h3>', '<table class="variables">', header]
         for row in rows:
-            low, high = _limits(row, native) if causality in ("parameter", "input") else (None, None)
+            low, high = limit_text(row, native) if causality in ("parameter", "input") else (None, None)
             allowed = _range(row, low, high) if causality in ("parameter", "input") else ""
             notes = [f'<span class="role">{_esc(text)}</span> ' for text in _roles(row, model_table, model_exchange)]
             narrower = _narrower(row, native)
