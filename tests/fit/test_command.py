@@ -205,16 +205,29 @@ def r_fit(path):
 
 
 def test_the_example_drop_test_is_what_its_generator_makes_and_fits_to_its_truth(tmp_path):
-    """examples/data/ holds what examples/make_drop_test.py writes (the same bytes: the docs' example is
-    reproducible, and labelled synthetic), and each of its files fits back to the generator's plate.Sy of
-    250 MPa (its docstring) within a few per cent."""
+    """examples/data/ holds what examples/make_drop_test.py writes (the docs' example is reproducible, and
+    labelled synthetic), and each of its files fits back to the generator's plate.Sy of 250 MPa (its
+    docstring) within a few per cent.
+
+    Not byte for byte: e(v) may differ in its last bits between CPUs (numpy's SIMD kernels), which can move
+    a printed value across a rounding boundary. The tables agree to their printed resolution (5 significant
+    digits for speeds, 1 us for times), the recordings to one 16-bit step."""
+    from restitution.fit.reading import read_data
+    from restitution.fit.recording import read_wav
+
     root = Path(__file__).resolve().parents[2]
     made = subprocess.run([sys.executable, str(root / "examples" / "make_drop_test.py"), "--out", str(tmp_path)],
                           capture_output=True, text=True, timeout=300)
     assert made.returncode == 0, made.stderr
     for name in ("drop_pairs.csv", "drop_times.csv", "drop.wav"):
-        assert (tmp_path / name).read_bytes() == (root / "examples" / "data" / name).read_bytes(), name
-        assert b"SYNTHETIC" in (tmp_path / name).read_bytes()
+        assert b"SYNTHETIC" in (tmp_path / name).read_bytes() and b"SYNTHETIC" in (root / "examples" / "data" / name).read_bytes()
+    new, kept = read_data(tmp_path / "drop_pairs.csv"), read_data(root / "examples" / "data" / "drop_pairs.csv")
+    for a, b in ((new.v_in, kept.v_in), (new.v_out, kept.v_out)):
+        assert a.shape == b.shape and np.allclose(a, b, rtol=1e-4, atol=0.0)  # one unit of the 5th digit
+    new, kept = read_data(tmp_path / "drop_times.csv"), read_data(root / "examples" / "data" / "drop_times.csv")
+    assert new.t.shape == kept.t.shape and np.max(np.abs(new.t - kept.t)) <= 1.01e-6
+    (a, rate_a), (b, rate_b) = read_wav(tmp_path / "drop.wav"), read_wav(root / "examples" / "data" / "drop.wav")
+    assert rate_a == rate_b and a.shape == b.shape and np.max(np.abs(a - b)) <= 1.01 / 32768
     for name in ("drop_pairs.csv", "drop_times.csv", "drop.wav"):
         done = _run(root / "examples" / "data" / name, *BODIES, "--fit", "plate.Sy", "--json", tmp_path / "r.json")
         assert done.returncode == 0, (name, done.stderr)
