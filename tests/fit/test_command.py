@@ -233,3 +233,18 @@ def test_the_example_drop_test_is_what_its_generator_makes_and_fits_to_its_truth
         assert done.returncode == 0, (name, done.stderr)
         estimate = _json(tmp_path / "r.json")["parameters"]["plate.Sy"]["estimate"]
         assert abs(estimate / 250e6 - 1) < 0.03, (name, estimate)
+
+
+@pytest.mark.parametrize("option", ["--json", "--plot", "--times"])
+def test_an_output_that_is_not_a_regular_file_is_refused_before_any_work(files, tmp_path, option):
+    """A folder (or device, FIFO) named as an output is refused in one line, exit 2, before the fit: the
+    other outputs asked for are not written."""
+    d, _times = files
+    folder = tmp_path / "a_folder"
+    folder.mkdir()
+    others = {"--json": tmp_path / "r.json", "--plot": tmp_path / "r.png", "--times": tmp_path / "t.csv"}
+    args = [a for name, path in others.items() if name != option for a in (name, path)]
+    done = _run(d / "drop.wav", *BODIES, "--fit", "plate.Sy", option, folder, *args)
+    lines = done.stderr.strip().splitlines()
+    assert done.returncode == 2 and len(lines) == 1 and option in lines[0], done.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a_folder"] and not any(folder.iterdir())
