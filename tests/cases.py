@@ -31,10 +31,12 @@ T_OVER_D = [0.01, 0.05, 0.2, 1.0, 10.0, 100.0, 1e3]
 # FMU output -> ImpactResult field (the public interface table)
 FMU_REALS = {"e": "e", "v_rebound": "v_rebound", "jgm.e": "e_ep", "jgm.V_c": "V_c", "jgm.V_star": "V_star",
              "zener.e": "e_ze", "zener.lambda": "lam", "zener.tau0": "tau0", "zener.t_contact": "t_contact",
-             "plate.mass_ratio": "mass_ratio", "plate.v_after": "v_plate", "sphere.m": "m_a"}
+             "plate.mass_ratio": "mass_ratio", "plate.v_after": "v_plate", "sphere.m": "m_a",
+             "monitor.wave_delay": "wave_delay", "monitor.edge_echo": "edge_echo"}
 FMU_FLAGS = {"valid": "valid", "zener.in_range": "lambda_in_range", "jgm.in_range": "vstar_in_range",
              "e_negative": "e_negative", "effects.plasticity": "plasticity_used",
-             "effects.plate_waves": "plate_waves_used", "zener.contact_ends": "contact_ends"}
+             "effects.plate_waves": "plate_waves_used", "zener.contact_ends": "contact_ends",
+             "monitor.concurrent": "concurrent", "monitor.edge_clear": "edge_clear"}
 
 
 def params_for(pair, t_over_d=1.0, d=D):
@@ -87,6 +89,9 @@ CASES = st.fixed_dictionaries({
     "restitution_model": st.sampled_from(r.RESTITUTION_MODELS),
     "zener_method": st.sampled_from(("exact", "paper_fit", "linear")),
     "plasticity": st.sampled_from(r.EFFECT_MODES), "plate_waves": st.sampled_from(r.EFFECT_MODES),
+    # the edge monitor's distance: unbounded (0, as the FMUs say it; the package's +inf too, which the FMUs'
+    # finite values cannot carry: tests/physics/test_monitors.py) or anything from 1 um to 1 km
+    "plate_edge_distance": st.one_of(st.just(0.0), log_uniform(1e-6, 1e3)),
 })
 
 

@@ -3,6 +3,7 @@ with :func:`restitution.impact`'s argument names, for the equivalence tests and 
 from __future__ import annotations
 
 import ctypes
+import math
 from types import SimpleNamespace
 
 import numpy as np
@@ -11,7 +12,9 @@ from restitution.agreement import FLAGS, REALS  # the result record: the C struc
 from restitution.fmu.models.sphere_plate_impact.variables import TABLE
 
 _INPUT_REALS = ("v", "sphere_E", "sphere_nu", "sphere_Sy", "sphere_rho", "sphere_d",
-                "plate_E", "plate_nu", "plate_Sy", "plate_rho", "plate_t")
+                "plate_E", "plate_nu", "plate_Sy", "plate_rho", "plate_t", "plate_edge_distance")
+#: What a parameter the caller leaves out is: an unbounded plate, impact()'s default.
+_DEFAULTS = {"plate_edge_distance": math.inf}
 #: Codes of the FMU's Integer parameters, which rst_physics.h numbers the same way.
 MODEL_CODE = TABLE["restitution_model"].codes
 METHOD_CODE = TABLE["zener_method"].codes
@@ -40,7 +43,8 @@ class NativePhysics:
     def call(self, v, params: dict, restitution_model="e45", zener_method="exact", plasticity="auto",
              plate_waves="auto", effect_tolerance=1e-6, ode_rtol=1e-10):
         """(status, Result) of one impact, floats in."""
-        inp = Inputs(float(v), *(float(params[n]) for n in _INPUT_REALS[1:]), MODEL_CODE[restitution_model],
+        inp = Inputs(float(v), *(float(params.get(n, _DEFAULTS.get(n))) for n in _INPUT_REALS[1:]),
+                     MODEL_CODE[restitution_model],
                      METHOD_CODE[zener_method], MODE_CODE[plasticity], MODE_CODE[plate_waves],
                      float(effect_tolerance), float(ode_rtol))
         out = Result()
@@ -49,7 +53,7 @@ class NativePhysics:
 
     def impact(self, v, params: dict, **options) -> SimpleNamespace:
         """Every case of the broadcast inputs; arrays named as ImpactResult's fields. Raises on a non-OK status."""
-        arrays = np.broadcast_arrays(np.asarray(v, dtype=float), *(np.asarray(params[n], dtype=float)
+        arrays = np.broadcast_arrays(np.asarray(v, dtype=float), *(np.asarray(params.get(n, _DEFAULTS.get(n)), dtype=float)
                                                                    for n in _INPUT_REALS[1:]))
         shape = arrays[0].shape
         flat = [a.ravel() for a in arrays]

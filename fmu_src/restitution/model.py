@@ -13,26 +13,28 @@ from functools import lru_cache
 import numpy as np
 
 from . import fusion, jgm, zener
-from ._num import is_scalar, where
+from ._num import is_scalar, minimum, where
 from .fusion import apparent_restitution, mass_ratio
 from .jgm import restitution_e44, restitution_e45, vstar_in_fit_range
 from .quantities import si_only, with_units
 from .validation import check_choice, check_nonnegative, check_poisson, check_positive
-from .zener import (TAU0_HERTZ, ZENER_METHODS, lambda_from_terms, lambda_in_studied_range, lambda_material_terms,
-                    zener_linear, zener_paper_fit, zener_solution)
+from .zener import (TAU0_HERTZ, ZENER_METHODS, edge_clear, lambda_from_terms, lambda_in_studied_range,
+                    lambda_material_terms, wave_delay, waves_concurrent, zener_linear, zener_paper_fit, zener_solution)
 
 # The pipeline passes SI numbers it has checked: it calls the equations without their unit layer
 # (restitution.quantities), which would cost more than the equations on the scalar path.
 (critical_interference, critical_load, critical_pressure, critical_velocity, effective_modulus, sphere_mass,
  yield_strain) = map(si_only, (jgm.critical_interference, jgm.critical_load, jgm.critical_pressure,
                                jgm.critical_velocity, jgm.effective_modulus, jgm.sphere_mass, jgm.yield_strain))
-(contact_duration, hertz_stiffness, time_scale) = map(
-    si_only, (zener.contact_duration, zener.hertz_stiffness, zener.time_scale))
+(contact_duration, hertz_stiffness, time_scale, dilatational_slowness, edge_echo_ratio) = map(
+    si_only, (zener.contact_duration, zener.hertz_stiffness, zener.time_scale, zener.dilatational_slowness,
+              zener.edge_echo_ratio))
 equivalent_plate_mass, velocities_after_impact = map(si_only, (fusion.equivalent_plate_mass,
                                                               fusion.velocities_after_impact))
 
 __all__ = ["ImpactResult", "impact", "published", "RESTITUTION_MODELS", "EFFECT_MODES", "ZENER_SLOPE_BOUND",
-           "PARAMETERS", "DOMAIN", "validate_parameters", "RECORD_REALS", "RECORD_FLAGS"]
+           "PARAMETERS", "DOMAIN", "validate_parameters", "RECORD_REALS", "RECORD_FLAGS", "EDGE_ECHO_PUBLISHED_MAX",
+           "check_edge_distance"]
 
 RESTITUTION_MODELS = ("e45", "e44")
 EFFECT_MODES = ("off", "on", "auto")
@@ -62,6 +64,32 @@ DOMAIN = {
     "sphere_E": (1e5, 1e13), "sphere_Sy": (1e3, 1e13), "sphere_rho": (1.0, 1e5), "sphere_d": (1e-6, 10.0),
     "plate_E": (1e5, 1e13), "plate_Sy": (1e3, 1e13), "plate_rho": (1.0, 1e5), "plate_t": (1e-7, 100.0),
 }
+
+#: The largest ``edge_echo`` the FMUs and the sweep tables publish [1] (:func:`published`): an unbounded
+#: plate (or no contact) has an infinite echo ratio, and every published output must be finite.
+#: 1e9 contact times is far beyond any echo that matters (the monitor's threshold is 1).
+EDGE_ECHO_PUBLISHED_MAX = 1e9
+
+
+def check_edge_distance(value):
+    """The distance [m] from the impact point to the plate's nearest edge: >= 0, where 0 and +inf
+    both mean an unbounded plate (Zener's assumption; 0 is how the FMUs say it, their values being
+    finite); ValueError otherwise (negative, NaN)."""
+    if value.__class__ is float and value >= 0.0:  # fast path, +inf included
+        return value
+    if is_scalar(value):
+        v = float(value)
+        if not v >= 0.0:
+            raise ValueError(f"plate.edge_distance = {v!r} m is outside the allowed range: >= 0 "
+                             "(0 or inf: an unbounded plate)")
+        return v
+    arr = np.asarray(value, dtype=float)
+    if not np.all(arr >= 0.0):
+        bad = float(arr[~(arr >= 0.0)].flat[0])
+        raise ValueError(f"plate.edge_distance = {bad!r} m is outside the allowed range: >= 0 "
+                         "(0 or inf: an unbounded plate)")
+    return arr
+
 
 _PARAMETER_CHECKS = tuple((name, name.replace("_", ".", 1), unit, kind) for name, unit, kind in PARAMETERS)
 
@@ -103,12 +131,16 @@ class ImpactResult:
     m_eff: Real  #: equivalent plate mass, Eq. (19) [kg] (+inf for e_ze = 1)
     mass_ratio: Real  #: m_a / m_eff = (1 - e_ze)/(1 + e_ze), Eq. (19) [1], in [0, 1] (0 for e_ze = 1)
     v_plate: Real  #: plate velocity after impact, Eq. (17) [m/s]
+    wave_delay: Real  #: Zener's ejection time over its half-space value, tau0(lambda)/tau0(0) [1] (section 4)
+    edge_echo: Real  #: first dilatational edge echo 2a/c_L over the contact time [1] (+inf: unbounded plate)
     plasticity_used: Flag  #: JGM contributed (e_ep < 1 was applied)
     plate_waves_used: Flag  #: Zener contributed (e_ze was computed)
     lambda_in_range: Flag  #: lambda <= 1.5, Zener's studied range
     vstar_in_range: Flag  #: V* <= 1000, JGM's fit range
     e_negative: Flag  #: e < 0: the sphere keeps moving with the plate
     contact_ends: Flag  #: tau0 is finite (False: the linear method at lambda >= 2 never releases)
+    concurrent: Flag  #: wave_delay <= 1.8136 (its value at lambda = 1.5): plastic and wave processes overlap
+    edge_clear: Flag  #: edge_echo >= 1: no edge echo returns during the contact
 
     @property
     def valid(self):
@@ -133,11 +165,14 @@ class ImpactResult:
                     f"t_contact = {self.t_contact:.4g} s\n"
                     f"  valid = {self.valid}: lambda <= 1.5 (lambda_in_range) {self.lambda_in_range}, "
                     f"V* <= 1000 (vstar_in_range) {self.vstar_in_range}\n"
-                    + "  " + ", ".join(f"{name} = {getattr(self, name)}" for name in _REPR_FLAGS))
+                    + "  " + ", ".join(f"{name} = {getattr(self, name)}" for name in _REPR_FLAGS) + "\n"
+                    + "  monitors: " + ", ".join(f"{value} = {getattr(self, value):.4g} ({flag} {getattr(self, flag)})"
+                                                 for value, flag in _REPR_MONITORS))
         e = np.asarray(self.e)
         n = e.size
         counts = ", ".join(f"{name} {int(np.count_nonzero(getattr(self, name)))}"
-                           for name in ("lambda_in_range", "vstar_in_range") + _REPR_FLAGS)
+                           for name in ("lambda_in_range", "vstar_in_range") + _REPR_FLAGS
+                           + tuple(flag for _value, flag in _REPR_MONITORS))
         finite = e[np.isfinite(e)]
         span = f"e in [{finite.min():.4g}, {finite.max():.4g}]" if finite.size else "no finite e"
         return (f"ImpactResult of {n} impacts, shape {e.shape}: {span}; valid at "
@@ -155,23 +190,30 @@ RECORD_FLAGS = tuple(f.name for f in fields(ImpactResult) if f.type == "Flag") +
 
 #: The flags shown by ``repr`` beside ``valid`` and its two parts.
 _REPR_FLAGS = ("plasticity_used", "plate_waves_used", "e_negative", "contact_ends")
+#: The monitors of the assumptions, with their flags, shown by ``repr`` on a line of their own.
+_REPR_MONITORS = (("wave_delay", "concurrent"), ("edge_echo", "edge_clear"))
 
 
 #: Outputs that are +inf where the contact never ends (``contact_ends`` False: the linear method at
 #: lambda >= 2, whose oscillator never returns to zero force).
-ENDLESS = ("tau0", "t_contact")
+ENDLESS = ("tau0", "t_contact", "wave_delay")
 
 
 def published(values: dict) -> dict:
     """``values`` (:meth:`ImpactResult.as_dict`) as the FMUs and the sweep tables publish them: every
     value finite. Result writers (OMSimulator's, for one) drop a whole time point for one inf, so where
     the contact never ends tau0 and t_contact read 0 beside ``contact_ends`` = False, and the
-    equivalent plate mass is published as ``mass_ratio`` (0 for a half-space) instead of m_eff = +inf.
+    equivalent plate mass is published as ``mass_ratio`` (0 for a half-space) instead of m_eff = +inf;
+    ``edge_echo`` is capped at :data:`EDGE_ECHO_PUBLISHED_MAX` (+inf for an unbounded plate) and
+    ``wave_delay`` reads 0 with tau0 where the contact never ends.
     Nothing else changes; the package's own results keep the infinities."""
-    ends = values["contact_ends"]
-    if ends is True:  # one impact, the usual case
+    ends, echo = values["contact_ends"], values["edge_echo"]
+    if ends is True and echo.__class__ is float and echo <= EDGE_ECHO_PUBLISHED_MAX:  # one impact, a bounded plate
         return values
     out = dict(values)
+    out["edge_echo"] = minimum(echo, EDGE_ECHO_PUBLISHED_MAX)
+    if ends is True:
+        return out
     for key in ENDLESS:
         out[key] = where(ends, values[key], 0.0)
     return out
@@ -187,9 +229,9 @@ def _mode(name, value):
     return check_choice(name, value, EFFECT_MODES)
 
 
-@with_units(v="m/s", sphere_E="Pa", sphere_nu="dimensionless", sphere_Sy="Pa", sphere_rho="kg/m**3", sphere_d="m", plate_E="Pa", plate_nu="dimensionless", plate_Sy="Pa", plate_rho="kg/m**3", plate_t="m")
+@with_units(v="m/s", sphere_E="Pa", sphere_nu="dimensionless", sphere_Sy="Pa", sphere_rho="kg/m**3", sphere_d="m", plate_E="Pa", plate_nu="dimensionless", plate_Sy="Pa", plate_rho="kg/m**3", plate_t="m", plate_edge_distance="m")
 def impact(v, sphere_E, sphere_nu, sphere_Sy, sphere_rho, sphere_d,
-           plate_E, plate_nu, plate_Sy, plate_rho, plate_t, *,
+           plate_E, plate_nu, plate_Sy, plate_rho, plate_t, *, plate_edge_distance=math.inf,
            restitution_model: str = "e45", zener_method: str = "exact",
            plasticity="auto", plate_waves="auto", effect_tolerance: float = 1e-6,
            ode_rtol: float = 1e-10, validate: bool = True) -> ImpactResult:
@@ -197,6 +239,8 @@ def impact(v, sphere_E, sphere_nu, sphere_Sy, sphere_rho, sphere_d,
 
     Parameters (units in brackets): ``v`` approach speed [m/s] >= 0; sphere E [Pa],
     nu [1], Sy [Pa], rho [kg/m^3], d [m]; plate E, nu, Sy, rho, t [m].
+    ``plate_edge_distance`` [m]: from the impact point to the plate's nearest edge, for the edge-echo
+    monitor only (``edge_echo``, ``edge_clear``); +inf (default) or 0: an unbounded plate, Zener's assumption.
     ``restitution_model``: "e45" (Eq. 8, default) or "e44" (Eq. 7, second branch reconstructed).
     ``zener_method``: "exact" (default), "paper_fit", "linear" or "ode" (see :mod:`restitution.zener`).
     ``plasticity`` / ``plate_waves``: "on", "off" (e_ep = 1, resp. e_ze = 1) or "auto":
@@ -209,7 +253,9 @@ def impact(v, sphere_E, sphere_nu, sphere_Sy, sphere_rho, sphere_d,
     ``validate=False`` skips the input checks (for callers that already checked).
 
     Validity is reported, never clipped: ``lambda_in_range`` (<= 1.5), ``vstar_in_range``
-    (<= 1000), ``e_negative``. Bad input raises ValueError naming the parameter.
+    (<= 1000), ``e_negative``, and the monitors of the assumptions: ``wave_delay`` with ``concurrent``
+    (<= 1.8136), ``edge_echo`` with ``edge_clear`` (>= 1); docs/assumptions.md. Bad input raises
+    ValueError naming the parameter.
     """
     plasticity = _mode("plasticity", plasticity)
     plate_waves = _mode("plate_waves", plate_waves)
@@ -224,27 +270,30 @@ def impact(v, sphere_E, sphere_nu, sphere_Sy, sphere_rho, sphere_d,
             sphere_E=sphere_E, sphere_nu=sphere_nu, sphere_Sy=sphere_Sy, sphere_rho=sphere_rho,
             sphere_d=sphere_d, plate_E=plate_E, plate_nu=plate_nu, plate_Sy=plate_Sy,
             plate_rho=plate_rho, plate_t=plate_t).values()
+        plate_edge_distance = check_edge_distance(plate_edge_distance)
     params = (sphere_E, sphere_nu, sphere_Sy, sphere_rho, sphere_d, plate_E, plate_nu, plate_Sy, plate_rho, plate_t)
     if (v.__class__ is float and sphere_E.__class__ is float and sphere_nu.__class__ is float
             and sphere_Sy.__class__ is float and sphere_rho.__class__ is float and sphere_d.__class__ is float
             and plate_E.__class__ is float and plate_nu.__class__ is float and plate_Sy.__class__ is float
-            and plate_rho.__class__ is float and plate_t.__class__ is float):
+            and plate_rho.__class__ is float and plate_t.__class__ is float
+            and plate_edge_distance.__class__ is float):
         # one impact in Python floats (the FMU's case; spelt out: a generator costs 10 % of the call)
         scalar = True
     else:
-        scalar = is_scalar(v) and all(is_scalar(x) for x in params)
+        scalar = is_scalar(v) and is_scalar(plate_edge_distance) and all(is_scalar(x) for x in params)
         if scalar:
-            v, params = float(v), tuple(map(float, params))
+            v, params, plate_edge_distance = float(v), tuple(map(float, params)), float(plate_edge_distance)
         else:
             # No up-front broadcast: what depends on the parameters only is computed once per
             # distinct parameter value (a scalar parameter stays a scalar), not once per case.
             v = np.asarray(v, dtype=float)
             params = tuple(np.asarray(x, dtype=float) for x in params)
-    return _pipeline(v, params, scalar, restitution_model, zener_method, plasticity, plate_waves,
+            plate_edge_distance = np.asarray(plate_edge_distance, dtype=float)
+    return _pipeline(v, params, plate_edge_distance, scalar, restitution_model, zener_method, plasticity, plate_waves,
                      effect_tolerance, ode_rtol)
 
 
-def _pipeline(v, params, scalar, restitution_model, zener_method, plasticity, plate_waves,
+def _pipeline(v, params, edge_distance, scalar, restitution_model, zener_method, plasticity, plate_waves,
               effect_tolerance, ode_rtol) -> ImpactResult:
     """The model, written once for Python floats (``scalar``) and numpy arrays alike.
 
@@ -256,7 +305,7 @@ def _pipeline(v, params, scalar, restitution_model, zener_method, plasticity, pl
 
     # --- JGM, Eqs. (1)-(8)
     material_terms = _material_terms_cached if scalar else _material_terms
-    E_prime, eps_y, m_a, V_c, k, wave_speed, density_factor, modulus_factor = material_terms(
+    E_prime, eps_y, m_a, V_c, k, wave_speed, density_factor, modulus_factor, slowness = material_terms(
         sphere_E, sphere_nu, sphere_Sy, sphere_rho, sphere_d, plate_E, plate_nu, plate_Sy, plate_rho)
     V_star = v / V_c
     if plasticity == "off":
@@ -287,14 +336,20 @@ def _pipeline(v, params, scalar, restitution_model, zener_method, plasticity, pl
     ratio = mass_ratio(e_ze, d_ze)
     _, v_plate = velocities_after_impact(v, e_ep, e_ze, d_ze)
 
+    # --- Monitors of the assumptions (sections 3 and 4): where Zener was skipped or off, the
+    # half-space contact is the reference itself
+    delay = where(needed, wave_delay(tau0, _TAU0_AT_LAMBDA0[zener_method]), 1.0)
+    echo = edge_echo_ratio(edge_distance, slowness, t_contact)
+
     values = (e, e * v, e_ep, V_c, V_star, eps_y, e_ze, lam, tau0, T, t_contact, m_a, m_eff, ratio, v_plate,
+              delay, echo,
               e_ep < 1.0, needed, lambda_in_studied_range(lam), vstar_in_fit_range(V_star), e < 0.0,
-              tau0 < math.inf)
+              tau0 < math.inf, waves_concurrent(delay), edge_clear(echo))
     out = object.__new__(ImpactResult)  # frozen dataclass: fill __dict__ directly, ~5x faster
     if scalar:  # every value is already a Python float or bool (math-module paths; the tests check it)
         out.__dict__.update(zip(_FIELD_NAMES, values))
         return out
-    shape = np.broadcast_shapes(v.shape, *(x.shape for x in params))
+    shape = np.broadcast_shapes(v.shape, edge_distance.shape, *(x.shape for x in params))
     out.__dict__.update((name, _own_array(value, shape, bool if name in _FLAGS else float))
                         for name, value in zip(_FIELD_NAMES, values))
     return out
@@ -327,8 +382,9 @@ def _own_array(x, shape, dtype):
 def _material_terms(sphere_E, sphere_nu, sphere_Sy, sphere_rho, sphere_d, plate_E, plate_nu, plate_Sy,
                     plate_rho):
     """What depends on the materials only: (E' [Pa], eps_y [1], m_a [kg], V_c [m/s], k [N/m^1.5],
-    then the material factors of lambda, :func:`restitution.zener.lambda_material_terms`),
-    Eqs. (1)-(6), the Hertz stiffness of Eq. (9) and part of Eq. (12)."""
+    then the material factors of lambda, :func:`restitution.zener.lambda_material_terms`, and the plate's
+    dilatational slowness 1/c_L [s/m]), Eqs. (1)-(6), the Hertz stiffness of Eq. (9), part of Eq. (12)
+    and the edge monitor's wave speed."""
     E_prime = effective_modulus(sphere_E, sphere_nu, plate_E, plate_nu)
     CSy = critical_pressure(sphere_nu, sphere_Sy, plate_nu, plate_Sy)
     eps_y = yield_strain(E_prime, sphere_nu, sphere_Sy, plate_nu, plate_Sy)
@@ -336,7 +392,8 @@ def _material_terms(sphere_E, sphere_nu, sphere_Sy, sphere_rho, sphere_d, plate_
     m_a = sphere_mass(sphere_rho, sphere_d)
     V_c = critical_velocity(critical_interference(CSy, E_prime, R), critical_load(CSy, E_prime, R), m_a)
     return (E_prime, eps_y, m_a, V_c, hertz_stiffness(E_prime, sphere_d),
-            *lambda_material_terms(sphere_E, sphere_nu, sphere_rho, plate_E, plate_nu, plate_rho))
+            *lambda_material_terms(sphere_E, sphere_nu, sphere_rho, plate_E, plate_nu, plate_rho),
+            dilatational_slowness(plate_E, plate_nu, plate_rho))
 
 
 #: :func:`_material_terms` memoised for Python floats (a pure function): a co-simulation or a

@@ -25,7 +25,8 @@ __all__ = [
     "ZENER_METHODS", "LAMBDA_STUDIED_MAX", "lambda_in_studied_range", "TAU0_HERTZ", "plate_wave_speed", "inelasticity_parameter",
     "hertz_stiffness", "time_scale", "zener_paper_fit", "zener_paper_fit_deficit", "zener_linear",
     "zener_linear_deficit", "zener_linear_fit", "zener_ode", "zener_restitution", "zener_solution",
-    "contact_duration",
+    "contact_duration", "WAVE_DELAY_LIMIT", "wave_delay", "waves_concurrent", "dilatational_wave_speed",
+    "dilatational_slowness", "edge_echo_ratio", "edge_clear",
 ]
 
 ZENER_METHODS = ("exact", "paper_fit", "linear", "ode")
@@ -94,6 +95,71 @@ def lambda_in_studied_range(lam):
 def contact_duration(T, tau0):
     """t_contact = T tau0 [s]: the time sphere and plate stay in compressive contact."""
     return T * tau0
+
+
+# --- Monitors of Zener's assumptions (I. Green, Nonlinear Dyn (2022), sections 3 and 4) ---------------
+
+#: The delay :func:`wave_delay` at the end of Zener's studied range, lambda = 1.5, with the exact solution:
+#: tau0(1.5)/tau0(0) = 1.81359 [1] (rounded up in the 5th digit; tests/physics/test_monitors.py checks it against
+#: an independent solve of Eq. (10)). Above it the wave process outlasts the half-space contact by more
+#: than the paper validated.
+WAVE_DELAY_LIMIT = 1.8136
+
+
+def wave_delay(tau0, tau0_half_space):
+    """tau0(lambda) / tau0(0) [1]: how much the plate waves lengthen the contact, Zener's ejection time over
+    its half-space (Hertz) value, both by the same method. 1 for a half-space, 1.36 at lambda = 1, 1.81 at
+    lambda = 1.5, +inf where the contact never ends.
+
+    A monitor of the paper's section 4: Eq. (20) fuses the elastoplastic and the wave COR, which holds
+    only if "the underlying physical processes of both models occur concurrently". JGM's plastic
+    deformation happens within a Hertz-like contact; the longer the waves delay the ejection beyond it,
+    the less the two processes overlap (threshold :data:`WAVE_DELAY_LIMIT`, :func:`waves_concurrent`).
+    Not an equation of the paper: an extension that makes its caveat measurable."""
+    return tau0 / tau0_half_space
+
+
+def waves_concurrent(delay):
+    """True where :func:`wave_delay` <= :data:`WAVE_DELAY_LIMIT` [1]: the delay is within what the paper
+    validated (lambda <= 1.5 under the exact solution)."""
+    return delay <= WAVE_DELAY_LIMIT
+
+
+@with_units(E_b="Pa", nu_b="dimensionless", rho_b="kg/m**3")
+def dilatational_wave_speed(E_b, nu_b, rho_b):
+    """c_L = sqrt(E_b (1 - nu_b) / (rho_b (1 + nu_b)(1 - 2 nu_b))) [m/s]: the plate's bulk dilatational
+    (P-) wave speed, the fastest elastic wave in it; +inf for nu_b = 0.5 (incompressible).
+    Not in the paper: it times the edge echo of :func:`edge_echo_ratio`."""
+    return 1.0 / _dilatational_slowness(E_b, nu_b, rho_b)
+
+
+@with_units(E_b="Pa", nu_b="dimensionless", rho_b="kg/m**3")
+def dilatational_slowness(E_b, nu_b, rho_b):
+    """1 / c_L [s/m] of :func:`dilatational_wave_speed`, written as a slowness so that nu_b = 0.5 gives 0
+    (an infinitely fast wave) without a division by zero."""
+    return sqrt(rho_b * (1.0 + nu_b) * (1.0 - 2.0 * nu_b) / (E_b * (1.0 - nu_b)))
+
+
+@with_units(edge_distance="m", slowness="s/m", t_contact="s")
+def edge_echo_ratio(edge_distance, slowness, t_contact):
+    """(2 a / c_L) / t_contact [1]: the time the first dilatational wave reflected from the plate's nearest
+    edge, at distance a [m] from the impact point, takes to come back, over the contact time [s].
+
+    A monitor of the paper's section 3, which takes Zener's plate as infinite: waves reflected from its
+    edges must not return before the sphere leaves. Below 1 an echo arrives during the contact
+    (:func:`edge_clear`). Conservative: the bulk dilatational wave (``slowness`` = 1/c_L,
+    :func:`dilatational_slowness`) is the fastest; the flexural waves that carry Zener's energy loss
+    come back later. a = 0 or +inf means an unbounded plate (Zener's assumption): +inf, as for no
+    contact (t_contact = 0); 0 where the contact never ends (t_contact = +inf)."""
+    unbounded = (edge_distance == 0.0) | (edge_distance == math.inf)
+    no_contact = t_contact == 0.0
+    echo = 2.0 * where(unbounded, 0.0, edge_distance) * slowness
+    return where(unbounded | no_contact, math.inf, echo / where(no_contact, 1.0, t_contact))
+
+
+def edge_clear(ratio):
+    """True where :func:`edge_echo_ratio` >= 1 [1]: no edge echo returns while the sphere is in contact."""
+    return ratio >= 1.0
 
 
 def zener_paper_fit(lam):
@@ -204,3 +270,4 @@ def zener_restitution(lam, method: str = "exact", rtol: float = 1e-10):
 # the module's own calls pass SI numbers: the equations without their unit layer
 _reduced_modulus = si_only(reduced_modulus)
 _plate_wave_speed = si_only(plate_wave_speed)
+_dilatational_slowness = si_only(dilatational_slowness)

@@ -12,7 +12,7 @@ from restitution.model import ImpactResult, impact
 from agree import assert_agree, stack
 
 FLAGS = {"plasticity_used", "plate_waves_used", "lambda_in_range", "vstar_in_range", "e_negative", "valid",
-         "contact_ends"}
+         "contact_ends", "concurrent", "edge_clear"}
 
 
 def _cases(n, seed=5):

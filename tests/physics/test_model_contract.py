@@ -18,7 +18,8 @@ from restitution.model import PARAMETERS, validate_parameters
 S2, AL = MATERIALS["s2_tool_steel"], MATERIALS["al_6061"]
 PARAMS = dict(**Sphere(S2, 6.35e-3).params(), **Plate(AL, 6.35e-3).params())
 FIELDS = tuple(r.ImpactResult.__dataclass_fields__)
-FLAGS = ("plasticity_used", "plate_waves_used", "lambda_in_range", "vstar_in_range", "e_negative", "contact_ends")
+FLAGS = ("plasticity_used", "plate_waves_used", "lambda_in_range", "vstar_in_range", "e_negative", "contact_ends",
+         "concurrent", "edge_clear")
 
 
 # --- options: the message names the option and lists what is allowed

@@ -189,5 +189,5 @@ def test_the_fmu_domain_corner_through_impact():
     assert rel(res.lam, LAMBDA_MAX) <= 1e-12
     assert res.e_ze * res.lam**5 == pytest.approx(E_INF_LITERAL, rel=1e-10)
     for name, value in res.as_dict().items():
-        if not isinstance(value, bool):
+        if not isinstance(value, bool) and name != "edge_echo":  # +inf: the plate is unbounded (the default)
             assert math.isfinite(value), name

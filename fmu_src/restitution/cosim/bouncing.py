@@ -27,15 +27,19 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..assumptions import warn_departures
 from ..fmu.models.sphere_plate_impact.variables import TABLE
 
 __all__ = ["Bounces", "Trajectory", "bounce", "impact_sequence", "fmu_rebound", "package_rebound", "RECORDED", "STANDARD_GRAVITY"]
 
 STANDARD_GRAVITY = 9.80665  # [m/s^2]
 
-#: FMU output name -> record field (the output's ImpactResult field), read at every impact.
+#: FMU output name -> record field (the output's ImpactResult field), read at every impact: what
+#: :class:`Bounces` keeps, and what :func:`restitution.assumptions.departures` reads.
 RECORDED = {name: TABLE[name].key
-            for name in ("e", "jgm.e", "zener.e", "zener.lambda", "zener.tau0", "zener.t_contact", "v_rebound")}
+            for name in ("e", "jgm.e", "zener.e", "zener.lambda", "zener.tau0", "zener.t_contact", "v_rebound",
+                         "jgm.V_star", "monitor.edge_echo", "zener.in_range", "jgm.in_range", "e_negative",
+                         "monitor.edge_clear")}
 
 
 class Trajectory:
@@ -95,14 +99,19 @@ class Bounces(Trajectory):
     extra: dict = field(default_factory=dict)
 
 
+#: The fields :func:`restitution.assumptions.departures` judges an impact by.
+_JUDGED = ("e", "lam", "V_star", "edge_echo", "lambda_in_range", "vstar_in_range", "e_negative", "edge_clear")
+
+
 def package_rebound(**options):
     """Rebound function backed by :func:`restitution.impact` (options as for impact, incl. materials)."""
     from ..model import impact
 
+    keys = tuple(RECORDED.values())
+
     def rebound(v):
-        res = impact(v, **options)
-        return {"e": res.e, "e_ep": res.e_ep, "e_ze": res.e_ze, "lam": res.lam, "tau0": res.tau0,
-                "t_contact": res.t_contact, "v_rebound": res.v_rebound}
+        res = impact(v, **options).__dict__  # the fields (a frozen dataclass has no other attributes)
+        return {key: res[key] for key in keys}
     return rebound
 
 
@@ -184,9 +193,14 @@ def bounce(rebound, drop_height: float, gravity: float = STANDARD_GRAVITY, v_min
 
     ``rebound(v_approach) -> dict`` gives e, e_ep, e_ze, lam, tau0, t_contact, v_rebound
     for an impact at speed v [m/s]; :func:`fmu_rebound` and :func:`package_rebound` make one.
+    Impacts outside the validated domain (lambda > 1.5, V* > 1000, e < 0, an edge echo during the
+    contact) raise one :class:`restitution.assumptions.AssumptionWarning` per condition, as the FMUs
+    log them, where the rebound function gives the fields to judge by (both of those do).
     """
     events, stop = impact_sequence(rebound, drop_height, gravity, v_min, max_bounces,
                                    getattr(rebound, "advance", None))
+    if events and all(key in events[0][2] for key in _JUDGED):
+        warn_departures((out for _t, _v, out in events), stacklevel=3)
     rows = []
     for t, v_impact, out in events:
         v_reb = out["v_rebound"]

@@ -92,7 +92,7 @@ def _run(args) -> int:
             return EXIT_IO_ERROR
     print(result.summary())
     print("wrote " + ", ".join(str(p) for p in written))
-    for warning in (result.warning(), result.rest_warning()):
+    for warning in (result.warning(), *result.departure_warnings(), result.rest_warning()):
         if warning:
             print(warning, file=sys.stderr)
     return EXIT_NOT_AT_REST if result.not_at_rest() else 0

@@ -60,6 +60,9 @@ class DropResult(Trajectory):
     stop_reason: str  #: "v_min", "e<=0" or "max_bounces"
     gravity: float = 9.80665  #: [m/s2]
     validity: dict = field(default_factory=dict)  #: VALIDITY flag -> Boolean array, per impact
+    #: what the FMU said about this drop's impacts outside the validated domain (restitution.assumptions:
+    #: once per FMU instance and condition, so a later drop repeats none of an earlier one's)
+    departures: list = field(default_factory=list)
 
     @property
     def out_of_range(self) -> int:
@@ -150,6 +153,11 @@ class SceneResult:
         zener = sum(int(np.count_nonzero(~d.validity["zener.in_range"])) for d in self.drops)
         return (f"warning: {n} of {self.n_impacts} impacts lie outside the models' validated ranges "
                 f"(valid = 0: {jgm} with V* > 1000, {zener} with lambda > 1.5); their e is an extrapolation")
+
+    def departure_warnings(self) -> list[str]:
+        """One line per condition of :mod:`restitution.assumptions` that any impact met, in the FMU's
+        words (quantity, value, limit), naming the first drop that met it."""
+        return [f"warning: {d.drop.label}: {text}" for d in self.drops for text in d.departures]
 
     def write_csv(self, path) -> Path:
         """One row per impact: drop, impact instant and speed, requested outputs, effects used,

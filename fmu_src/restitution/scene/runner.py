@@ -140,13 +140,17 @@ def _run_drop(instance, scene: Scene, drop: Drop, params: dict, read_names, read
         columns["apex"] = apex_heights(v_reb, g)
     for j, col in enumerate(read_cols):
         columns[col] = data[:, 1 + j]
+    said = [text for status, text in instance.messages[seen:] if status == _FMI_WARNING]
     return DropResult(drop=drop, time=np.array(times), v_approach=np.array(speeds), v_rebound=v_reb,
                       columns=columns, plasticity=flags[:, 0], plate_waves=flags[:, 1], stop_reason=stop,
-                      gravity=g, validity={name: flags[:, 2 + k] for k, name in enumerate(VALIDITY)})
+                      gravity=g, validity={name: flags[:, 2 + k] for k, name in enumerate(VALIDITY)},
+                      departures=said)
 
 
 #: Status of a rejected value (Error, 3 in FMI 2.0 and 3.0; Fatal is 4).
 _FMI_ERROR = 3
+#: Status of the FMU's messages about impacts outside the validated domain (Warning, 1).
+_FMI_WARNING = 1
 
 
 def _rejected(scene: Scene, drop: Drop, message: str) -> SceneError:

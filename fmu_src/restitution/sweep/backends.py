@@ -41,9 +41,10 @@ __all__ = ["Backend", "PackageBackend", "FmuBackend", "get_backend", "code_finge
 
 _REAL_OUT = [name for name, _f, t in OUTPUTS if t == "Real"]
 _BOOL_OUT = [name for name, _f, t in OUTPUTS if t == "Boolean"]
-#: impact()'s keyword options (the inputs that are neither v nor a material or geometry parameter)
+#: impact()'s keyword options (the inputs that are neither v nor a material or geometry parameter), each
+#: one value per vectorized call; the edge distance is an array like the geometry (it may be drawn at random)
 _OPTION_NAMES = tuple(v.name for v in SETTABLE
-                      if v.key not in {"v", *(key for key, _unit, _check in PARAMETERS)})
+                      if v.key not in {"v", "plate_edge_distance", *(key for key, _unit, _check in PARAMETERS)})
 
 
 def code_fingerprint(package_dir=None) -> str:

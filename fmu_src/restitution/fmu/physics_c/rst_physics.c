@@ -215,6 +215,23 @@ static double tau0_at_lambda0(int method)
     }
 }
 
+/* --- Monitors of Zener's assumptions, sections 3 and 4 (restitution.zener) ------------------------- */
+
+/* 1 / c_L [s/m], the plate's bulk dilatational slowness (zener.dilatational_slowness): 0 at nu = 0.5. */
+static double dilatational_slowness(double E_b, double nu_b, double rho_b)
+{
+    return sqrt(rho_b * (1.0 + nu_b) * (1.0 - 2.0 * nu_b) / (E_b * (1.0 - nu_b)));
+}
+
+/* (2 a / c_L) / t_contact [1] (zener.edge_echo_ratio): +inf for an unbounded plate (a = 0 or +inf) or no
+ * contact, 0 where the contact never ends. */
+static double edge_echo_ratio(double edge_distance, double slowness, double t_contact)
+{
+    if (edge_distance == 0.0 || edge_distance == INFINITY || t_contact == 0.0)
+        return INFINITY;
+    return 2.0 * edge_distance * slowness / t_contact;
+}
+
 /* --- Fusion, Eqs. (17)-(20) (restitution.fusion) ------------------------------------------------ */
 
 /* e = (e_ze (1 + e_ep) - (1 - e_ep)) / 2 [1], Eq. (20) regrouped as a difference of non-negative terms. */
@@ -325,6 +342,12 @@ int rst_impact(const rst_impact_inputs *in, rst_impact_result *out)
     out->vstar_in_range = out->V_star <= RST_VSTAR_FIT_MAX;
     out->e_negative = e < 0.0;
     out->contact_ends = tau0 < INFINITY;
+    /* monitors (model._pipeline): the half-space contact is its own reference where Zener was skipped */
+    out->wave_delay = needed ? tau0 / tau0_at_lambda0(in->zener_method) : 1.0;
+    out->edge_echo = edge_echo_ratio(in->plate_edge_distance,
+                                     dilatational_slowness(in->plate_E, in->plate_nu, in->plate_rho), out->t_contact);
+    out->concurrent = out->wave_delay <= RST_WAVE_DELAY_LIMIT;
+    out->edge_clear = out->edge_echo >= 1.0;
     out->valid = out->lambda_in_range && out->vstar_in_range;
     return RST_PHYSICS_OK;
 }

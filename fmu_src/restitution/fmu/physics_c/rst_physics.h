@@ -39,6 +39,7 @@ typedef struct {
     double v;                                                  /* approach speed [m/s] >= 0 */
     double sphere_E, sphere_nu, sphere_Sy, sphere_rho, sphere_d;
     double plate_E, plate_nu, plate_Sy, plate_rho, plate_t;
+    double plate_edge_distance; /* [m] impact point to the nearest edge; 0 or +inf: unbounded (edge monitor only) */
     int restitution_model;   /* RST_E45 or RST_E44 */
     int zener_method;        /* RST_ZENER_* */
     int plasticity;          /* RST_EFFECT_* */

@@ -51,6 +51,7 @@ def zener_table_header() -> str:
         f"#define RST_TAU0_PAPER_FIT_0 {_hex(zener.zener_paper_fit(0.0)[1])}",
         f"#define RST_TAU0_LINEAR_0 {_hex(zener.zener_linear(0.0)[1])}",
         f"#define RST_PAPER_FIT_LAMBDA_CAP {_hex(zener._PAPER_FIT_LAMBDA_CAP)}",
+        f"#define RST_WAVE_DELAY_LIMIT {_hex(zener.WAVE_DELAY_LIMIT)}",
         f"#define RST_ZT_N_CHEB {len(zener_exact._G_CHEB)}",
         f"#define RST_ZT_N_PIECES {len(pieces)}",
         f"#define RST_ZT_N_CELLS {len(cells)}",

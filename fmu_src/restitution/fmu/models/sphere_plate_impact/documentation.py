@@ -65,6 +65,12 @@ DOCUMENTATION = (
             "sphere leaves the plate after a finite time (false only for the linear method at \u03bb \u2265 2).",
             "`sphere.used.*`, `plate.used.*`: the material properties the model used, a preset's where "
             "`sphere.material` or `plate.material` names one.",
+            "`monitor.wave_delay`, `monitor.concurrent`: Zener's contact time over its half-space value, "
+            "\u03c4\u2080(\u03bb)/\u03c4\u2080(0), and whether it is at most 1.8136, its value at \u03bb = 1.5 "
+            "(below).",
+            "`monitor.edge_echo`, `monitor.edge_clear`: the time a P-wave takes to come back from the plate's "
+            "nearest edge, `plate.edge_distance` away, over the contact time, and whether it is at least 1 "
+            "(below).",
         ),
         "Zener's COR and contact time come from `zener_method`: 1 = exact interpolates a table of the ODE's "
         "solution computed offline (relative error \u2264 1e-8 for \u03bb in [0, 100], the verified asymptote "
@@ -99,9 +105,17 @@ DOCUMENTATION = (
             "is on the plate, so R = d/2.",
             "The plate is wide enough that the waves it carries away do not come back from its edges while the "
             "sphere is in contact (Zener's \u201clarge plates\u201d): its lateral size does not enter the model, "
-            "only its thickness `plate.t`.",
+            "only its thickness `plate.t`. The monitor: set `plate.edge_distance` (0, the default, is an unbounded "
+            "plate) and read `monitor.edge_echo`, the first echo's return time 2a/c_L (c_L the plate's P-wave "
+            "speed, the fastest: a conservative estimate) over the contact time; below 1 (`monitor.edge_clear` "
+            "false) an echo arrives during the contact.",
             "Plastic deformation and plate waves take place concurrently, during the same contact; Eq. (20) "
-            "combines their losses on that assumption.",
+            "combines their losses on that assumption. The monitor: `monitor.wave_delay`, how much the waves "
+            "lengthen the contact; above 1.8136 (`monitor.concurrent` false) the delay exceeds what the paper "
+            "validated.",
+            "An impact outside the validated domain (\u03bb > 1.5, V* > 1000, e < 0, an edge echo during the "
+            "contact) is logged once per instance and condition, with a warning in category logStatusWarning "
+            "naming the quantity, its value and the limit; the call returns OK.",
             "`valid` is true inside both models' validated ranges: \u03bb \u2264 1.5 (Zener's studied range, "
             "`zener.in_range`) and V* \u2264 1000 (the range of the JGM fits, `jgm.in_range`). Outside them the "
             "FMU still computes and reports; nothing is clipped.",

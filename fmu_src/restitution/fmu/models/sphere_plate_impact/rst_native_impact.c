@@ -9,6 +9,7 @@
 
 #define VR(name) RST_SPHEREPLATEIMPACT_VR_##name
 #define CODE(name) RST_SPHEREPLATEIMPACT_##name
+#define RST_EDGE_ECHO_PUBLISHED_MAX 1e9 /* restitution.model.EDGE_ECHO_PUBLISHED_MAX [1] */
 
 /* The FMU's codes are the physics' (both follow restitution.model): checked when compiling. */
 #define SAME(fmu_code, physics_code) ((int)CODE(fmu_code) == (int)(physics_code))
@@ -110,6 +111,7 @@ int rst_impact_evaluate(double *values, char *message, size_t size)
     in.plate_Sy = values[VR(PLATE_USED_SY)];
     in.plate_rho = values[VR(PLATE_USED_RHO)];
     in.plate_t = values[VR(PLATE_T)];
+    in.plate_edge_distance = values[VR(PLATE_EDGE_DISTANCE)];
     in.restitution_model = to_code(values[VR(RESTITUTION_MODEL)]);
     in.zener_method = to_code(values[VR(ZENER_METHOD)]);
     in.plasticity = to_code(values[VR(PLASTICITY)]);
@@ -131,10 +133,15 @@ int rst_impact_evaluate(double *values, char *message, size_t size)
     RST_SPHEREPLATEIMPACT_REAL_OUTPUTS(PUBLISH)
     RST_SPHEREPLATEIMPACT_BOOLEAN_OUTPUTS(PUBLISH)
 #undef PUBLISH
-    if (!r.contact_ends) { /* as restitution.model.published: tau0 and t_contact read 0 where the contact never ends */
+    /* as restitution.model.published: tau0, t_contact and the wave delay read 0 where the contact never ends,
+     * the edge echo (+inf for an unbounded plate) is capped */
+    if (!r.contact_ends) {
         values[VR(ZENER_TAU0)] = 0.0;
         values[VR(ZENER_T_CONTACT)] = 0.0;
+        values[VR(MONITOR_WAVE_DELAY)] = 0.0;
     }
+    if (r.edge_echo > RST_EDGE_ECHO_PUBLISHED_MAX)
+        values[VR(MONITOR_EDGE_ECHO)] = RST_EDGE_ECHO_PUBLISHED_MAX;
     if ((k = first_nonfinite(values)) >= 0) {
         double bad = values[REAL_OUTPUTS[k]];
         snprintf(message, size, "non-finite output %s = %s", RST_SPHEREPLATEIMPACT_VARIABLES[REAL_OUTPUTS[k]].name,

@@ -11,8 +11,9 @@
 #include "rst_native_impact.h"
 
 typedef struct {
-    int stale;  /* an input or parameter changed since the last evaluation */
-    int failed; /* the last evaluation failed: outputs are NaN/false */
+    int stale;         /* an input or parameter changed since the last evaluation */
+    int failed;        /* the last evaluation failed: outputs are NaN/false */
+    unsigned int warned; /* the conditions of log_departures already logged by this instance (bits) */
 } impact_backend;
 
 static rst_status instantiate(rst_instance *inst, const char *resource_dir, int visible)
@@ -44,6 +45,37 @@ static void describe_inputs(rst_instance *inst, char *out, size_t size)
     }
 }
 
+#define OUT(name) rst_store(inst)[RST_SPHEREPLATEIMPACT_VR_##name]
+
+/* An impact outside the validated domain, logged once per instance and condition with a warning (the
+ * call still returns OK: reported, never clipped). The conditions and their words are
+ * restitution.assumptions' (tests compare the two FMUs' messages). */
+static void log_departures(rst_instance *inst, impact_backend *b)
+{
+    enum { LAMBDA = 1, V_STAR = 2, NEGATIVE = 4, EDGE = 8 };
+    if (!OUT(ZENER_IN_RANGE) && !(b->warned & LAMBDA)) {
+        b->warned |= LAMBDA;
+        rst_log(inst, RST_WARNING, "zener.lambda = %.4g is above 1.5, the range Zener's plate-wave model was studied "
+                "on: e = %.4g is an extrapolation (valid = false)", OUT(ZENER_LAMBDA), OUT(E));
+    }
+    if (!OUT(JGM_IN_RANGE) && !(b->warned & V_STAR)) {
+        b->warned |= V_STAR;
+        rst_log(inst, RST_WARNING, "jgm.V_star = %.4g is above 1000, the range of the JGM fits: e = %.4g is an "
+                "extrapolation (valid = false)", OUT(JGM_V_STAR), OUT(E));
+    }
+    if (OUT(E_NEGATIVE) && !(b->warned & NEGATIVE)) {
+        b->warned |= NEGATIVE;
+        rst_log(inst, RST_WARNING, "e = %.4g is below 0: the sphere keeps moving with the plate after the impact "
+                "(e_negative)", OUT(E));
+    }
+    if (!OUT(MONITOR_EDGE_CLEAR) && !(b->warned & EDGE)) {
+        b->warned |= EDGE;
+        rst_log(inst, RST_WARNING, "monitor.edge_echo = %.4g is below 1: a wave reflected from the plate's edge "
+                "returns during the contact, which Zener's unbounded plate excludes (edge_clear = false)",
+                OUT(MONITOR_EDGE_ECHO));
+    }
+}
+
 static void evaluate(rst_instance *inst)
 {
     impact_backend *b = (impact_backend *)rst_backend(inst);
@@ -55,6 +87,8 @@ static void evaluate(rst_instance *inst)
     if (b->failed) {
         describe_inputs(inst, inputs, sizeof inputs);
         rst_log(inst, RST_ERROR, "evaluation failed for %s: %s", inputs, message);
+    } else if (!OUT(VALID) || !OUT(MONITOR_EDGE_CLEAR) || OUT(E_NEGATIVE)) {
+        log_departures(inst, b);
     }
 }
 
@@ -72,6 +106,13 @@ static rst_status changed(rst_instance *inst)
 {
     ((impact_backend *)rst_backend(inst))->stale = 1;
     return RST_OK;
+}
+
+/* fmi2Reset: a fresh start, whose departures are logged again */
+static rst_status reset(rst_instance *inst)
+{
+    ((impact_backend *)rst_backend(inst))->warned = 0;
+    return changed(inst);
 }
 
 static rst_status set(rst_instance *inst, rst_type type, const rst_vr vr[], size_t n,
@@ -114,6 +155,6 @@ const rst_model RST_MODEL = {
     .identifier = RST_MODEL_IDENTIFIER, .guid = RST_MODEL_GUID,
     .variables = RST_MODEL_VARIABLES, .n_variables = RST_MODEL_N_VARIABLES, .backend_size = sizeof(impact_backend),
     .instantiate = instantiate, .exit_initialization = exit_initialization, .accept = accept, .set = set,
-    .get_outputs = get_outputs, .do_step = do_step, .reset = changed, .restore_state = changed,
+    .get_outputs = get_outputs, .do_step = do_step, .reset = reset, .restore_state = changed,
     /* model exchange: no states and no events, the outputs a function of the inputs (direct feedthrough) */
     .model_exchange = 1, RST_MODEL_EXCHANGE_VECTORS};

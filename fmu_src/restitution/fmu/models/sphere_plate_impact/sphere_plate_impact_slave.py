@@ -9,7 +9,10 @@ instance): a value outside its range is refused, the previous value kept, and a 
 naming the variable, its value and the allowed range is logged with fmi2Error (in the built
 FMU the C guard refuses it first and returns fmi2Error). An evaluation that fails, or gives a
 non-finite output (every published output is finite), is logged with the inputs; the outputs then
-read NaN (Booleans false) and ``fmi2DoStep`` returns fmi2Discard.
+read NaN (Booleans false) and ``fmi2DoStep`` returns fmi2Discard. An impact outside the validated
+domain (lambda > 1.5, V* > 1000, e < 0, an edge echo during the contact) is computed as usual and
+logged once per instance and condition with fmi2Warning (restitution.assumptions); the calls return
+fmi2OK.
 
 The FMU state is exactly the inputs and parameters, tagged with the model, the state format
 and the variable list; a state is validated as the setters would before anything is restored.
@@ -60,6 +63,7 @@ resolve_materials = _variables.resolve_materials
 _model = _support.submodule(_restitution, "model")
 PARAMETERS, impact, published = _model.PARAMETERS, _model.impact, _model.published
 si_only = _support.submodule(_restitution, "quantities").si_only
+departures = _support.submodule(_restitution, "assumptions").departures
 
 #: FMU name of each Real output, by ImpactResult key
 _REAL_OUTPUTS = {v.key: v.name for v in TABLE.outputs if v.type == "Real"}
@@ -98,6 +102,7 @@ class SpherePlateImpact(Fmi2Slave):
         self._call = None  # impact()'s arguments but v, built when a parameter changed
         self._used = None  # the parameters with each body's material preset applied, when a parameter changed
         self._failure = None  # message of the last evaluation that raised
+        self._warned = set()  # the conditions of restitution.assumptions already logged by this instance
         self._output_keys = {}  # (Real|Boolean, value reference) -> ImpactResult key, for get_real/get_boolean
         self._last_read = {"Real": (None, None), "Boolean": (None, None)}  # type -> (vrs, reader) of the last get
         for var in TABLE:
@@ -210,7 +215,7 @@ class SpherePlateImpact(Fmi2Slave):
                     tuple(float(used[name]) for name in _PHYSICAL),
                     dict({TABLE.key_of(name): var.word(int(v[name])) for name, var in _CHOICES.items()},
                          effect_tolerance=float(v["effect_tolerance"]), ode_rtol=float(v["zener.ode_tolerance"]),
-                         validate=False))
+                         plate_edge_distance=float(v["plate.edge_distance"]), validate=False))
             args, kwargs = self._call
             result = _impact_si(float(v["v_approach"]), *args, **kwargs)
         except Exception as exc:  # a numerical failure must not become fmi2Fatal
@@ -221,7 +226,15 @@ class SpherePlateImpact(Fmi2Slave):
             return self._fail("non-finite output " + ", ".join(bad))
         self._failure = None
         self._outputs = outputs
+        if not (outputs["valid"] and outputs["edge_clear"] and not outputs["e_negative"]):  # rare: say it once
+            self._log_departures(outputs)
         return self._outputs
+
+    def _log_departures(self, outputs):
+        for name, message in departures(outputs):
+            if name not in self._warned:
+                self._warned.add(name)
+                self.log(message, Fmi2Status.warning)
 
     def _fail(self, reason):
         self._failure = f"evaluation failed for {self._describe_inputs()}: {reason}"
@@ -250,6 +263,7 @@ class SpherePlateImpact(Fmi2Slave):
         self._used = None
         self._failure = None
         self._outputs = {}
+        self._warned = set()
 
     # --- FMU state: the inputs and parameters, with a schema tag, validated before restoring ---
     def _get_fmu_state(self):

@@ -145,6 +145,25 @@ TABLE = Table("SpherePlateImpact", "Apparent coefficient of restitution of a sph
     _material("plate", "default: Al 6061"),
     *_used("sphere"),
     *_used("plate"),
+    # the monitors of the model's assumptions (docs/assumptions.md), appended: the references above stay
+    parameter("plate.edge_distance", "plate_edge_distance", "m", 0.0,
+              "Distance from the impact point to the plate's nearest edge, for monitor.edge_echo only; "
+              "0 (default): an unbounded plate, Zener's assumption", (0.0, math.inf, False, True)),
+    _feedthrough("monitor.wave_delay", "wave_delay", "1",
+                 "Zener's ejection time over its half-space value, tau0(lambda)/tau0(0) by the same method: 1 for "
+                 "a half-space, 1.81 at lambda = 1.5; above 1.8136 the plastic and wave processes may no longer be "
+                 "concurrent as Eq. (20) assumes (monitor.concurrent); 0 where zener.contact_ends is false"),
+    _feedthrough("monitor.edge_echo", "edge_echo", "1",
+                 "Return time of the first dilatational (P-) wave reflected from the nearest edge, "
+                 "2 plate.edge_distance / c_L, over the contact time (conservative: the fastest wave); below 1 an "
+                 "edge echo arrives during the contact (monitor.edge_clear); 1e9 for an unbounded plate "
+                 "(plate.edge_distance = 0) or no contact"),
+    _feedthrough("monitor.concurrent", "concurrent", None,
+                 "monitor.wave_delay <= 1.8136, its value at lambda = 1.5: the wave delay is within what the "
+                 "paper validated", "Boolean"),
+    _feedthrough("monitor.edge_clear", "edge_clear", None,
+                 "monitor.edge_echo >= 1: no wave reflected from the plate's edge returns during the contact",
+                 "Boolean"),
 ), constants={f"MATERIAL_{prop.upper()}": (math.nan, *(float(getattr(MATERIALS[k], prop)) for k in PRESETS))
               for prop, _unit, _what in MATERIAL_PROPERTIES})
 

@@ -1,0 +1,62 @@
+"""The monitors of the model's assumptions through every FMU (pythonfmu, native FMI 2.0, native FMI 3.0)
+in fmpy: the outputs are the package's published values, and an impact outside the validated domain
+is logged once per instance and condition, with fmi2Warning / fmi3Warning in category
+logStatusWarning, in restitution.assumptions' words, while every call returns OK (fmpy's simulate_fmu
+raises on anything worse)."""
+import math
+
+import pytest
+from fmpy import simulate_fmu
+
+import restitution as r
+from restitution.assumptions import departures
+from restitution.model import published
+
+MONITORS = ("monitor.wave_delay", "monitor.edge_echo", "monitor.concurrent", "monitor.edge_clear")
+FIELDS = ("wave_delay", "edge_echo", "concurrent", "edge_clear")
+WARNING = 1  # fmi2Warning and fmi3Warning
+#: the issue's thin plate: 0.5 mm of Al 6061 under the default 1/4 in S2 steel ball at 3 m/s (lambda = 17,
+#: e < 0), struck 10 mm from an edge; the FMUs' defaults are the paper's Table 3 pair
+THIN = {"plate.t": 0.5e-3, "v_approach": 3.0, "plate.edge_distance": 0.01}
+
+
+def package(v, t, edge):
+    ball, plate = r.MATERIALS["s2_tool_steel"], r.MATERIALS["al_6061"]
+    res = r.impact(v, **r.Sphere(ball, 6.35e-3).params(), **r.Plate(plate, t).params(), plate_edge_distance=edge)
+    return published(res.as_dict())
+
+
+def simulate(fmu, start_values, stop_time=0.01):
+    said = []
+    result = simulate_fmu(str(fmu), start_values=start_values, output=list(MONITORS) + ["e"], stop_time=stop_time,
+                          output_interval=stop_time / 10, debug_logging=True,
+                          logger=lambda *args: said.append(tuple(args[-3:])))
+    messages = [(status, category.decode(), text.decode()) for status, category, text in said]
+    return result, messages
+
+
+def test_the_monitors_are_the_packages_published_values(any_version_impact_fmu):
+    result, _ = simulate(any_version_impact_fmu, THIN)
+    want = package(3.0, 0.5e-3, 0.01)
+    last = result[-1]
+    for name, field in zip(MONITORS, FIELDS):
+        if isinstance(want[field], bool):
+            assert bool(last[name]) == want[field], name
+        else:  # ratios of tau0 and of a wave time to the contact time: a few ulps of conditioning
+            assert last[name] == pytest.approx(want[field], rel=1e-12), name
+
+
+def test_an_unbounded_plate_publishes_the_echo_cap(any_version_impact_fmu):
+    result, messages = simulate(any_version_impact_fmu, {"v_approach": 2.3})
+    assert result[-1]["monitor.edge_echo"] == 1e9 and bool(result[-1]["monitor.edge_clear"])
+    assert not [m for m in messages if m[0] == WARNING]  # the paper's case: nothing to say
+    assert math.isclose(result[-1]["monitor.wave_delay"], package(2.3, 6.35e-3, 0.0)["wave_delay"], rel_tol=1e-12)
+
+
+def test_a_departure_is_logged_once_per_instance_and_condition(any_version_impact_fmu):
+    """Ten steps of the same impact, one message per condition, in the package's words."""
+    _, messages = simulate(any_version_impact_fmu, THIN)
+    warned = [(category, text) for status, category, text in messages if status == WARNING]
+    expected = [text for _name, text in departures(package(3.0, 0.5e-3, 0.01))]
+    assert [text for _c, text in warned] == expected and len(expected) == 3
+    assert {category for category, _t in warned} == {"logStatusWarning"}
