@@ -237,11 +237,14 @@ class SweepStatistics:
         """The statistics of ``names`` (those kept) as a compact aligned table, with units."""
         counts = self.counts()
         n_out = counts["cases"] - counts["ok"]
+        names = [name for name in names if name in self.names]
+        if not names:
+            return f"statistics: none of {', '.join(KEYWORDS.get(n, n) for n in MAIN_OUTPUTS)} is kept by --columns"
         whole = self.whole()
         head = (f"statistics of {counts['cases']:,} cases ({counts['ok']:,} evaluated, {n_out:,} with inputs "
                 f"out of range{', left out' if n_out else ''}):")
         rows = [("output", "unit", "mean", "std", "p2.5", "p50", "p97.5", "mean 95% CI")]
-        for name in (n for n in names if n in self.names):
+        for name in names:
             s = whole[name]
             mean, half = s["mean"][0], s["ci_half"][0]
             label = KEYWORDS.get(name, name)
