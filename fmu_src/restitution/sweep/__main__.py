@@ -405,11 +405,11 @@ def _main(parser, args) -> int:
             print(f"COR map: {result.plot(plot, statistics=statistics)}")
         except ModuleNotFoundError as exc:
             print(f"no COR map ({exc}; pip install matplotlib)", file=sys.stderr)
-        except ValueError as exc:  # --columns left out what it draws: the table and summary are written
-            print(f"no COR map: {exc} (keep it with --columns)", file=sys.stderr)
         except (OutputWriteError, OutputPathError) as exc:
             status = EXIT_REFUSED if isinstance(exc, OutputPathError) else EXIT_IO_ERROR
             return _error(f"{exc}; the table was written to {out}", status)
+        except ValueError as exc:  # --columns left out what it draws (after OutputPathError, a ValueError too)
+            print(f"no COR map: {exc} (keep it with --columns)", file=sys.stderr)
     return status
 
 
