@@ -12,6 +12,7 @@ checked before any work, and written whole or not at all. One copy of this logic
 - :class:`GrowingOutput` is a text file written record by record (a scene's drops): each record is
   fsynced and visible under the final name as soon as it is whole; an I/O error puts back the file
   that was there before (or removes the new one).
+- :func:`write_json` writes a JSON record that way (non-finite numbers as null, numpy scalars as numbers).
 - An I/O error (ENOSPC, EIO, EACCES, ...) is an :class:`OutputWriteError`, whose text is one line
   naming the path and the system's reason; the tools print it and exit with :data:`EXIT_IO_ERROR`.
 """
@@ -20,13 +21,15 @@ from __future__ import annotations
 import contextlib
 import errno
 import itertools
+import json
+import math
 import os
 import stat
 import tempfile
 from pathlib import Path
 
 __all__ = ["EXIT_REFUSED", "EXIT_IO_ERROR", "OutputPathError", "OutputWriteError", "os_reason", "describe_os_error",
-           "file_kind", "check_output", "check_output_dir", "atomic_write", "GrowingOutput"]
+           "file_kind", "check_output", "check_output_dir", "atomic_write", "json_ready", "write_json", "GrowingOutput"]
 
 #: Exit status of an output path refused before any work (a user mistake, as the other ones).
 EXIT_REFUSED = 2
@@ -220,6 +223,26 @@ def atomic_write(path, write, what: str = "output", durable: bool = True) -> Pat
         _remove(tmp)
         raise
     return path
+
+
+def json_ready(value):
+    """``value`` with every non-finite float as None (JSON has no NaN) and numpy scalars and arrays
+    as Python numbers and lists, through dicts, lists and tuples."""
+    if hasattr(value, "tolist") and not isinstance(value, (str, bytes)):  # a numpy scalar or array
+        value = value.tolist()
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    if isinstance(value, dict):
+        return {k: json_ready(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [json_ready(v) for v in value]
+    return value
+
+
+def write_json(path, data, what: str = "output") -> Path:
+    """``data`` as indented JSON in ``path`` (:func:`json_ready`, then :func:`atomic_write`)."""
+    text = json.dumps(json_ready(data), indent=1, allow_nan=False) + "\n"
+    return atomic_write(path, lambda tmp: Path(tmp).write_text(text, encoding="utf-8"), what)
 
 
 class GrowingOutput:

@@ -3,7 +3,6 @@ and :func:`plot` (``--plot``: the data, the fitted e(v) or bounce train with its
 outside the model's validated range marked)."""
 from __future__ import annotations
 
-import json
 import math
 
 import numpy as np
@@ -62,24 +61,11 @@ def table(calibration) -> str:
     return "\n".join(lines)
 
 
-def _json_ready(value):
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    if isinstance(value, dict):
-        return {k: _json_ready(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_json_ready(v) for v in value]
-    if isinstance(value, np.generic):
-        return _json_ready(value.item())
-    return value
-
-
 def write_json(path, calibration) -> None:
     """``calibration.to_dict()`` into ``path``, atomically (non-finite numbers as null)."""
-    from ..output_files import atomic_write
+    from ..output_files import write_json as write_record
 
-    text = json.dumps(_json_ready(calibration.to_dict()), indent=1, allow_nan=False) + "\n"
-    atomic_write(path, lambda tmp: tmp.write_text(text, encoding="utf-8"), "--json")
+    write_record(path, calibration.to_dict(), "--json")
 
 
 def band_params(calibration, draws: int = 400) -> list[dict]:

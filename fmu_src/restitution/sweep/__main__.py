@@ -191,6 +191,9 @@ def main(argv=None) -> int:
     parser.add_argument("--out", help="table: .csv or .parquet (default: sweep.parquet with pyarrow, else sweep.csv)")
     parser.add_argument("--plot", help="COR map image (default: <out>_cor_map.png)")
     parser.add_argument("--no-plot", action="store_true", help="skip the COR map")
+    parser.add_argument("--summary", metavar="FILE", help="JSON: mean, std, percentiles and the mean's 95 %% "
+                                                          "interval of every output, the out-of-range cases, the draws "
+                                                          "(printed for the main outputs whenever there are --random inputs)")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
     parser.add_argument("--dry-run", action="store_true", help="print what the sweep covers and stop")
     parser.add_argument("--list", action="store_true", help="list parameter names and materials and stop")
@@ -261,6 +264,7 @@ def _main(parser, args) -> int:
     plot = None if (args.no_plot or run.get("plot") is False) else Path(
         args.plot or run.get("plot") or out.with_name(out.stem + "_cor_map.png"))
     parts = out.with_name(out.name + ".parts")
+    summary = args.summary or run.get("summary")
     print(f"sweep: {spec.describe()}")
 
     n_backends = 2 if backend == "both" else 1
@@ -284,6 +288,12 @@ def _main(parser, args) -> int:
             check_output(plot, "--plot")
             if os.path.realpath(plot) == os.path.realpath(out):
                 raise OutputPathError(f"--plot {plot}: is the table's file (--out {out}); give another name")
+        if summary is not None:
+            check_output(summary, "--summary")
+            taken = {os.path.realpath(p): o for p, o in ((out, "--out"), (plot, "--plot")) if p is not None}
+            if os.path.realpath(summary) in taken:
+                raise OutputPathError(f"--summary {summary}: is the file of {taken[os.path.realpath(summary)]}; "
+                                      f"give another name")
     except OutputPathError as exc:
         return _error(str(exc), EXIT_REFUSED)
     try:
@@ -303,6 +313,7 @@ def _main(parser, args) -> int:
     from .cluster import open_client
     from .parts import PartError, ResumeError
     from .run import SweepInterrupted, run_sweep
+    from .statistics import SweepStatistics, write_summary
 
     if plan.stream:
         print(f"sweep: {plan.describe()}", file=sys.stderr)
@@ -312,6 +323,8 @@ def _main(parser, args) -> int:
     if args.resume and not all((parts / name / "manifest.json").is_file() for name in backends):
         print(f"--resume: no finished chunks in {parts}: the whole sweep runs", file=sys.stderr)
     results = {}
+    # gathered from the chunks as they come (and from the kept parts on --resume) of the written table's back end
+    statistics = SweepStatistics(spec, keep_columns(columns)) if spec.random or summary else None
     try:
         with contextlib.ExitStack() as stack:
             target = "serial"
@@ -322,7 +335,8 @@ def _main(parser, args) -> int:
                     parser.error(f"--scheduler {scheduler}: cannot connect: {exc}")
             for name in backends:
                 res = run_sweep(spec, name, fmu=fmu, scheduler=target, chunk_size=chunk, progress=progress,
-                                columns=columns, parts=parts / name, resume=args.resume, in_memory=not plan.stream)
+                                columns=columns, parts=parts / name, resume=args.resume, in_memory=not plan.stream,
+                                observe=statistics.add if statistics is not None and name == backends[0] else None)
                 print(res.summary())
                 results[name] = res
     except SweepInterrupted as exc:
@@ -375,17 +389,27 @@ def _main(parser, args) -> int:
     for res in results.values():
         if res.warning():
             print(f"{res.backend}: {res.warning()}", file=sys.stderr)
+    if spec.random:
+        print(statistics.text())
+    if summary is not None:
+        try:
+            print(f"summary: {write_summary(summary, statistics.summary(backend=result.backend))}")
+        except (OutputWriteError, OutputPathError) as exc:
+            return _error(f"{exc}; the table was written to {out}",
+                          EXIT_REFUSED if isinstance(exc, OutputPathError) else EXIT_IO_ERROR)
     if plot is not None and plan.stream:
         print(f"no COR map: the table is too big for memory (streamed to {out}); plot a smaller sweep",
               file=sys.stderr)
     elif plot is not None:
         try:
-            print(f"COR map: {result.plot(plot)}")
+            print(f"COR map: {result.plot(plot, statistics=statistics)}")
         except ModuleNotFoundError as exc:
             print(f"no COR map ({exc}; pip install matplotlib)", file=sys.stderr)
         except (OutputWriteError, OutputPathError) as exc:
             status = EXIT_REFUSED if isinstance(exc, OutputPathError) else EXIT_IO_ERROR
             return _error(f"{exc}; the table was written to {out}", status)
+        except ValueError as exc:  # --columns left out what it draws (after OutputPathError, a ValueError too)
+            print(f"no COR map: {exc} (keep it with --columns)", file=sys.stderr)
     return status
 
 

@@ -1,4 +1,5 @@
-"""COR map of a sweep: e against approach speed and t/d, one panel per material pair (matplotlib)."""
+"""COR map of a sweep: e against approach speed and t/d, one panel per material pair (matplotlib); for a
+sweep with random draws, the distribution of e (a histogram, or its median and 95 % band along a grid axis)."""
 from __future__ import annotations
 
 import math
@@ -7,9 +8,10 @@ from pathlib import Path
 import numpy as np
 
 from ..output_files import atomic_write
-from .spec import pair_label
+from .spec import T_OVER_D, pair_label
+from .values import unit_of
 
-__all__ = ["plot_cor_map"]
+__all__ = ["plot_cor_map", "plot_random"]
 
 LAMBDA_MAX = 1.5  #: Zener's studied range, lambda <= 1.5
 VSTAR_MAX = 1000.0  #: range of the JGM fits, V* <= 1000
@@ -68,14 +70,24 @@ def fit_title(fig, title: str, fontsize: float = 10):
     return text
 
 
-def plot_cor_map(result, path, title: str | None = None, dpi: int = 120) -> Path:
+def plot_cor_map(result, path, title: str | None = None, dpi: int = 120, statistics=None) -> Path:
     """Draw e over (v_approach, t/d) for each material pair of a :class:`SweepResult` into ``path``.
 
     A grid sweep gives a colour map (each cell the mean e of its cases, with e contours and
     a dashed line where the validity range ends: lambda <= 1.5 and V* <= 1000), or curves when one
-    of the two takes at most :data:`MAX_CURVES` values (one curve per value); scattered (random)
-    cases are drawn as coloured points; a sweep over only one of the two is drawn as a curve.
+    of the two takes at most :data:`MAX_CURVES` values (one curve per value); cases off a grid
+    are drawn as coloured points; a sweep over only one of the two is drawn as a curve.
+    A sweep with random draws is drawn by :func:`plot_random` (from ``statistics``, a
+    :class:`~restitution.sweep.statistics.SweepStatistics` of it, gathered here if not given).
     """
+    spec = getattr(result, "spec", None)
+    if spec is not None and spec.random:
+        if statistics is None:
+            from .statistics import SweepStatistics
+
+            statistics = SweepStatistics(spec, keep=set(result.columns))
+            statistics.add(result.columns)
+        return plot_random(statistics, path, title=title, dpi=dpi)
     import matplotlib
 
     matplotlib.use("Agg", force=False)
@@ -101,7 +113,6 @@ def plot_cor_map(result, path, title: str | None = None, dpi: int = 120) -> Path
                              constrained_layout=True)
     mappable = None
     boundary = False
-    scattered = bool(getattr(getattr(result, "spec", None), "random", None))  # random draws: points
     for k, pair in enumerate(pairs):
         ax = axes[k // ncols][k % ncols]
         sel = (cols["pair"] == pair) & ok
@@ -118,7 +129,7 @@ def plot_cor_map(result, path, title: str | None = None, dpi: int = 120) -> Path
         if uv.size > 1 and ut.size > 1:
             logv, logt = _log_axis(uv), _log_axis(ut)
             cells = uv.size * ut.size
-            gridded = not scattered and cells <= 4 * e.size and np.unique(iv * ut.size + it).size == cells
+            gridded = cells <= 4 * e.size and np.unique(iv * ut.size + it).size == cells
             if gridded and min(uv.size, ut.size) <= MAX_CURVES and uv.size != ut.size:
                 # a few values of one input over many of the other (COR against thickness at 1, 3 and
                 # 5 m/s): one curve per value, not a colour map of a few wide blocks
@@ -162,7 +173,7 @@ def plot_cor_map(result, path, title: str | None = None, dpi: int = 120) -> Path
         else:
             x, name = (v, "approach speed v [m/s]") if uv.size > 1 else (td, "t/d")
             order = np.argsort(x, kind="stable")
-            if np.unique(x).size == x.size and not scattered:
+            if np.unique(x).size == x.size:
                 ax.plot(x[order], e[order], "-", lw=1.2)
             else:
                 ax.plot(x, e, ".", ms=2, alpha=0.5)
@@ -184,9 +195,110 @@ def plot_cor_map(result, path, title: str | None = None, dpi: int = 120) -> Path
         elif not valid_all.all():
             title += "; red marks: outside the validated range"
     fit_title(fig, title, fontsize=10)
+    return _save(fig, path, dpi)
+
+
+def _save(fig, path, dpi) -> Path:
+    import matplotlib.pyplot as plt
+
     path = Path(path)
     try:  # under a temporary name, renamed when whole (restitution.output_files)
         atomic_write(path, lambda tmp: fig.savefig(tmp, dpi=dpi), "COR map")
     finally:
         plt.close(fig)
     return path
+
+
+def _axis_label(name: str) -> str:
+    """An input's axis label with its SI unit: ``v_approach [m/s]``, ``t/d [1]``."""
+    if name == T_OVER_D:
+        return "plate thickness / sphere diameter t/d [1]"
+    return f"{name} [{unit_of(name) or '1'}]"
+
+
+def _draws_text(spec) -> str:
+    """What a random sweep drew and held: ``plate.Sy ~ uniform_rel:0.15; fixed plate.t = 3mm``."""
+    text = "; ".join(f"{name} ~ {given}" for name, given in spec.random.items())
+    if spec.fixed:
+        text += "; " + ", ".join(f"{name} = {value}{'' if isinstance(value, str) or not unit_of(name) else ' ' + unit_of(name)}"
+                                 for name, value in spec.fixed.items())
+    return text
+
+
+def plot_random(statistics, path, title: str | None = None, dpi: int = 120) -> Path:
+    """The distribution of e in a sweep with random draws, one panel per material pair, from its
+    :class:`~restitution.sweep.statistics.SweepStatistics`: with no grid axis besides the pairs, a
+    histogram of e with its mean and its 2.5 and 97.5 % percentiles marked; with grid axes, e against
+    the longest one, its median per grid point and the band between the 2.5 and 97.5 % percentiles
+    (one band per value of the other axes, up to :data:`MAX_CURVES`; medians only beyond)."""
+    import matplotlib
+
+    matplotlib.use("Agg", force=False)
+    import matplotlib.pyplot as plt
+
+    if "e" not in statistics.names:
+        raise ValueError("the plot of a random sweep needs the column 'e'")
+    spec = statistics.spec
+    stats, coords = statistics.by_point(["e"])
+    e = stats["e"]
+    axes = sorted((a for a in coords if a != "pair"), key=lambda a: -np.unique(coords[a]).size)
+    pair_of = coords["pair"].astype(int) if "pair" in coords else np.zeros(spec.n_grid, dtype=int)
+    labels = spec.pairs or [""]
+    ncols = min(3, len(labels))
+    nrows = math.ceil(len(labels) / ncols)
+    fig, grid = plt.subplots(nrows, ncols, figsize=(4.6 * ncols + 0.8, 3.9 * nrows), squeeze=False,
+                             constrained_layout=True)
+    values, points = statistics.values("e") if not axes else (None, None)
+    for k, pair in enumerate(labels):
+        ax = grid[k // ncols][k % ncols]
+        ax.set_title(pair_label(pair), fontsize=10)
+        here = np.flatnonzero(pair_of == k)
+        if not axes:  # random draws around one point: their histogram
+            v = values if points is None else values[points == k]
+            v = v[np.isfinite(v)]
+            if v.size == 0:
+                ax.text(0.5, 0.5, "no case with inputs in range", ha="center", va="center", transform=ax.transAxes)
+                continue
+            ax.hist(v, bins=min(60, max(10, int(np.sqrt(v.size)))), color="tab:blue", alpha=0.75)
+            ax.axvline(e["mean"][k], color="k", lw=1.4, label=f"mean {e['mean'][k]:.4g}")
+            for p, style in (("p2.5", "--"), ("p97.5", "--")):
+                ax.axvline(e[p][k], color="tab:red", lw=1.1, ls=style)
+            ax.plot([], [], "--", color="tab:red", label=f"2.5-97.5 %: {e['p2.5'][k]:.4g} ... {e['p97.5'][k]:.4g}")
+            ax.set(xlabel="apparent COR e [1]", ylabel="cases per bin")
+            ax.legend(fontsize=7)
+            continue
+        x_axis, others = axes[0], axes[1:]
+        x = coords[x_axis]
+        key = np.zeros(spec.n_grid, dtype=np.int64)  # one group per combination of the other axes' values
+        for other in others:
+            key = key * spec.n_grid + np.unique(coords[other], return_inverse=True)[1]
+        groups = np.unique(key[here])
+        banded = groups.size <= MAX_CURVES
+        for group in groups:
+            sel = here[key[here] == group]
+            sel = sel[np.argsort(x[sel], kind="stable")]
+            label = statistics.point_label(coords, sel[0], skip=("pair", x_axis)) or "median"
+            (line,) = ax.plot(x[sel], e["p50"][sel], "-", lw=1.3 if banded else 0.8, label=label if banded else None)
+            if banded:
+                ax.fill_between(x[sel], e["p2.5"][sel], e["p97.5"][sel], color=line.get_color(), alpha=0.25, lw=0)
+        ax.fill_between([], [], [], color="0.5", alpha=0.25, label="2.5-97.5 % of the draws")
+        if _log_axis(x[here]):
+            from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
+
+            ax.set_xscale("log")  # plain numbers at 1, 2, 5 per decade: an axis of less than two decades reads
+            ax.xaxis.set_major_locator(LogLocator(subs=(1.0, 2.0, 5.0)))
+            ax.xaxis.set_major_formatter(FuncFormatter(lambda value, _pos: f"{value:g}"))
+            ax.xaxis.set_minor_formatter(NullFormatter())
+        ax.set(xlabel=_axis_label(x_axis), ylabel="apparent COR e [1], median")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7)
+    for k in range(len(labels), nrows * ncols):
+        grid[k // ncols][k % ncols].set_visible(False)
+    if title is None:
+        counts = statistics.counts()
+        title = f"Apparent COR e (Green 2022), {counts['ok']:,} random cases"
+        if counts["cases"] > counts["ok"]:
+            title += f" ({counts['cases'] - counts['ok']:,} with inputs out of range left out)"
+        title += f": {_draws_text(spec)}"
+    fit_title(fig, title, fontsize=10)
+    return _save(fig, path, dpi)

@@ -80,7 +80,7 @@ def _chunks(n: int, chunk_size: int):
 def run_sweep(spec: SweepSpec | dict, backend: str | Backend = "package", *, fmu=None, scheduler=None,
               n_workers: int | None = None, chunk_size: int | None = None, progress: bool = False,
               columns=None, release: bool = True, parts=None, resume: bool = False,
-              in_memory: bool = True) -> SweepResult:
+              in_memory: bool = True, observe=None) -> SweepResult:
     """Evaluate every case of ``spec`` and return the table.
 
     ``backend``: "package" (vectorized :func:`restitution.impact`) or "fmu" (the FMU at ``fmu``,
@@ -97,7 +97,10 @@ def run_sweep(spec: SweepSpec | dict, backend: str | Backend = "package", *, fmu
     ``parts``: directory where each finished chunk is written as it completes; ``resume=True``
     keeps the chunks already there (same spec, back end, chunk size and columns) and evaluates
     only the missing ones. ``in_memory=False`` (needs ``parts``): the chunks are not gathered, a
-    :class:`DiskSweepResult` streams the table from ``parts`` when written. An interrupt raises
+    :class:`DiskSweepResult` streams the table from ``parts`` when written. ``observe``: called with
+    the columns (a dict) of every chunk of the table as it is taken: each finished chunk, and with
+    ``resume`` each one kept from ``parts`` (as the part store checks it), in no particular order
+    (:class:`~restitution.sweep.statistics.SweepStatistics.add`). An interrupt raises
     :class:`SweepInterrupted` with the finished chunks' table.
     """
     if isinstance(spec, dict):
@@ -113,7 +116,7 @@ def run_sweep(spec: SweepSpec | dict, backend: str | Backend = "package", *, fmu
     n = spec.n_cases
     keep = keep_columns(columns)
     store = None if parts is None else PartStore(Path(parts))
-    run = _Run(spec, backend, keep, store, in_memory)
+    run = _Run(spec, backend, keep, store, in_memory, observe)
 
     if scheduler == "serial":
         chunk_size = _chunk_size(store, resume, chunk_size or backend.default_chunk)
@@ -213,23 +216,27 @@ def run_sweep(spec: SweepSpec | dict, backend: str | Backend = "package", *, fmu
 class _Run:
     """The finished chunks of one run: in memory (start -> (columns, info); the columns as they came,
     packed from a worker), or on disk only (start -> (None, info)) when ``in_memory`` is false;
-    written to ``store`` as they finish."""
+    written to ``store`` as they finish; each chunk's columns shown to ``observe`` (if given) once."""
 
-    def __init__(self, spec, backend, keep, store, in_memory: bool):
+    def __init__(self, spec, backend, keep, store, in_memory: bool, observe=None):
         self.spec, self.backend, self.keep, self.store, self.in_memory = spec, backend, keep, store, in_memory
+        self.observe = observe
         self.done = {}
 
     def open(self, chunk_size, resume, n_chunks, where, workers):
         self.n_chunks, self.where, self.workers = n_chunks, where, workers
         if self.store is not None:
             self.done = self.store.open(self.spec, self.backend, chunk_size, self.keep, resume,
-                                        load_columns=self.in_memory)
+                                        load_columns=self.in_memory, observe=self.observe)
         self.t0 = time.perf_counter()
 
     def finished(self, a, b, part):
         columns, info = part
+        plain = columns.columns() if isinstance(columns, PackedColumns) else columns  # views: no copy
         if self.store is not None:
-            self.store.write(a, b, (columns.columns() if isinstance(columns, PackedColumns) else columns, info))
+            self.store.write(a, b, (plain, info))
+        if self.observe is not None:
+            self.observe(plain)
         self.done[a] = (columns if self.in_memory else None, info)
 
     def result(self) -> SweepResult:
