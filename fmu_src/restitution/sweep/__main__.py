@@ -10,7 +10,8 @@ from pathlib import Path
 from ..extras import MissingExtra, require
 from ..materials_table import text as materials_text
 from ..output_files import (EXIT_IO_ERROR, EXIT_REFUSED, OutputPathError, OutputWriteError,
-                            check_output, describe_os_error)
+                            atomic_write, check_output, describe_os_error)
+from .sobol import SOBOL_OUTPUTS, SobolCollector, SobolError, SobolSpec
 from .spec import CODES, INPUT_NAMES, INPUTS, MAX_SAMPLES, MAX_SEED, T_OVER_D, SweepSpec, canonical_name, load_spec
 from .values import QuantityError
 
@@ -55,6 +56,15 @@ def _error(text: str, status: int) -> int:
     return status
 
 
+def write_summary(path: Path, sections: dict) -> Path:
+    """The summary JSON (``--summary``): ``sections`` as one object, written under a temporary name and
+    renamed when whole (OutputWriteError / OutputPathError naming ``--summary``)."""
+    import json
+
+    text = json.dumps(sections, indent=1, allow_nan=False)
+    return atomic_write(path, lambda tmp: Path(tmp).write_text(text + "\n", encoding="utf-8"), "--summary")
+
+
 def _kept(parts: Path) -> str:
     n = sum(1 for _ in parts.glob("*/chunk-*.npz")) if parts.is_dir() else 0
     return f"the {n:,} finished chunk(s) are kept in {parts}" if n else f"no finished chunk is kept in {parts}"
@@ -73,6 +83,10 @@ EXAMPLES = """examples:
   # values with their units (a bare number is SI)
   python -m restitution.sweep --set sphere.d="1/4 in" --set plate.E=114GPa --grid plate.t=linspace:1mm:5mm:9 \\
       --grid v_approach=geomspace:10cm/s:10m/s:40 --out t.csv
+
+  # Sobol' indices of e, e_ep, e_ze and t_contact: 1024 base samples, 1024 x (2 + 2) cases
+  python -m restitution.sweep --random plate.t=uniform_rel:0.15 --random v_approach=uniform:0.5:3 \
+      --samples 1024 --sobol --summary sobol.json --out sobol.csv
 
   # the same sweep on an existing cluster
   python -m restitution.sweep spec.toml --scheduler tcp://scheduler-host:8786
@@ -102,8 +116,8 @@ def _list() -> str:
 
 def build_spec(args) -> tuple[SweepSpec, dict]:
     """The spec of the spec file and the options, with its explicit values checked against the inputs'
-    declared ranges, and its [run] table. A refused value is a :class:`QuantityError` naming the
-    option (or the spec file's table) that gave it."""
+    declared ranges (a Saltelli design, :class:`SobolSpec`, with --sobol), and its [run] table. A refused
+    value is a :class:`QuantityError` naming the option (or the spec file's table) that gave it."""
     data = load_spec(args.spec) if args.spec else {}
     if not isinstance(data, dict):
         raise ValueError(f"spec file {args.spec}: expected a table (pairs, grid, random, fixed, samples, seed, "
@@ -130,7 +144,7 @@ def build_spec(args) -> tuple[SweepSpec, dict]:
     if args.seed is not None:
         data["seed"] = args.seed
     try:
-        spec = SweepSpec.from_dict(data)
+        spec = (SobolSpec if args.sobol else SweepSpec).from_dict(data)
         spec.check_domain()  # explicit values inside the inputs' declared ranges, before any work
     except QuantityError as exc:
         raise QuantityError(_value_error(exc, given, args.spec), exc.name) from None
@@ -167,7 +181,12 @@ def main(argv=None) -> int:
                              "normal_rel:sd, uniform_rel:h, choice:a,b (repeat)")
     parser.add_argument("--set", action="append", metavar="NAME=VALUE",
                         help="fixed value, with a unit or SI: plate.t=3mm, plate.E=114GPa, sphere.d='1/4 in' (repeat)")
-    parser.add_argument("--samples", type=_int_in(1, MAX_SAMPLES), help="random cases per grid point")
+    parser.add_argument("--samples", type=_int_in(1, MAX_SAMPLES),
+                        help="random cases per grid point (--sobol: N base samples, a power of 2)")
+    parser.add_argument("--sobol", action="store_true",
+                        help="Sobol' indices of the --random inputs: a Saltelli design of N (D + 2) cases, "
+                             "S1 and ST of e, e_ep, e_ze, t_contact with 95%% bootstrap intervals (no grid)")
+    parser.add_argument("--summary", metavar="FILE", help="write the Sobol' indices (--sobol) to FILE (JSON)")
     parser.add_argument("--seed", type=_int_in(0, MAX_SEED), help="seed of the random draws (0 ... 2**63 - 1)")
     parser.add_argument("--backend", choices=("package", "fmu", "both"),
                         help="package: vectorized (default); fmu: the FMU itself; both: run both and "
@@ -215,9 +234,11 @@ def _main(parser, args) -> int:
 
     try:
         spec, run = build_spec(args)
+        if args.summary and not args.sobol:
+            raise SobolError("--summary writes the Sobol' indices: give --sobol")
         run_ints = {key: _int_in(low, high)(str(run[key])) for key, low, high in (
             ("workers", 1, MAX_WORKERS), ("chunk_size", 1, MAX_CHUNK)) if run.get(key) is not None}
-    except QuantityError as exc:  # a value: one line naming it, no usage
+    except (QuantityError, SobolError) as exc:  # a value, or a sweep --sobol cannot take: one line, no usage
         return _error(str(exc), EXIT_REFUSED)
     except (ValueError, argparse.ArgumentTypeError) as exc:
         parser.error(str(exc))
@@ -232,6 +253,8 @@ def _main(parser, args) -> int:
     columns = args.columns or run.get("columns")
     if isinstance(columns, str):
         columns = [c.strip() for c in columns.split(",") if c.strip()]
+    if args.sobol and columns is not None:  # the analysed outputs come from the chunks: they must travel
+        columns = list(dict.fromkeys([*columns, *SOBOL_OUTPUTS.values()]))
     try:
         keep_columns(columns)
     except ValueError as exc:
@@ -284,6 +307,8 @@ def _main(parser, args) -> int:
             check_output(plot, "--plot")
             if os.path.realpath(plot) == os.path.realpath(out):
                 raise OutputPathError(f"--plot {plot}: is the table's file (--out {out}); give another name")
+        if args.summary:
+            check_output(Path(args.summary), "--summary")
     except OutputPathError as exc:
         return _error(str(exc), EXIT_REFUSED)
     try:
@@ -312,6 +337,7 @@ def _main(parser, args) -> int:
     if args.resume and not all((parts / name / "manifest.json").is_file() for name in backends):
         print(f"--resume: no finished chunks in {parts}: the whole sweep runs", file=sys.stderr)
     results = {}
+    collectors = {name: SobolCollector(spec) for name in backends} if args.sobol else {}
     try:
         with contextlib.ExitStack() as stack:
             target = "serial"
@@ -322,7 +348,8 @@ def _main(parser, args) -> int:
                     parser.error(f"--scheduler {scheduler}: cannot connect: {exc}")
             for name in backends:
                 res = run_sweep(spec, name, fmu=fmu, scheduler=target, chunk_size=chunk, progress=progress,
-                                columns=columns, parts=parts / name, resume=args.resume, in_memory=not plan.stream)
+                                columns=columns, parts=parts / name, resume=args.resume, in_memory=not plan.stream,
+                                on_chunk=collectors.get(name))
                 print(res.summary())
                 results[name] = res
     except SweepInterrupted as exc:
@@ -375,6 +402,10 @@ def _main(parser, args) -> int:
     for res in results.values():
         if res.warning():
             print(f"{res.backend}: {res.warning()}", file=sys.stderr)
+    if args.sobol:
+        status = max(status, _sobol_report(collectors[backends[0]], args.summary))
+        if status == EXIT_IO_ERROR:
+            return status
     if plot is not None and plan.stream:
         print(f"no COR map: the table is too big for memory (streamed to {out}); plot a smaller sweep",
               file=sys.stderr)
@@ -387,6 +418,26 @@ def _main(parser, args) -> int:
             status = EXIT_REFUSED if isinstance(exc, OutputPathError) else EXIT_IO_ERROR
             return _error(f"{exc}; the table was written to {out}", status)
     return status
+
+
+def _sobol_report(collector, summary) -> int:
+    """Print the Sobol' indices (and why an output has none, and whether the intervals rank the inputs),
+    write them to ``summary``; the exit status: 1 when an output has no indices."""
+    from .sobol import format_indices, ranking_warning, refusals
+
+    section = collector.analyze()
+    print(format_indices(section))
+    for line in refusals(section):
+        print(f"python -m restitution.sweep: error: {line}", file=sys.stderr)
+    warning = ranking_warning(section)
+    if warning:
+        print(warning, file=sys.stderr)
+    if summary:
+        try:
+            print(f"summary: {write_summary(Path(summary), section)}")
+        except (OutputWriteError, OutputPathError) as exc:
+            return _error(str(exc), EXIT_IO_ERROR)
+    return 1 if section["refused"] else 0
 
 
 if __name__ == "__main__":
