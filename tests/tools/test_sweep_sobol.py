@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 from restitution.sweep import run_sweep
+from restitution.sweep import sobol
 from restitution.sweep.backends import Backend
 from restitution.sweep.__main__ import main as sweep_cli
 from restitution.sweep.sobol import (MAX_ST_CONF, RANK_GAP, SOBOL_OUTPUTS, SobolCollector, SobolSpec,
@@ -104,7 +105,7 @@ def test_ishigami_function_matches_its_known_indices():
         assert_close(section["sobol"]["e"][name], exact[name], name)
 
 
-def test_the_design_does_not_depend_on_chunks_and_resumed_chunks_are_collected(tmp_path):
+def test_the_design_does_not_depend_on_chunks_and_resumed_chunks_are_collected(tmp_path, monkeypatch):
     spec = SobolSpec.from_dict(dict(random={"v_approach": "uniform:1:2", "plate.t": "uniform_rel:0.1"},
                                     samples=64, seed=9))
     whole = spec.cases()
@@ -116,6 +117,13 @@ def test_the_design_does_not_depend_on_chunks_and_resumed_chunks_are_collected(t
     a, ab1, ab2, b = rows[:, 0], rows[:, 1], rows[:, 2], rows[:, 3]
     assert np.array_equal(ab1[:, 0], b[:, 0]) and np.array_equal(ab1[:, 1], a[:, 1])
     assert np.array_equal(ab2[:, 0], a[:, 0]) and np.array_equal(ab2[:, 1], b[:, 1])
+
+    # a design too big to travel with the tasks is built where the cases are: the same rows
+    monkeypatch.setattr(sobol, "SHIPPED_VALUES", 0)
+    built = SobolSpec.from_dict(dict(random={"v_approach": "uniform:1:2", "plate.t": "uniform_rel:0.1"},
+                                     samples=64, seed=9))
+    assert built._shipped is None and spec._shipped is not None
+    assert all(np.array_equal(built.cases(5, 99)[name], whole[name][5:99]) for name in ("v_approach", "plate.t"))
 
     first = SobolCollector(spec)
     run_sweep(spec, scheduler="serial", chunk_size=50, on_chunk=first, parts=tmp_path / "p")
@@ -227,3 +235,25 @@ def test_ranking_warning_criterion():
     assert "the ST intervals of b and a overlap" in overlap and overlap.endswith("more samples needed: --samples 2048")
     wide = ranking_warning(section_of(a=(0.9, MAX_ST_CONF + 0.01), b=(0.1, 0.01)))
     assert "ST_conf > 0.1 for a" in wide and wide.count("\n") == 0
+
+
+def test_a_dask_run_gives_the_serial_indices_with_the_design_shipped_or_built_on_the_workers(monkeypatch):
+    from restitution.sweep import open_client
+
+    spec_dict = dict(pairs=["s2_tool_steel/al_6061"], random={"v_approach": "uniform:0.5:3", "plate.t": "uniform_rel:0.2"},
+                     samples=128, seed=2)
+    serial = SobolCollector(SobolSpec.from_dict(spec_dict))
+    run_sweep(serial.spec, scheduler="serial", on_chunk=serial)
+    monkeypatch.setattr(sobol, "SHIPPED_VALUES", 0)  # in this process only: the second spec carries no design
+    specs = [serial.spec, SobolSpec.from_dict(spec_dict)]
+    assert specs[1]._shipped is None
+    with open_client("local", n_workers=2) as client:
+        for spec in specs:
+            collector = SobolCollector(spec)
+            run_sweep(spec, scheduler=client, chunk_size=100, on_chunk=collector)
+            # the same cases (numpy may round a case's last bit differently where a chunk cuts the arrays)
+            got, expected = collector.analyze()["sobol"], serial.analyze()["sobol"]
+            assert got.keys() == expected.keys()
+            for key in got:
+                for name in got[key]:
+                    assert got[key][name] == pytest.approx(expected[key][name], rel=1e-9, abs=1e-12)
