@@ -85,7 +85,7 @@ EXAMPLES = """examples:
       --grid v_approach=geomspace:10cm/s:10m/s:40 --out t.csv
 
   # Sobol' indices of e, e_ep, e_ze and t_contact: 1024 base samples, 1024 x (2 + 2) cases
-  python -m restitution.sweep --random plate.t=uniform_rel:0.15 --random v_approach=uniform:0.5:3 \
+  python -m restitution.sweep --random plate.t=uniform_rel:0.15 --random v_approach=uniform:0.5:3 \\
       --samples 1024 --sobol --summary sobol.json --out sobol.csv
 
   # the same sweep on an existing cluster
