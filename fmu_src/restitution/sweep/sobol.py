@@ -109,7 +109,7 @@ def saltelli_design(problem: dict, n: int, seed: int) -> np.ndarray:
 @dataclass
 class SobolSpec(SweepSpec):
     """A sweep whose cases are the Saltelli design of its random inputs: ``base_samples`` (N, a power
-    of 2) base samples, ``samples`` = N (D + 2) cases. Build it with :meth:`from_sweep`."""
+    of 2) base samples, ``samples`` = N (D + 2) cases. Build it with :meth:`from_dict`."""
 
     base_samples: int = 0
 
