@@ -11,6 +11,7 @@ from ..extras import MissingExtra, require
 from ..materials_table import text as materials_text
 from ..output_files import (EXIT_IO_ERROR, EXIT_REFUSED, OutputPathError, OutputWriteError,
                             check_output, describe_os_error)
+from .sobol import SOBOL_OUTPUTS, SobolCollector, SobolError, SobolSpec
 from .spec import CODES, INPUT_NAMES, INPUTS, MAX_SAMPLES, MAX_SEED, T_OVER_D, SweepSpec, canonical_name, load_spec
 from .values import QuantityError
 
@@ -55,6 +56,18 @@ def _error(text: str, status: int) -> int:
     return status
 
 
+def _hooks(*hooks):
+    """One ``on_chunk`` hook that calls each of ``hooks`` that is not None (None when none is)."""
+    hooks = [h for h in hooks if h is not None]
+    if len(hooks) < 2:
+        return hooks[0] if hooks else None
+
+    def every(start, stop, columns):
+        for hook in hooks:
+            hook(start, stop, columns)
+    return every
+
+
 def _kept(parts: Path) -> str:
     n = sum(1 for _ in parts.glob("*/chunk-*.npz")) if parts.is_dir() else 0
     return f"the {n:,} finished chunk(s) are kept in {parts}" if n else f"no finished chunk is kept in {parts}"
@@ -73,6 +86,10 @@ EXAMPLES = """examples:
   # values with their units (a bare number is SI)
   python -m restitution.sweep --set sphere.d="1/4 in" --set plate.E=114GPa --grid plate.t=linspace:1mm:5mm:9 \\
       --grid v_approach=geomspace:10cm/s:10m/s:40 --out t.csv
+
+  # Sobol' indices of e, e_ep, e_ze and t_contact: 1024 base samples, 1024 x (2 + 2) cases
+  python -m restitution.sweep --random plate.t=uniform_rel:0.15 --random v_approach=uniform:0.5:3 \\
+      --samples 1024 --sobol --summary sobol.json --out sobol.csv
 
   # the same sweep on an existing cluster
   python -m restitution.sweep spec.toml --scheduler tcp://scheduler-host:8786
@@ -102,8 +119,8 @@ def _list() -> str:
 
 def build_spec(args) -> tuple[SweepSpec, dict]:
     """The spec of the spec file and the options, with its explicit values checked against the inputs'
-    declared ranges, and its [run] table. A refused value is a :class:`QuantityError` naming the
-    option (or the spec file's table) that gave it."""
+    declared ranges (a Saltelli design, :class:`SobolSpec`, with --sobol), and its [run] table. A refused
+    value is a :class:`QuantityError` naming the option (or the spec file's table) that gave it."""
     data = load_spec(args.spec) if args.spec else {}
     if not isinstance(data, dict):
         raise ValueError(f"spec file {args.spec}: expected a table (pairs, grid, random, fixed, samples, seed, "
@@ -130,7 +147,7 @@ def build_spec(args) -> tuple[SweepSpec, dict]:
     if args.seed is not None:
         data["seed"] = args.seed
     try:
-        spec = SweepSpec.from_dict(data)
+        spec = (SobolSpec if args.sobol else SweepSpec).from_dict(data)
         spec.check_domain()  # explicit values inside the inputs' declared ranges, before any work
     except QuantityError as exc:
         raise QuantityError(_value_error(exc, given, args.spec), exc.name) from None
@@ -167,7 +184,11 @@ def main(argv=None) -> int:
                              "normal_rel:sd, uniform_rel:h, choice:a,b (repeat)")
     parser.add_argument("--set", action="append", metavar="NAME=VALUE",
                         help="fixed value, with a unit or SI: plate.t=3mm, plate.E=114GPa, sphere.d='1/4 in' (repeat)")
-    parser.add_argument("--samples", type=_int_in(1, MAX_SAMPLES), help="random cases per grid point")
+    parser.add_argument("--samples", type=_int_in(1, MAX_SAMPLES),
+                        help="random cases per grid point (--sobol: N base samples, a power of 2)")
+    parser.add_argument("--sobol", action="store_true",
+                        help="Sobol' indices of the --random inputs: a Saltelli design of N (D + 2) cases, "
+                             "S1 and ST of e, e_ep, e_ze, t_contact with 95%% bootstrap intervals (no grid)")
     parser.add_argument("--seed", type=_int_in(0, MAX_SEED), help="seed of the random draws (0 ... 2**63 - 1)")
     parser.add_argument("--backend", choices=("package", "fmu", "both"),
                         help="package: vectorized (default); fmu: the FMU itself; both: run both and "
@@ -193,7 +214,8 @@ def main(argv=None) -> int:
     parser.add_argument("--no-plot", action="store_true", help="skip the COR map")
     parser.add_argument("--summary", metavar="FILE", help="JSON: mean, std, percentiles and the mean's 95 %% "
                                                           "interval of every output, the out-of-range cases, the draws "
-                                                          "(printed for the main outputs whenever there are --random inputs)")
+                                                          "(printed for the main outputs whenever there are --random inputs), "
+                                                          "and with --sobol the indices")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
     parser.add_argument("--dry-run", action="store_true", help="print what the sweep covers and stop")
     parser.add_argument("--list", action="store_true", help="list parameter names and materials and stop")
@@ -220,7 +242,7 @@ def _main(parser, args) -> int:
         spec, run = build_spec(args)
         run_ints = {key: _int_in(low, high)(str(run[key])) for key, low, high in (
             ("workers", 1, MAX_WORKERS), ("chunk_size", 1, MAX_CHUNK)) if run.get(key) is not None}
-    except QuantityError as exc:  # a value: one line naming it, no usage
+    except (QuantityError, SobolError) as exc:  # a value, or a sweep --sobol cannot take: one line, no usage
         return _error(str(exc), EXIT_REFUSED)
     except (ValueError, argparse.ArgumentTypeError) as exc:
         parser.error(str(exc))
@@ -235,6 +257,8 @@ def _main(parser, args) -> int:
     columns = args.columns or run.get("columns")
     if isinstance(columns, str):
         columns = [c.strip() for c in columns.split(",") if c.strip()]
+    if args.sobol and columns is not None:  # the analysed outputs come from the chunks: they must travel
+        columns = list(dict.fromkeys([*columns, *SOBOL_OUTPUTS.values()]))
     try:
         keep_columns(columns)
     except ValueError as exc:
@@ -325,6 +349,7 @@ def _main(parser, args) -> int:
     results = {}
     # gathered from the chunks as they come (and from the kept parts on --resume) of the written table's back end
     statistics = SweepStatistics(spec, keep_columns(columns)) if spec.random or summary else None
+    sobol = SobolCollector(spec) if args.sobol else None
     try:
         with contextlib.ExitStack() as stack:
             target = "serial"
@@ -336,7 +361,7 @@ def _main(parser, args) -> int:
             for name in backends:
                 res = run_sweep(spec, name, fmu=fmu, scheduler=target, chunk_size=chunk, progress=progress,
                                 columns=columns, parts=parts / name, resume=args.resume, in_memory=not plan.stream,
-                                observe=statistics.add if statistics is not None and name == backends[0] else None)
+                                on_chunk=_hooks(statistics, sobol) if name == backends[0] else None)
                 print(res.summary())
                 results[name] = res
     except SweepInterrupted as exc:
@@ -391,9 +416,11 @@ def _main(parser, args) -> int:
             print(f"{res.backend}: {res.warning()}", file=sys.stderr)
     if spec.random:
         print(statistics.text())
+    sobol_section, sobol_status = _sobol_report(sobol) if sobol is not None else ({}, 0)
+    status = max(status, sobol_status)
     if summary is not None:
         try:
-            print(f"summary: {write_summary(summary, statistics.summary(backend=result.backend))}")
+            print(f"summary: {write_summary(summary, statistics.summary(backend=result.backend), sobol_section)}")
         except (OutputWriteError, OutputPathError) as exc:
             return _error(f"{exc}; the table was written to {out}",
                           EXIT_REFUSED if isinstance(exc, OutputPathError) else EXIT_IO_ERROR)
@@ -411,6 +438,23 @@ def _main(parser, args) -> int:
         except ValueError as exc:  # --columns left out what it draws (after OutputPathError, a ValueError too)
             print(f"no COR map: {exc} (keep it with --columns)", file=sys.stderr)
     return status
+
+
+def _sobol_report(collector) -> tuple[dict, int]:
+    """Print the Sobol' indices (and why an output has none, and whether the intervals rank the inputs);
+    (the summary's sections: ``sobol``, the indices, and ``sobol_design``, how they were made and what was
+    refused; the exit status: 1 when an output has no indices)."""
+    from .sobol import format_indices, ranking_warning, refusals
+
+    section = collector.analyze()
+    print(format_indices(section))
+    for line in refusals(section):
+        print(f"python -m restitution.sweep: error: {line}", file=sys.stderr)
+    warning = ranking_warning(section)
+    if warning:
+        print(warning, file=sys.stderr)
+    design = {key: value for key, value in section.items() if key != "sobol"}
+    return {"sobol": section["sobol"], "sobol_design": design}, 1 if section["refused"] else 0
 
 
 if __name__ == "__main__":

@@ -124,9 +124,9 @@ class PartStore:
         return self.path / f"chunk-{a:015d}-{b:015d}.npz"
 
     def open(self, spec, backend, chunk_size, keep, resume: bool, load_columns: bool = True,
-             observe=None) -> dict:
+             on_chunk=None) -> dict:
         """Chunks already finished (``resume``; start -> (columns, info), columns None unless
-        ``load_columns``; each chunk's columns shown to ``observe`` if given, as they are read), after checking that they belong to this sweep and that each part is
+        ``load_columns``; each chunk's columns shown to ``on_chunk(a, b, columns)`` if given, as they are read), after checking that they belong to this sweep and that each part is
         whole (a damaged one is removed, so its cases are computed again); without ``resume``, an
         empty directory."""
         manifest = json.loads(json.dumps({
@@ -176,8 +176,8 @@ class PartStore:
             except PartError as exc:
                 self._remove(file, chunk, exc.reason)
                 continue
-            if observe is not None:  # read for the check anyway: the statistics need no second read
-                observe(columns)
+            if on_chunk is not None:  # read for the check anyway: the analyses need no second read
+                on_chunk(a, b, columns)
             done[a] = (columns if load_columns else None, info)
         return done
 

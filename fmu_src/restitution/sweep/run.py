@@ -80,7 +80,7 @@ def _chunks(n: int, chunk_size: int):
 def run_sweep(spec: SweepSpec | dict, backend: str | Backend = "package", *, fmu=None, scheduler=None,
               n_workers: int | None = None, chunk_size: int | None = None, progress: bool = False,
               columns=None, release: bool = True, parts=None, resume: bool = False,
-              in_memory: bool = True, observe=None) -> SweepResult:
+              in_memory: bool = True, on_chunk=None) -> SweepResult:
     """Evaluate every case of ``spec`` and return the table.
 
     ``backend``: "package" (vectorized :func:`restitution.impact`) or "fmu" (the FMU at ``fmu``,
@@ -97,10 +97,12 @@ def run_sweep(spec: SweepSpec | dict, backend: str | Backend = "package", *, fmu
     ``parts``: directory where each finished chunk is written as it completes; ``resume=True``
     keeps the chunks already there (same spec, back end, chunk size and columns) and evaluates
     only the missing ones. ``in_memory=False`` (needs ``parts``): the chunks are not gathered, a
-    :class:`DiskSweepResult` streams the table from ``parts`` when written. ``observe``: called with
-    the columns (a dict) of every chunk of the table as it is taken: each finished chunk, and with
-    ``resume`` each one kept from ``parts`` (as the part store checks it), in no particular order
-    (:class:`~restitution.sweep.statistics.SweepStatistics.add`). An interrupt raises
+    :class:`DiskSweepResult` streams the table from ``parts`` when written. ``on_chunk(start, stop,
+    columns)`` is called in this process with each chunk's columns (cases ``start ... stop - 1``) as it
+    is finished, and with ``resume`` each one kept from ``parts`` as the part store checks it (no second
+    read), in no particular order, so that an analysis keeps the few columns it needs without reading the
+    table back (:class:`~restitution.sweep.statistics.SweepStatistics`,
+    :class:`~restitution.sweep.sobol.SobolCollector`). An interrupt raises
     :class:`SweepInterrupted` with the finished chunks' table.
     """
     if isinstance(spec, dict):
@@ -116,7 +118,7 @@ def run_sweep(spec: SweepSpec | dict, backend: str | Backend = "package", *, fmu
     n = spec.n_cases
     keep = keep_columns(columns)
     store = None if parts is None else PartStore(Path(parts))
-    run = _Run(spec, backend, keep, store, in_memory, observe)
+    run = _Run(spec, backend, keep, store, in_memory, on_chunk)
 
     if scheduler == "serial":
         chunk_size = _chunk_size(store, resume, chunk_size or backend.default_chunk)
@@ -216,18 +218,18 @@ def run_sweep(spec: SweepSpec | dict, backend: str | Backend = "package", *, fmu
 class _Run:
     """The finished chunks of one run: in memory (start -> (columns, info); the columns as they came,
     packed from a worker), or on disk only (start -> (None, info)) when ``in_memory`` is false;
-    written to ``store`` as they finish; each chunk's columns shown to ``observe`` (if given) once."""
+    written to ``store`` as they finish, and shown to ``on_chunk`` (see :func:`run_sweep`)."""
 
-    def __init__(self, spec, backend, keep, store, in_memory: bool, observe=None):
+    def __init__(self, spec, backend, keep, store, in_memory: bool, on_chunk=None):
         self.spec, self.backend, self.keep, self.store, self.in_memory = spec, backend, keep, store, in_memory
-        self.observe = observe
+        self.on_chunk = on_chunk
         self.done = {}
 
     def open(self, chunk_size, resume, n_chunks, where, workers):
         self.n_chunks, self.where, self.workers = n_chunks, where, workers
         if self.store is not None:
             self.done = self.store.open(self.spec, self.backend, chunk_size, self.keep, resume,
-                                        load_columns=self.in_memory, observe=self.observe)
+                                        load_columns=self.in_memory, on_chunk=self.on_chunk)
         self.t0 = time.perf_counter()
 
     def finished(self, a, b, part):
@@ -235,8 +237,8 @@ class _Run:
         plain = columns.columns() if isinstance(columns, PackedColumns) else columns  # views: no copy
         if self.store is not None:
             self.store.write(a, b, (plain, info))
-        if self.observe is not None:
-            self.observe(plain)
+        if self.on_chunk is not None:
+            self.on_chunk(a, b, plain)
         self.done[a] = (columns if self.in_memory else None, info)
 
     def result(self) -> SweepResult:

@@ -4,7 +4,7 @@ interval of the mean of every Real output the table keeps, over the cases the mo
 and the first of them listed.
 
 The statistics are gathered chunk by chunk as the sweep runs (:meth:`SweepStatistics.add` is the
-``observe`` hook of :func:`~restitution.sweep.run.run_sweep`: every finished chunk, and on
+``on_chunk`` hook of :func:`~restitution.sweep.run.run_sweep`: every finished chunk, and on
 ``--resume`` every chunk kept in the parts, as the part store checks it), never from the written
 table. Of a chunk only the evaluated values of the Real outputs are kept (8 bytes a value), with the
 grid point of each row when the sweep has a grid; the numbers are reduced once the sweep is whole,
@@ -109,7 +109,7 @@ class SweepStatistics:
     """The statistics of one sweep's outputs, gathered from its chunks (see the module docstring).
 
     ``keep``: the columns the table keeps (:func:`~restitution.sweep.table.keep_columns`; None: all).
-    Feed it every chunk with :meth:`add` (the ``observe`` hook of ``run_sweep``); then :meth:`summary`
+    Feed it every chunk with :meth:`add` (or call it: the ``on_chunk`` hook of ``run_sweep``); then :meth:`summary`
     (the JSON record), :meth:`text` (the table printed on screen), :meth:`by_point` (per grid point)."""
 
     def __init__(self, spec, keep=None):
@@ -131,6 +131,10 @@ class SweepStatistics:
         values = {name: np.asarray(columns[name], dtype=float)[ok] for name in self.names}
         points = case[ok] // self.spec.samples if self.spec.n_grid > 1 else None
         self._chunks[int(case[0])] = (values, points, table_counts(columns), case[~ok][:LISTED_CASES].tolist())
+
+    def __call__(self, start: int, stop: int, columns: dict) -> None:
+        """:meth:`add`, as ``run_sweep``'s ``on_chunk`` hook calls it (the chunk's cases start ... stop - 1)."""
+        self.add(columns)
 
     def __len__(self):
         """Cases taken so far."""

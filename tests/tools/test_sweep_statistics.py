@@ -150,14 +150,14 @@ def test_resumed_sweep_gives_the_statistics_of_a_whole_run(tmp_path, monkeypatch
 
 
 def test_resume_statistics_come_from_the_parts_loaded_for_the_check(tmp_path):
-    """run_sweep's observe hook sees the kept parts (read once, for their checksum) and the new chunks."""
+    """run_sweep's on_chunk hook sees the kept parts (read once, for their checksum) and the new chunks."""
     spec = SweepSpec(pairs=["s2_tool_steel/al_6061"], random={"plate.Sy": "uniform_rel:0.15"}, samples=300, seed=3)
     parts = tmp_path / "parts"
     run_sweep(spec, scheduler="serial", chunk_size=100, parts=parts)
     (parts / "chunk-000000000000100-000000000000200.npz").unlink()
     statistics = SweepStatistics(spec)
     res = run_sweep(spec, scheduler="serial", chunk_size=100, parts=parts, resume=True, in_memory=False,
-                    observe=statistics.add)
+                    on_chunk=statistics)
     assert len(statistics) == 300
     table = read_table(res.write(tmp_path / "t.csv"))
     assert statistics.summary()["outputs"]["e"]["mean"] == pytest.approx(np.mean(table["e"]), rel=1e-12)
