@@ -1,9 +1,10 @@
 """``restitution cor``: one coefficient of restitution, from the command line.
 
-    restitution cor --sphere chrome_steel --d "6.35 mm" --plate al_6061 --t "3 mm" --v "2 m/s" [--json FILE]
+    restitution cor --sphere chrome_steel --d "6.35 mm" --plate al_6061 --t "3 mm" --v "2 m/s" [--edge LEN] [--json FILE]
 
-prints e and what lies behind it (e_ep, e_ze, v_rebound, V*, lambda, the contact time and the validity
-flags), each with its unit. Lengths and the speed take any unit (a bare number is SI); a value outside
+prints e and what lies behind it (e_ep, e_ze, v_rebound, V*, lambda, the contact time, the validity
+flags and the monitors of the model's assumptions, docs/assumptions.md), each with its unit. ``--edge``:
+the distance from the impact point to the plate's nearest edge (default: an unbounded plate). Lengths and the speed take any unit (a bare number is SI); a value outside
 the model's domain (the ranges the FMUs declare) is refused in one line naming the quantity, with the
 likely slip ("did you mean 3 mm?"); an unknown material names the close ones. ``--json FILE`` writes the
 inputs and every field of the result in SI units.
@@ -16,28 +17,31 @@ import math
 import sys
 
 from .model import ZENER_METHODS, impact, published
+from .zener import WAVE_DELAY_LIMIT
 from .options import OptionError, input_quantity, material
 from .output_files import EXIT_IO_ERROR, EXIT_REFUSED, OutputPathError, atomic_write, check_output
 
 __all__ = ["main", "evaluate"]
 
 #: The options with a unit: option -> (FMU input name whose unit and range apply, impact keyword).
-QUANTITIES = {"d": ("sphere.d", "sphere_d"), "t": ("plate.t", "plate_t"), "v": ("v_approach", "v")}
+QUANTITIES = {"d": ("sphere.d", "sphere_d"), "t": ("plate.t", "plate_t"), "v": ("v_approach", "v"),
+              "edge": ("plate.edge_distance", "plate_edge_distance")}
 #: Units of the result's fields, as printed and in the JSON (SI).
 UNITS = {"e": "1", "e_ep": "1", "e_ze": "1", "v_rebound": "m/s", "V_c": "m/s", "V_star": "1", "eps_y": "1",
          "lam": "1", "tau0": "1", "T": "s", "t_contact": "s", "m_a": "kg", "m_eff": "kg", "mass_ratio": "1",
-         "v_plate": "m/s"}
+         "v_plate": "m/s", "wave_delay": "1", "edge_echo": "1"}
 
 
-def evaluate(sphere: str, d, plate: str, t, v, zener_method: str = "exact") -> tuple[dict, dict]:
+def evaluate(sphere: str, d, plate: str, t, v, zener_method: str = "exact", edge=None) -> tuple[dict, dict]:
     """(inputs in SI, the published result as a dict) for the named materials, the diameter ``d``, the
-    thickness ``t`` and the approach speed ``v`` (each a number in SI or a text with its unit).
+    thickness ``t``, the approach speed ``v`` and the edge distance ``edge`` (each a number in SI or a text
+    with its unit; ``edge`` None or 0: an unbounded plate).
     :class:`~restitution.options.OptionError` (one line) for an unknown material or a value outside the domain."""
     bodies = {"sphere": material("sphere", sphere), "plate": material("plate", plate)}
     values = {option: input_quantity(option, QUANTITIES[option][0], str(text))
-              for option, text in (("d", d), ("t", t), ("v", v))}
+              for option, text in (("d", d), ("t", t), ("v", v), ("edge", edge)) if text is not None}
     params = {**bodies["sphere"].params("sphere"), **bodies["plate"].params("plate"),
-              "sphere_d": values["d"], "plate_t": values["t"]}
+              "sphere_d": values["d"], "plate_t": values["t"], "plate_edge_distance": values.get("edge", 0.0)}
     result = published(impact(values["v"], **params, zener_method=zener_method).as_dict())
     inputs = {"sphere": sphere, "plate": plate, "v": values["v"], **params, "zener_method": zener_method}
     return inputs, {key: (bool(value) if isinstance(value, bool) or key not in UNITS else float(value))
@@ -63,6 +67,12 @@ def report(inputs: dict, r: dict) -> str:
         _line("t_contact", r["t_contact"], "contact duration"),
         f"  valid = {yes[r['valid']]}  (lambda <= 1.5: {yes[r['lambda_in_range']]}, V* <= 1000: "
         f"{yes[r['vstar_in_range']]}, e < 0: {yes[r['e_negative']]})",
+        f"  wave_delay = {r['wave_delay']:.6g}  contact time over its half-space value, tau0(lambda)/tau0(0); "
+        f"concurrent (<= {WAVE_DELAY_LIMIT}): {yes[r['concurrent']]}",
+        (f"  edge_echo = {r['edge_echo']:.6g}  first edge echo (2 a/c_L, a = {inputs['plate_edge_distance'] * 1e3:.6g} "
+         f"mm) over the contact time; edge_clear (>= 1): {yes[r['edge_clear']]}"
+         if inputs["plate_edge_distance"] > 0.0 else "  edge_echo: an unbounded plate (give --edge LEN for the "
+                                                     "edge monitor)"),
     ])
 
 
@@ -75,6 +85,8 @@ def main(argv=None) -> int:
     parser.add_argument("--plate", required=True, metavar="KEY", help="plate material")
     parser.add_argument("--t", required=True, metavar="LEN", help="plate thickness, e.g. \"3 mm\"")
     parser.add_argument("--v", required=True, metavar="SPEED", help="approach speed, e.g. \"2 m/s\"")
+    parser.add_argument("--edge", metavar="LEN", help="distance from the impact point to the plate's nearest "
+                                                      "edge, e.g. \"76 mm\" (default: an unbounded plate)")
     parser.add_argument("--zener-method", default="exact", choices=ZENER_METHODS,
                         help="Zener's COR and contact time (default: exact)")
     parser.add_argument("--json", metavar="FILE", help="write the inputs and every field of the result (SI)")
@@ -82,7 +94,7 @@ def main(argv=None) -> int:
     try:
         if args.json:
             check_output(args.json, "--json")
-        inputs, result = evaluate(args.sphere, args.d, args.plate, args.t, args.v, args.zener_method)
+        inputs, result = evaluate(args.sphere, args.d, args.plate, args.t, args.v, args.zener_method, args.edge)
     except (OptionError, OutputPathError) as exc:
         print(f"restitution cor: error: {exc}", file=sys.stderr)
         return EXIT_REFUSED

@@ -45,6 +45,21 @@ def test_a_unit_and_si_give_the_same_case():
     assert with_unit.stdout.splitlines()[1:] == bare.stdout.splitlines()[1:]
 
 
+def test_the_edge_monitor_takes_a_distance_with_a_unit():
+    """--edge 76.2 mm: the P-wave echo (2 a / c_L, c_L of Al 6061 from its Lame constants) over the contact time
+    the same command prints, to the 6 printed digits."""
+    done = _run("cor", *ARGS, "--edge", "76.2 mm")
+    assert done.returncode == 0, done.stderr
+    lines = {line.split(" = ")[0].strip(): line for line in done.stdout.splitlines() if " = " in line}
+    t_contact = float(lines["t_contact"].split()[2])
+    E, nu, rho = (float(table_material("al_6061")[k]) for k in ("E", "nu", "rho"))
+    c_l = ((E * nu / ((1 + nu) * (1 - 2 * nu)) + E / (1 + nu)) / rho) ** 0.5
+    assert float(lines["edge_echo"].split()[2]) == pytest.approx(2 * 0.0762 / c_l / t_contact, rel=2e-5)
+    assert "wave_delay" in lines and "concurrent" in lines["wave_delay"]
+    unbounded = _run("cor", *ARGS)
+    assert "an unbounded plate" in unbounded.stdout
+
+
 @pytest.mark.parametrize("change, words", [
     (("--v", "-1 m/s"), ["--v", "v_approach", "outside"]),
     (("--v", "2e5"), ["--v", "v_approach", "outside"]),
@@ -52,9 +67,10 @@ def test_a_unit_and_si_give_the_same_case():
     (("--d", "six"), ["--d", "sphere.d", "not a number"]),
     (("--sphere", "chrome_stel"), ["--sphere", "chrome_steel"]),
     (("--plate", "unobtainium"), ["--plate", "unknown material"]),
+    (("--edge", "-3 mm"), ["--edge", "plate.edge_distance", "outside"]),
 ])
 def test_bad_input_is_one_line_and_exit_2(change, words):
-    args = list(ARGS)
+    args = list(ARGS) + (["--edge", "1 m"] if change[0] == "--edge" else [])
     args[args.index(change[0]) + 1] = change[1]
     done = _run("cor", *args)
     assert done.returncode == 2 and done.stdout == ""
