@@ -2,11 +2,14 @@
 in fmpy: the outputs are the package's published values, and an impact outside the validated domain
 is logged once per instance and condition, with fmi2Warning / fmi3Warning in category
 logStatusWarning, in restitution.assumptions' words, while every call returns OK (fmpy's simulate_fmu
-raises on anything worse)."""
+raises on anything worse). Each simulation runs in a child process: simulate_fmu deletes the pythonfmu
+FMU's folder when done, which a later pythonfmu instantiation in the same process may not survive."""
+import json
 import math
+import subprocess
+import sys
 
 import pytest
-from fmpy import simulate_fmu
 
 import restitution as r
 from restitution.assumptions import departures
@@ -26,19 +29,33 @@ def package(v, t, edge):
     return published(res.as_dict())
 
 
+#: The child: simulate_fmu with debug logging on; prints the last row and every (status, category, message).
+CHILD = r"""
+import json, sys
+from fmpy import simulate_fmu
+fmu, start, outputs, stop = sys.argv[1], json.loads(sys.argv[2]), json.loads(sys.argv[3]), float(sys.argv[4])
+said = []
+result = simulate_fmu(fmu, start_values=start, output=outputs, stop_time=stop, output_interval=stop / 10,
+                      debug_logging=True, logger=lambda *args: said.append(args[-3:]))
+last = {name: (bool(result[-1][name]) if result.dtype[name].kind == "b" else float(result[-1][name]))
+        for name in outputs}
+print(json.dumps({"last": last, "said": [[int(s), c.decode(), m.decode()] for s, c, m in said]}))
+"""
+
+
 def simulate(fmu, start_values, stop_time=0.01):
-    said = []
-    result = simulate_fmu(str(fmu), start_values=start_values, output=list(MONITORS) + ["e"], stop_time=stop_time,
-                          output_interval=stop_time / 10, debug_logging=True,
-                          logger=lambda *args: said.append(tuple(args[-3:])))
-    messages = [(status, category.decode(), text.decode()) for status, category, text in said]
-    return result, messages
+    """(the outputs at the last time, [(status, category, message), ...]) of one simulate_fmu run."""
+    outputs = list(MONITORS) + ["e"]
+    done = subprocess.run([sys.executable, "-c", CHILD, str(fmu), json.dumps(start_values), json.dumps(outputs),
+                           repr(stop_time)], capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    data = json.loads(done.stdout.strip().splitlines()[-1])
+    return data["last"], [tuple(m) for m in data["said"]]
 
 
 def test_the_monitors_are_the_packages_published_values(any_version_impact_fmu):
-    result, _ = simulate(any_version_impact_fmu, THIN)
+    last, _ = simulate(any_version_impact_fmu, THIN)
     want = package(3.0, 0.5e-3, 0.01)
-    last = result[-1]
     for name, field in zip(MONITORS, FIELDS):
         if isinstance(want[field], bool):
             assert bool(last[name]) == want[field], name
@@ -47,10 +64,10 @@ def test_the_monitors_are_the_packages_published_values(any_version_impact_fmu):
 
 
 def test_an_unbounded_plate_publishes_the_echo_cap(any_version_impact_fmu):
-    result, messages = simulate(any_version_impact_fmu, {"v_approach": 2.3})
-    assert result[-1]["monitor.edge_echo"] == 1e9 and bool(result[-1]["monitor.edge_clear"])
+    last, messages = simulate(any_version_impact_fmu, {"v_approach": 2.3})
+    assert last["monitor.edge_echo"] == 1e9 and bool(last["monitor.edge_clear"])
     assert not [m for m in messages if m[0] == WARNING]  # the paper's case: nothing to say
-    assert math.isclose(result[-1]["monitor.wave_delay"], package(2.3, 6.35e-3, 0.0)["wave_delay"], rel_tol=1e-12)
+    assert math.isclose(last["monitor.wave_delay"], package(2.3, 6.35e-3, 0.0)["wave_delay"], rel_tol=1e-12)
 
 
 def test_a_departure_is_logged_once_per_instance_and_condition(any_version_impact_fmu):

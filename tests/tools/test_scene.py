@@ -437,3 +437,25 @@ def test_default_scene_results_are_ignored_by_git():
         pytest.skip("not a git checkout")
     probe = subprocess.run(["git", "check-ignore", "-q", "scene-results/any/any.csv"], cwd=ROOT)
     assert probe.returncode == 0
+
+
+def test_a_scene_outside_the_validated_domain_says_so_once_per_condition(impact_fmu):
+    """A 0.3 mm plate under a 1/4 in steel ball dropped from 0.5 m: lambda far above 1.5 and e < 0 at the first
+    impact. The FMU logs each condition once (a fresh instance: the count is per instance), and the result
+    gives those lines, naming the drop, in restitution.assumptions' words."""
+    from restitution.assumptions import CONDITIONS
+
+    scene = scene_from(MINIMAL.replace('thickness = "3.18 mm"', 'thickness = "0.3 mm"').replace(
+        'drop_heights = "0.1 m"', 'drop_heights = ["0.5 m", "0.4 m"]'))
+    fresh = open_instance(impact_fmu)
+    try:
+        result = run_scene(scene, instance=fresh, progress=False)
+    finally:
+        fresh.close()
+    lines = result.departure_warnings()
+    assert lines and all(line.startswith("warning: ") for line in lines)
+    said = [line.split(": ", 2)[2] for line in lines]
+    assert any(text.startswith("zener.lambda = ") and "is above 1.5" in text for text in said)
+    names = [name for name, _flag, _message in CONDITIONS]
+    first_words = [text.split(" = ")[0] for text in said]
+    assert len(first_words) == len(set(first_words)) <= len(names)  # once per condition, over both drops

@@ -61,7 +61,7 @@ class DropResult(Trajectory):
     gravity: float = 9.80665  #: [m/s2]
     validity: dict = field(default_factory=dict)  #: VALIDITY flag -> Boolean array, per impact
     #: what the FMU said about this drop's impacts outside the validated domain (restitution.assumptions:
-    #: once per FMU instance and condition, so a later drop repeats none of an earlier one's)
+    #: once per condition; the runner resets the FMU for each drop)
     departures: list = field(default_factory=list)
 
     @property
@@ -156,8 +156,13 @@ class SceneResult:
 
     def departure_warnings(self) -> list[str]:
         """One line per condition of :mod:`restitution.assumptions` that any impact met, in the FMU's
-        words (quantity, value, limit), naming the first drop that met it."""
-        return [f"warning: {d.drop.label}: {text}" for d in self.drops for text in d.departures]
+        words (quantity, value, limit), naming the first drop that met it (the FMU says it once per drop:
+        the runner resets it for each)."""
+        first = {}
+        for d in self.drops:
+            for text in d.departures:
+                first.setdefault(text.split(" = ", 1)[0], f"warning: {d.drop.label}: {text}")
+        return list(first.values())
 
     def write_csv(self, path) -> Path:
         """One row per impact: drop, impact instant and speed, requested outputs, effects used,

@@ -13,7 +13,7 @@
 typedef struct {
     int stale;         /* an input or parameter changed since the last evaluation */
     int failed;        /* the last evaluation failed: outputs are NaN/false */
-    unsigned int warned; /* the conditions of log_departures already logged by this instance (bits) */
+    unsigned int warned; /* the conditions of log_departures logged since instantiation or reset (bits) */
 } impact_backend;
 
 static rst_status instantiate(rst_instance *inst, const char *resource_dir, int visible)
@@ -108,7 +108,8 @@ static rst_status changed(rst_instance *inst)
     return RST_OK;
 }
 
-/* fmi2Reset: a fresh start, whose departures are logged again */
+/* fmi2Reset: a fresh start, whose departures are logged again (as the pythonfmu FMU, whose reset makes a
+ * new slave) */
 static rst_status reset(rst_instance *inst)
 {
     ((impact_backend *)rst_backend(inst))->warned = 0;

@@ -102,7 +102,7 @@ class SpherePlateImpact(Fmi2Slave):
         self._call = None  # impact()'s arguments but v, built when a parameter changed
         self._used = None  # the parameters with each body's material preset applied, when a parameter changed
         self._failure = None  # message of the last evaluation that raised
-        self._warned = set()  # the conditions of restitution.assumptions already logged by this instance
+        self._warned = set()  # the conditions of restitution.assumptions logged (pythonfmu's reset makes a new slave)
         self._output_keys = {}  # (Real|Boolean, value reference) -> ImpactResult key, for get_real/get_boolean
         self._last_read = {"Real": (None, None), "Boolean": (None, None)}  # type -> (vrs, reader) of the last get
         for var in TABLE:
@@ -263,7 +263,6 @@ class SpherePlateImpact(Fmi2Slave):
         self._used = None
         self._failure = None
         self._outputs = {}
-        self._warned = set()
 
     # --- FMU state: the inputs and parameters, with a schema tag, validated before restoring ---
     def _get_fmu_state(self):
