@@ -345,8 +345,10 @@ def child(*args, cwd):
 def test_sweep_on_a_full_file_system(tmp_path, reference):
     """Parts fill 256 KiB after a few chunks: one line naming the part, the finished ones kept; with
     the space back, --resume completes the table; a table that does not fit leaves the old one."""
-    with full_disk(tmp_path / "disk", "256k") as disk:
-        (disk / "ballast").write_bytes(b"\0" * (150 * 1024))
+    # 12 parts of about 16 kB (20 kB in tmpfs pages) and a CSV of about 60 kB fit in 384 kB; with 278 kB of
+    # ballast the parts fill the disk after a few chunks
+    with full_disk(tmp_path / "disk", "384k") as disk:
+        (disk / "ballast").write_bytes(b"\0" * (278 * 1024))
         (disk / "s.csv").write_text("the old table\n")
         proc = child("restitution.sweep", *SWEEP, "--no-plot", "--out", "s.csv", cwd=disk)
         assert proc.returncode == 74, proc.stderr
@@ -365,7 +367,7 @@ def test_sweep_on_a_full_file_system(tmp_path, reference):
         run_sweep(SweepSpec(**SPEC), scheduler="serial", chunk_size=10, parts=parts)
         (disk / "s.csv").write_text("the old table\n")
         free = os.statvfs(disk).f_bavail * os.statvfs(disk).f_frsize
-        (disk / "ballast").write_bytes(b"\0" * (free - 16 * 1024))  # the CSV takes about 50 kB
+        (disk / "ballast").write_bytes(b"\0" * (free - 16 * 1024))  # the CSV takes about 60 kB
         proc = child("restitution.sweep", *SWEEP, "--no-plot", "--out", "s.csv", "--resume", cwd=disk)
         assert proc.returncode == 74, proc.stderr
         one_line(proc.stderr, "cannot write s.csv: No space left on device", "every chunk is kept in s.csv.parts")

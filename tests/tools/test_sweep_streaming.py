@@ -124,8 +124,8 @@ def test_cli_refuses_absurd_sizes_before_any_work(tmp_path):
     assert "100,000,000,000,000,000,000 cases" in proc.stdout  # was 7,766,279,631,452,241,920
     proc = _cli("--random", "v=uniform:1:2", "--samples", "1000000", "--dry-run", preexec_fn=small_memory)
     assert proc.returncode == 0 and "1,000,000 cases" in proc.stdout, proc.stdout
-    # 264 bytes a case: 32 eight-byte numbers (inputs, outputs, the pair label) and 8 one-byte Booleans
-    assert "252 MiB (264,000,000 bytes) in memory, within the memory budget" in proc.stdout, proc.stdout
+    # 290 bytes a case: 35 eight-byte numbers (inputs, outputs, the pair label) and 10 one-byte Booleans
+    assert "277 MiB (290,000,000 bytes) in memory, within the memory budget" in proc.stdout, proc.stdout
     proc = _cli("--grid", "v=1,2,3", "--dry-run", "--memory-budget", "500", "--out", str(tmp_path / "s.csv"))
     assert proc.returncode == 0 and "3 cases" in proc.stdout and "streamed to disk" in proc.stdout, proc.stdout
 
