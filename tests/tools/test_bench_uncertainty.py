@@ -1,0 +1,45 @@
+"""build_scripts/benchmarks/bench_uncertainty.py --quick runs in a process of its own and prints every line:
+both sides of each measurement and their ratio beside the goal, and the two sides of the Monte Carlo
+computed the same statistics of e. No timing is asserted (machines are noisy): the ratios are the
+benchmark's to print."""
+import os
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[2]
+SCRIPT = ROOT / "build_scripts" / "benchmarks" / "bench_uncertainty.py"
+NUMBER = r"[0-9.]+(?:e[+-]?\d+)?"
+
+
+def test_quick_run_prints_both_sides_and_the_ratio_of_each_measurement(tmp_path):
+    path = [str(ROOT / "fmu_src"), os.environ.get("PYTHONPATH")]
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(p for p in path if p)}
+    proc = subprocess.run([sys.executable, str(SCRIPT), "--quick"], capture_output=True, text=True, cwd=tmp_path,
+                          env=env, timeout=120)
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    out = proc.stdout
+    assert re.search(r"^bench_uncertainty\.py on \d{4}-\d\d-\d\d: .*\d+ cores", out, re.M), out
+    expected = [
+        rf"^1\(a\) Monte Carlo, .* sweep \+ statistics ({NUMBER}) s, impact \+ numpy statistics ({NUMBER}) s: "
+        rf"({NUMBER})x \(goal <= 2x: (met|NOT met)",
+        rf"^1\(b\) Monte Carlo, .* sweep command ({NUMBER}) s, plain impact process ({NUMBER}) s: ({NUMBER})x "
+        rf"\(goal <= 2x: (met|NOT met)\)",
+        rf"^     wall: sweep command ({NUMBER}) s, plain impact process ({NUMBER}) s: ({NUMBER})x",
+        rf"^2\. .*--scheduler serial .*: wall ({NUMBER}) s \(goal <= 5 s: (met|NOT met)\).* model evaluation "
+        rf"({NUMBER}) s, analysis ({NUMBER}) s: analysis / evaluation ({NUMBER})x",
+        rf"^2\. .*LocalCluster of 2 workers .*: wall ({NUMBER}) s \(goal <= 5 s: (met|NOT met)\).* model evaluation "
+        rf"({NUMBER}) s, analysis ({NUMBER}) s: analysis / evaluation ({NUMBER})x",
+        rf"^     in process .*: evaluation of the design ({NUMBER}) s, SobolCollector\.analyze\(\) ({NUMBER}) s: "
+        rf"analysis / evaluation ({NUMBER})x",
+    ]
+    for pattern in expected:
+        match = re.search(pattern, out, re.M)
+        assert match, (pattern, out)
+        numbers = [float(g) for g in match.groups() if g not in ("met", "NOT met")]
+        assert all(x >= 0 for x in numbers), (pattern, match.group(0))
+    # the two sides of the Monte Carlo are the same draws: e's statistics agree to rounding
+    for agree in re.findall(rf"agree to ({NUMBER})", out):
+        assert float(agree) < 1e-12, out
+    assert len(re.findall("agree to", out)) == 2, out
