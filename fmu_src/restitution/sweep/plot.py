@@ -220,9 +220,18 @@ def _draws_text(spec) -> str:
     """What a random sweep drew and held: ``plate.Sy ~ uniform_rel:0.15; fixed plate.t = 3mm``."""
     text = "; ".join(f"{name} ~ {given}" for name, given in spec.random.items())
     if spec.fixed:
-        text += "; " + ", ".join(f"{name} = {value}{'' if isinstance(value, str) or not unit_of(name) else ' ' + unit_of(name)}"
+        text += "; " + ", ".join(f"{name} = {value}{' ' + unit_of(name) if unit_of(name) and _bare(value) else ''}"
                                  for name, value in spec.fixed.items())
     return text
+
+
+def _bare(value) -> bool:
+    """Whether a fixed value is a bare number (SI: its unit is then shown), not a text with its own unit."""
+    try:
+        float(value)
+    except (TypeError, ValueError):
+        return False
+    return True
 
 
 def plot_random(statistics, path, title: str | None = None, dpi: int = 120) -> Path:
