@@ -252,14 +252,13 @@ def bounce_model_exchange(ball, rebound, drop_height: float, gravity: float = ST
     _check_inputs(drop_height, gravity, v_min, stop_time, max_bounces, event_tol, method, rtol, atol)
     parameters = {"h0": float(drop_height), "g": float(gravity), "v_min": float(v_min)}
     own = not isinstance(ball, ModelExchangeInstance)
-    inst = ModelExchangeInstance(ball, instance_name="ball", parameters=parameters) if own else ball
+    inst = ModelExchangeInstance(ball, instance_name="ball") if own else ball
     try:
         missing = [name for name in _BALL_NEEDS if name not in inst.variables]
         if missing or inst.n_states < 1 or inst.n_indicators < 1:
             raise ValueError(f"{inst.path}: not a BouncingBall FMU ({inst.model_description.modelName}: "
                              f"{'no variable(s) ' + ', '.join(missing) if missing else 'no states or indicators'})")
-        if not own:
-            inst.reset(parameters)
+        inst.reset(parameters)  # (checked first: the parameters of another FMU are no variables of it)
         return _run(inst, rebound, getattr(integrate, method), stop_time, max_bounces, event_tol, rtol, atol,
                     drop_height, gravity, method)
     finally:
