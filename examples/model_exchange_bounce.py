@@ -1,4 +1,4 @@
-"""A model-exchange drop: BouncingBall.fmu's states integrated by the master, e(v) from SpherePlateImpact at each contact.
+"""A model-exchange drop: BouncingBall.fmu integrated by the master, e(v) from SpherePlateImpact at each contact.
 
     python examples/model_exchange_bounce.py [--fmu-dir dist/fmi2] [--impact me|cs|package] [--show]
 

@@ -137,8 +137,9 @@ def test_impact_fmu_in_model_exchange_and_co_simulation(me_fmus):
 
 def test_a_run_stops_at_stop_time_or_max_bounces_and_an_instance_is_reused(me_fmus):
     """stop_time before the rest: the contacts so far (each run's contacts within the event-location bound of
-    the other's), "stop_time", rest_time inf; max_bounces: that many contacts; a ModelExchangeInstance passed in is reset for each drop (two drops through one instance give
-    the same contacts as a fresh FMU), and stays open for the caller."""
+    the other's), "stop_time", rest_time inf; max_bounces: that many contacts; a ModelExchangeInstance passed
+    in is reset for each drop (two drops through one instance give the same contacts as a fresh FMU), and
+    stays open for the caller."""
     ball_fmu, _impact = me_fmus
     rebound = package_rebound(**PACKAGE)
     full = bounce_model_exchange(ball_fmu, rebound, H0, gravity=G, v_min=1e-2)
