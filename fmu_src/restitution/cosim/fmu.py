@@ -251,7 +251,7 @@ class FmuInstance:
 
         self.path = Path(fmu_path)
         self.model_description = read_model_description(str(self.path))
-        self._fmi = _version_of(self.model_description)
+        self._fmi = self._interface()
         self._own_dir = unzip_dir is None
         self.unzip_dir = extract(str(self.path)) if unzip_dir is None else str(unzip_dir)
         self.variables = {v.name: v for v in self.model_description.modelVariables}
@@ -276,6 +276,10 @@ class FmuInstance:
             if self._own_dir:
                 shutil.rmtree(self.unzip_dir, ignore_errors=True)
             raise
+
+    def _interface(self):
+        """What differs between the FMI versions (and, in a subclass, the interface: model exchange)."""
+        return _version_of(self.model_description)
 
     @property
     def fmi_version(self) -> str:
