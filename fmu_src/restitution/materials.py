@@ -25,7 +25,7 @@ BRITTLE_SY = 1.0e12
 class Material:
     """An isotropic, elastic-perfectly plastic material."""
 
-    name: str
+    name: str  #: what messages and tables call it
     E: float  #: elastic modulus [Pa]
     nu: float  #: Poisson's ratio [1]
     Sy: float  #: yield strength [Pa] (BRITTLE_SY for brittle materials)
@@ -56,8 +56,8 @@ class Material:
 class Sphere:
     """Impacting sphere: material and diameter d [m]."""
 
-    material: Material
-    d: float
+    material: Material  #: what the sphere is made of
+    d: float  #: diameter [m]
 
     def __post_init__(self):
         object.__setattr__(self, "d", to_si("sphere.d", self.d, "m"))
@@ -72,8 +72,8 @@ class Sphere:
 class Plate:
     """Target plate: material and thickness t [m]."""
 
-    material: Material
-    t: float
+    material: Material  #: what the plate is made of
+    t: float  #: thickness [m]
 
     def __post_init__(self):
         object.__setattr__(self, "t", to_si("plate.t", self.t, "m"))

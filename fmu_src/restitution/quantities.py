@@ -74,6 +74,7 @@ def with_units(**units):
                         kwargs[name] = to_si(name, kwargs[name], unit)
             return function(*args, **kwargs)
 
+        wrapper.si_units = dict(units)  # each argument's SI unit, which the documentation site shows
         return wrapper
     return decorate
 

@@ -1,5 +1,7 @@
 """Calibration from drop tests: the model's parameters, and how sure they are, from measured rebounds.
 
+From Python::
+
     import restitution as r
     from restitution.fit import fit
     cal = fit("drop_pairs.csv", sphere=r.Sphere(r.MATERIALS["chrome_steel"], 6.35e-3),

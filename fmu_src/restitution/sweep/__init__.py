@@ -1,5 +1,6 @@
 """Design-space sweeps of the sphere-on-plate COR on Dask: a grid or random sample over any FMU
 parameter and the approach speed, evaluated by the vectorized package or by the FMU itself.
+From the command line::
 
     python -m restitution.sweep --pair s2_tool_steel/al_6061 \\
         --grid v_approach=geomspace:0.1:10:60 --grid t_over_d=geomspace:0.1:10:50 --out map.csv
