@@ -9,6 +9,7 @@ RECIPES = (
     "plot_monte_carlo_e.py",
     "fmi2_fmu_in_fmpy.py",
     "fmi3_fmu_in_fmpy.py",
+    "plot_model_exchange_bounce.py",
 )
 
 
