@@ -45,13 +45,15 @@ def open_client(scheduler=None, n_workers: int | None = None, threads_per_worker
     kwargs.update(cluster_kwargs)
     # the workers start with this process's sys.path, ignoring Ctrl-C (see _workers_ignore_sigint), and
     # with glibc's own allocation thresholds (see _workers_keep_glibc_thresholds)
-    with _without_fmu_resources_on_sys_path(), _workers_ignore_sigint(), _workers_keep_glibc_thresholds():
-        cluster = LocalCluster(**kwargs)
-    # direct_to_workers: this process takes each finished chunk from its worker. Through the scheduler
-    # (Dask's default for a client) every chunk crossed TCP twice and, the LocalCluster's scheduler
-    # living in this process, was received here twice, into fresh memory each time.
-    with cluster, Client(cluster, direct_to_workers=True) as client:
-        yield client
+    with _workers_ignore_sigint() as release:
+        with _without_fmu_resources_on_sys_path(), _workers_keep_glibc_thresholds():
+            cluster = LocalCluster(**kwargs)
+        # direct_to_workers: this process takes each finished chunk from its worker. Through the scheduler
+        # (Dask's default for a client) every chunk crossed TCP twice and, the LocalCluster's scheduler
+        # living in this process, was received here twice, into fresh memory each time.
+        with cluster, Client(cluster, direct_to_workers=True) as client:
+            release()  # a Ctrl-C of the start-up is raised here, where the cluster is closed on the way out
+            yield client
 
 
 @contextlib.contextmanager
@@ -73,24 +75,46 @@ def _workers_keep_glibc_thresholds():
 
 @contextlib.contextmanager
 def _workers_ignore_sigint():
-    """SIGINT ignored while a LocalCluster spawns its worker processes, which keep that disposition.
+    """SIGINT blocked in this thread while a LocalCluster starts, and noted, not raised, until
+    ``release()`` (called once the cluster can be closed again) raises it.
 
     Ctrl-C in a terminal reaches every process of the foreground group: the workers' event loops
     would die with a KeyboardInterrupt traceback each, and an FMU back end's worker would take it
-    inside an FMU call (fmi2Fatal). The client process alone takes Ctrl-C: it cancels the tasks,
-    keeps the finished chunks and closes the cluster, which stops the workers. A Ctrl-C during
-    these start-up seconds is ignored (press it again once the sweep runs)."""
+    inside an FMU call (fmi2Fatal). The threads the cluster starts here inherit this thread's signal
+    mask, and the worker processes they spawn inherit theirs, so SIGINT stays blocked in the workers
+    for good. The client process alone takes Ctrl-C: it cancels the tasks, keeps the finished chunks
+    and closes the cluster, which stops the workers. SIGINT used to be ignored (SIG_IGN) during the
+    start instead: a Ctrl-C of those seconds was lost (the numpy/OpenBLAS threads, which do not block
+    it, took it and the kernel discarded it) and the sweep ran to its end; raised mid-start, it would
+    leave half a cluster."""
     import signal
     import threading
 
-    if threading.current_thread() is not threading.main_thread():
-        yield
+    if not hasattr(signal, "pthread_sigmask"):  # not POSIX: no process group to share Ctrl-C with
+        yield lambda: None
         return
-    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    from multiprocessing import resource_tracker
+
+    # started now, not by the first worker's spawn: starting it unblocks SIGINT in the spawning thread
+    resource_tracker.ensure_running()
+    noted = []
+    handler = None
+    if threading.current_thread() is threading.main_thread():
+        handler = signal.signal(signal.SIGINT, lambda signum, frame: noted.append(signum))
+    mask = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+
+    def release():
+        nonlocal handler
+        signal.pthread_sigmask(signal.SIG_SETMASK, mask)
+        if handler is not None:
+            signal.signal(signal.SIGINT, handler)
+            handler = None
+            if noted:
+                raise KeyboardInterrupt
     try:
-        yield
+        yield release
     finally:
-        signal.signal(signal.SIGINT, previous)
+        release()
 
 
 @contextlib.contextmanager

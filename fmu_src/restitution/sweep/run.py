@@ -162,10 +162,12 @@ def run_sweep(spec: SweepSpec | dict, backend: str | Backend = "package", *, fmu
         bar.update(len(run.done))
         futures = {}  # in flight: key -> future
         payload = None
+        transfer = _TransferInterrupt().__enter__()  # left in the finally clause
         try:
             payload = backend.payload()
             if payload is not None and todo:
-                payload = client.scatter([payload], broadcast=True, hash=False)[0]
+                with transfer.held():
+                    payload = client.scatter([payload], broadcast=True, hash=False)[0]
             from distributed import as_completed
 
             # At most IN_FLIGHT_PER_WORKER chunks per worker are submitted at a time, the next one when
@@ -188,7 +190,8 @@ def run_sweep(spec: SweepSpec | dict, backend: str | Backend = "package", *, fmu
                 submit_next()
             for future in finished:
                 a, b = bounds.pop(future.key)
-                part = future.result()
+                with transfer.held():
+                    part = future.result()
                 futures.pop(future.key)
                 future.release()
                 submit_next()  # before this chunk is handled (written to the parts): no worker waits for it
@@ -203,6 +206,7 @@ def run_sweep(spec: SweepSpec | dict, backend: str | Backend = "package", *, fmu
             bar.abandon()
             raise
         finally:
+            transfer.__exit__()
             with contextlib.suppress(Exception):
                 client.cancel(list(futures.values()))
             if isinstance(backend, FmuBackend) and release:
@@ -213,6 +217,29 @@ def run_sweep(spec: SweepSpec | dict, backend: str | Backend = "package", *, fmu
                     client.cancel([payload])
         bar.close(len(run.done))
         return run.result()
+
+
+class _TransferInterrupt(DeferredInterrupt):
+    """Ctrl-C at once, except while data travels between this process and the workers (:meth:`held`:
+    a chunk taken from its worker, the payload scattered): then just after it. Raised in mid-transfer, the
+    KeyboardInterrupt cancelled the transfer and closed its connection, and the worker logged
+    ``distributed.worker - ERROR - failed during get data`` with a CommClosedError traceback."""
+
+    holding = False
+
+    def _note(self, signum, frame):
+        if not self.holding:
+            raise KeyboardInterrupt
+        super()._note(signum, frame)  # a second Ctrl-C during the transfer: at once
+
+    @contextlib.contextmanager
+    def held(self):
+        self.holding = True
+        try:
+            yield
+        finally:
+            self.holding = False
+        self.check()
 
 
 class _Run:
