@@ -257,6 +257,7 @@ class _Run:
         if self.store is not None:
             self.done = self.store.open(self.spec, self.backend, chunk_size, self.keep, resume,
                                         load_columns=self.in_memory, on_chunk=self.on_chunk)
+        self.reused = dict.fromkeys(self.done)  # kept from the parts (--resume): not in the rate
         self.t0 = time.perf_counter()
 
     def finished(self, a, b, part):
@@ -273,6 +274,9 @@ class _Run:
         elapsed = time.perf_counter() - self.t0
         starts = sorted(self.done)
         info = _info(self.backend, [self.done[a][1] for a in starts])
+        if self.reused:
+            info["reused"] = {"chunks": len(self.reused), "from": str(self.store.path),
+                              "cases": sum(int(self.done[a][1]["counts"]["cases"]) for a in self.reused)}
         kwargs = dict(spec=self.spec, backend=self.backend.describe(), scheduler=self.where, n_workers=self.workers,
                       elapsed=elapsed, n_chunks=self.n_chunks, info=info)
         if self.in_memory:
