@@ -34,7 +34,8 @@ def test_the_threshold_is_where_a_cluster_can_win_back_its_start(backend, monkey
     below, above = SweepSpec(random={"v": "uniform:1:2"}, samples=n // 2), SweepSpec(random={"v": "uniform:1:2"}, samples=n)
     assert serial_reason(below, [backend], 2).startswith("serial:")
     assert serial_reason(above, [backend], 2) is None
-    assert serial_reason(below, [backend, "package" if backend == "fmu" else "fmu"], 2) is None or backend == "fmu"
+    if backend == "package":  # --backend both: the two costs add, the FMU's dominates
+        assert serial_reason(below, ["package", "fmu"], 2) is None
     # slow options count: the integrated Zener model makes a few thousand cases worth a cluster
     ode = SweepSpec(random={"v": "uniform:1:2"}, samples=_cases_a_cluster_pays_for(backend, 2, 2),
                     grid={"zener_method": "exact,ode"})
