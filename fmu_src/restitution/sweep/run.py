@@ -211,12 +211,27 @@ def run_sweep(spec: SweepSpec | dict, backend: str | Backend = "package", *, fmu
                 client.cancel(list(futures.values()))
             if isinstance(backend, FmuBackend) and release:
                 with contextlib.suppress(Exception):
-                    client.run(release_fmus)  # an instance still busy with a cancelled chunk is freed after it
+                    # an instance still busy with a cancelled chunk is freed after it; see _RELEASE_ON_WORKER
+                    client.run(exec, _RELEASE_ON_WORKER, {})
             if hasattr(payload, "release"):
                 with contextlib.suppress(Exception):
                     client.cancel([payload])
         bar.close(len(run.done))
         return run.result()
+
+
+#: Run on each worker at the end of an FMU sweep: ``release_fmus()`` if the worker loaded the back end. Sent
+#: as source to the builtin ``exec``, not as the function: a worker unpickles a function by importing its
+#: module, and while a task thread instantiates an FMU the host's ``restitution`` is set aside
+#: (``_instantiate_with_bundled_code``), so a Ctrl-C in the first chunks made that import fail and the
+#: worker log ``distributed.core - ERROR ... No module named 'restitution.sweep'``. The module is found
+#: under a name nothing shadows, and release_fmus() waits for the instantiation (its lock).
+_RELEASE_ON_WORKER = """
+import sys
+backends = sys.modules.get("_restitution_sweep_backends")
+if backends is not None:
+    backends.release_fmus()
+"""
 
 
 class _TransferInterrupt(DeferredInterrupt):
