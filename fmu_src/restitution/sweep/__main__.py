@@ -198,7 +198,8 @@ def main(argv=None) -> int:
                                       "built if missing)")
     parser.add_argument("--scheduler", help="address of a running dask.distributed scheduler "
                                             "(tcp://host:8786), 'local' (new LocalCluster) or 'serial' "
-                                            "(no Dask); default: $DASK_SCHEDULER_ADDRESS, else local")
+                                            "(no Dask); default: $DASK_SCHEDULER_ADDRESS, else serial for a "
+                                            "sweep too small to win back a LocalCluster's start, else local")
     parser.add_argument("--workers", type=_int_in(1, MAX_WORKERS),
                         help="LocalCluster worker processes (default: one per core)")
     parser.add_argument("--chunk-size", type=_int_in(1, MAX_CHUNK), help="cases per Dask task")
@@ -350,6 +351,11 @@ def _main(parser, args) -> int:
     # gathered from the chunks as they come (and from the kept parts on --resume) of the written table's back end
     statistics = SweepStatistics(spec, keep_columns(columns)) if spec.random or summary else None
     sobol = SobolCollector(spec) if args.sobol else None
+    chosen = None
+    if scheduler is None:  # neither --scheduler nor $DASK_SCHEDULER_ADDRESS: a cluster only where it can pay
+        from .cluster import serial_reason
+        chosen = serial_reason(spec, backends, workers)
+        scheduler = "serial" if chosen else None
     try:
         with contextlib.ExitStack() as stack:
             target = "serial"
@@ -362,6 +368,8 @@ def _main(parser, args) -> int:
                 res = run_sweep(spec, name, fmu=fmu, scheduler=target, chunk_size=chunk, progress=progress,
                                 columns=columns, parts=parts / name, resume=args.resume, in_memory=not plan.stream,
                                 on_chunk=_hooks(statistics, sobol) if name == backends[0] else None)
+                if chosen:
+                    res.scheduler = f"this process ({chosen})"
                 print(res.summary())
                 results[name] = res
     except SweepInterrupted as exc:

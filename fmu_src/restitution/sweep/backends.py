@@ -172,6 +172,9 @@ def impact_groups(cases: dict, rows):
 _LOCK = threading.Lock()
 _EXTRACTED: dict = {}  # sha -> (unzip dir, created-by-us dir or None)
 _INSTANCES: dict = {}  # (sha, thread id) -> _LoadedFmu
+#: This module under a name the FMU's bundled ``restitution`` never shadows: the end of a Dask FMU sweep
+#: calls release_fmus() there without importing it (see restitution.sweep.run._RELEASE_ON_WORKER).
+sys.modules.setdefault("_restitution_sweep_backends", sys.modules[__name__])
 
 
 class _LoadedFmu:

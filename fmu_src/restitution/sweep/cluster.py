@@ -6,7 +6,7 @@ import contextlib
 import logging
 import os
 
-__all__ = ["machine_workers", "open_client", "count_workers", "describe_client"]
+__all__ = ["machine_workers", "open_client", "count_workers", "describe_client", "serial_reason"]
 
 def machine_workers() -> int:
     """Worker processes for a local cluster: the cores this process may use."""
@@ -45,13 +45,15 @@ def open_client(scheduler=None, n_workers: int | None = None, threads_per_worker
     kwargs.update(cluster_kwargs)
     # the workers start with this process's sys.path, ignoring Ctrl-C (see _workers_ignore_sigint), and
     # with glibc's own allocation thresholds (see _workers_keep_glibc_thresholds)
-    with _without_fmu_resources_on_sys_path(), _workers_ignore_sigint(), _workers_keep_glibc_thresholds():
-        cluster = LocalCluster(**kwargs)
-    # direct_to_workers: this process takes each finished chunk from its worker. Through the scheduler
-    # (Dask's default for a client) every chunk crossed TCP twice and, the LocalCluster's scheduler
-    # living in this process, was received here twice, into fresh memory each time.
-    with cluster, Client(cluster, direct_to_workers=True) as client:
-        yield client
+    with _workers_ignore_sigint() as release:
+        with _without_fmu_resources_on_sys_path(), _workers_keep_glibc_thresholds():
+            cluster = LocalCluster(**kwargs)
+        # direct_to_workers: this process takes each finished chunk from its worker. Through the scheduler
+        # (Dask's default for a client) every chunk crossed TCP twice and, the LocalCluster's scheduler
+        # living in this process, was received here twice, into fresh memory each time.
+        with cluster, Client(cluster, direct_to_workers=True) as client:
+            release()  # a Ctrl-C of the start-up is raised here, where the cluster is closed on the way out
+            yield client
 
 
 @contextlib.contextmanager
@@ -73,24 +75,46 @@ def _workers_keep_glibc_thresholds():
 
 @contextlib.contextmanager
 def _workers_ignore_sigint():
-    """SIGINT ignored while a LocalCluster spawns its worker processes, which keep that disposition.
+    """SIGINT blocked in this thread while a LocalCluster starts, and noted, not raised, until
+    ``release()`` (called once the cluster can be closed again) raises it.
 
     Ctrl-C in a terminal reaches every process of the foreground group: the workers' event loops
     would die with a KeyboardInterrupt traceback each, and an FMU back end's worker would take it
-    inside an FMU call (fmi2Fatal). The client process alone takes Ctrl-C: it cancels the tasks,
-    keeps the finished chunks and closes the cluster, which stops the workers. A Ctrl-C during
-    these start-up seconds is ignored (press it again once the sweep runs)."""
+    inside an FMU call (fmi2Fatal). The threads the cluster starts here inherit this thread's signal
+    mask, and the worker processes they spawn inherit theirs, so SIGINT stays blocked in the workers
+    for good. The client process alone takes Ctrl-C: it cancels the tasks, keeps the finished chunks
+    and closes the cluster, which stops the workers. SIGINT used to be ignored (SIG_IGN) during the
+    start instead: a Ctrl-C of those seconds was lost (the numpy/OpenBLAS threads, which do not block
+    it, took it and the kernel discarded it) and the sweep ran to its end; raised mid-start, it would
+    leave half a cluster."""
     import signal
     import threading
 
-    if threading.current_thread() is not threading.main_thread():
-        yield
+    if not hasattr(signal, "pthread_sigmask"):  # not POSIX: no process group to share Ctrl-C with
+        yield lambda: None
         return
-    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    from multiprocessing import resource_tracker
+
+    # started now, not by the first worker's spawn: starting it unblocks SIGINT in the spawning thread
+    resource_tracker.ensure_running()
+    noted = []
+    handler = None
+    if threading.current_thread() is threading.main_thread():
+        handler = signal.signal(signal.SIGINT, lambda signum, frame: noted.append(signum))
+    mask = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+
+    def release():
+        nonlocal handler
+        signal.pthread_sigmask(signal.SIG_SETMASK, mask)
+        if handler is not None:
+            signal.signal(signal.SIGINT, handler)
+            handler = None
+            if noted:
+                raise KeyboardInterrupt
     try:
-        yield
+        yield release
     finally:
-        signal.signal(signal.SIGINT, previous)
+        release()
 
 
 @contextlib.contextmanager
@@ -125,3 +149,50 @@ def describe_client(client, scheduler) -> str:
     if isinstance(getattr(client, "cluster", None), LocalCluster) and not isinstance(scheduler, str):
         return f"a LocalCluster ({client.scheduler.address})"
     return f"the Dask scheduler at {client.scheduler.address}"
+
+
+#: What a LocalCluster costs before it computes anything, measured on the project's 2-core machine
+#: (shared, load about 1.7; 2026-11): started and closed in a process 2.1 ... 2.5 s, and a whole
+#: 160-case command took 2.5 ... 3.5 s with --scheduler local against 0.65 s with --scheduler serial.
+CLUSTER_SECONDS = 2.5
+#: Seconds a case takes serially in this process, per back end (same machine, medians of 3): default
+#: options; plate_waves = on; zener_method = ode (the integrated Zener model, whatever else is set).
+CASE_SECONDS = {"package": (0.3e-6, 5e-6, 6e-3), "fmu": (60e-6, 320e-6, 6e-3)}
+
+
+def serial_reason(spec, backends, n_workers: int | None = None) -> str | None:
+    """Why a sweep given no scheduler (no --scheduler, no ``DASK_SCHEDULER_ADDRESS``) runs serially in
+    this process, or None when a LocalCluster may pay for itself: ``W`` workers save at most a fraction
+    ``1 - 1/W`` of the serial time, which must exceed :data:`CLUSTER_SECONDS`. With the measured
+    costs and 2 workers: up to about 16.7 million cases with the package back end, 83,000 with the
+    FMU, 830 with zener_method = ode."""
+    import dask
+
+    if dask.config.get("scheduler-address", None):
+        return None
+    workers = n_workers or machine_workers()
+    seconds = spec.n_cases * sum(CASE_SECONDS[name][_cost_class(spec)] for name in backends)
+    if seconds * (1 - 1 / workers) >= CLUSTER_SECONDS:
+        return None
+    return (f"serial: about {seconds:.2g} s of work, too little for a LocalCluster of {workers} worker(s) to win "
+            f"back its {CLUSTER_SECONDS:g} s start; --scheduler local starts one")
+
+
+def _cost_class(spec) -> int:
+    """0, 1 or 2: which column of :data:`CASE_SECONDS` the options that the sweep may take select."""
+    from .spec import CODES, START
+
+    def may_be(name, code):
+        if name in spec._fixed:
+            values = spec._fixed[name]
+        elif name in spec.grid:
+            values = spec.axes[name]
+        elif name in spec._dists:
+            kind, args = spec._dists[name]
+            values = args if kind == "choice" else (code,)  # a continuous draw of a code: assume the worst
+        else:
+            values = (START[name],)
+        return any(float(v) == code for v in values)
+    if may_be("zener_method", CODES["zener_method"]["ode"]):
+        return 2
+    return 1 if may_be("plate_waves", CODES["plate_waves"]["on"]) else 0

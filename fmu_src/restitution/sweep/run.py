@@ -162,10 +162,12 @@ def run_sweep(spec: SweepSpec | dict, backend: str | Backend = "package", *, fmu
         bar.update(len(run.done))
         futures = {}  # in flight: key -> future
         payload = None
+        transfer = _TransferInterrupt().__enter__()  # left in the finally clause
         try:
             payload = backend.payload()
             if payload is not None and todo:
-                payload = client.scatter([payload], broadcast=True, hash=False)[0]
+                with transfer.held():
+                    payload = client.scatter([payload], broadcast=True, hash=False)[0]
             from distributed import as_completed
 
             # At most IN_FLIGHT_PER_WORKER chunks per worker are submitted at a time, the next one when
@@ -188,7 +190,8 @@ def run_sweep(spec: SweepSpec | dict, backend: str | Backend = "package", *, fmu
                 submit_next()
             for future in finished:
                 a, b = bounds.pop(future.key)
-                part = future.result()
+                with transfer.held():
+                    part = future.result()
                 futures.pop(future.key)
                 future.release()
                 submit_next()  # before this chunk is handled (written to the parts): no worker waits for it
@@ -203,16 +206,55 @@ def run_sweep(spec: SweepSpec | dict, backend: str | Backend = "package", *, fmu
             bar.abandon()
             raise
         finally:
+            transfer.__exit__()
             with contextlib.suppress(Exception):
                 client.cancel(list(futures.values()))
             if isinstance(backend, FmuBackend) and release:
                 with contextlib.suppress(Exception):
-                    client.run(release_fmus)  # an instance still busy with a cancelled chunk is freed after it
+                    # an instance still busy with a cancelled chunk is freed after it; see _RELEASE_ON_WORKER
+                    client.run(exec, _RELEASE_ON_WORKER, {})
             if hasattr(payload, "release"):
                 with contextlib.suppress(Exception):
                     client.cancel([payload])
         bar.close(len(run.done))
         return run.result()
+
+
+#: Run on each worker at the end of an FMU sweep: ``release_fmus()`` if the worker loaded the back end. Sent
+#: as source to the builtin ``exec``, not as the function: a worker unpickles a function by importing its
+#: module, and while a task thread instantiates an FMU the host's ``restitution`` is set aside
+#: (``_instantiate_with_bundled_code``), so a Ctrl-C in the first chunks made that import fail and the
+#: worker log ``distributed.core - ERROR ... No module named 'restitution.sweep'``. The module is found
+#: under a name nothing shadows, and release_fmus() waits for the instantiation (its lock).
+_RELEASE_ON_WORKER = """
+import sys
+backends = sys.modules.get("_restitution_sweep_backends")
+if backends is not None:
+    backends.release_fmus()
+"""
+
+
+class _TransferInterrupt(DeferredInterrupt):
+    """Ctrl-C at once, except while data travels between this process and the workers (:meth:`held`:
+    a chunk taken from its worker, the payload scattered): then just after it. Raised in mid-transfer, the
+    KeyboardInterrupt cancelled the transfer and closed its connection, and the worker logged
+    ``distributed.worker - ERROR - failed during get data`` with a CommClosedError traceback."""
+
+    holding = False
+
+    def _note(self, signum, frame):
+        if not self.holding:
+            raise KeyboardInterrupt
+        super()._note(signum, frame)  # a second Ctrl-C during the transfer: at once
+
+    @contextlib.contextmanager
+    def held(self):
+        self.holding = True
+        try:
+            yield
+        finally:
+            self.holding = False
+        self.check()
 
 
 class _Run:
@@ -230,6 +272,7 @@ class _Run:
         if self.store is not None:
             self.done = self.store.open(self.spec, self.backend, chunk_size, self.keep, resume,
                                         load_columns=self.in_memory, on_chunk=self.on_chunk)
+        self.reused = dict.fromkeys(self.done)  # kept from the parts (--resume): not in the rate
         self.t0 = time.perf_counter()
 
     def finished(self, a, b, part):
@@ -246,6 +289,9 @@ class _Run:
         elapsed = time.perf_counter() - self.t0
         starts = sorted(self.done)
         info = _info(self.backend, [self.done[a][1] for a in starts])
+        if self.reused:
+            info["reused"] = {"chunks": len(self.reused), "from": str(self.store.path),
+                              "cases": sum(int(self.done[a][1]["counts"]["cases"]) for a in self.reused)}
         kwargs = dict(spec=self.spec, backend=self.backend.describe(), scheduler=self.where, n_workers=self.workers,
                       elapsed=elapsed, n_chunks=self.n_chunks, info=info)
         if self.in_memory:

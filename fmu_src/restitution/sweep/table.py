@@ -148,7 +148,9 @@ class SweepResult:
 
     @property
     def cases_per_second(self) -> float:
-        return len(self) / self.elapsed if self.elapsed > 0 else math.inf
+        """Cases evaluated per second of :attr:`elapsed`: those reused from the parts (``resume``) not counted."""
+        n = len(self) - self.info.get("reused", {}).get("cases", 0)
+        return n / self.elapsed if self.elapsed > 0 else math.inf
 
     def counts(self) -> dict:
         """``cases``, ``ok`` (evaluated), ``inside`` (``valid``: inside the validated ranges), and per
@@ -160,6 +162,10 @@ class SweepResult:
         text = (f"{len(self)} cases with the {self.backend} back end on {self.scheduler} "
                 f"({self.n_workers} worker(s), {self.n_chunks} chunk(s)): {self.elapsed:.3g} s, "
                 f"{self.cases_per_second:,.0f} cases/s")
+        reused = self.info.get("reused")
+        if reused:
+            text += (f" over the {len(self) - reused['cases']:,} cases evaluated ({reused['chunks']:,} chunk(s) of "
+                     f"{reused['cases']:,} cases reused from {reused['from']})")
         text += f"; {c['ok']} evaluated, {c['cases'] - c['ok']} with inputs out of range"
         text += (f"; {c['inside']} inside the models' validated ranges ({c['valid']} outside: "
                  f"{c['jgm.in_range']} beyond JGM's V* <= 1000, {c['zener.in_range']} beyond Zener's lambda <= 1.5)")
