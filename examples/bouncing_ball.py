@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 import restitution as r
-from restitution.viz import write_png
+from restitution.viz import finish
 from restitution.cosim import FmuInstance, bounce, build_default_fmu, fmu_rebound, impact_fmu_parameters
 
 HERE = Path(__file__).resolve().parent
@@ -92,11 +92,7 @@ def plot(cases: dict, path: Path, drop_height: float, t_end: float, dpi: int = 9
                  fontsize=9)
     ax.legend(fontsize=8, title="plate thickness", title_fontsize=8)
     ax.grid(alpha=0.3)
-    write_png(fig, path, dpi)
-    if show:
-        plt.show()
-    plt.close(fig)
-    return path
+    return finish(fig, path, dpi, show)
 
 
 def run(show_plot: bool = False, fmu_path=None, t_over_d=(0.25, 0.5, 1.0, 2.0), drop_height: float = 0.3,

@@ -23,7 +23,7 @@ import numpy as np
 import restitution as r
 from restitution.cosim import (FmuInstance, ModelExchangeInstance, bounce, bounce_model_exchange, build_default_fmu,
                                fmu_rebound, impact_fmu_parameters, model_exchange_rebound, package_rebound)
-from restitution.viz import write_png
+from restitution.viz import finish
 
 HERE = Path(__file__).resolve().parent
 OUTPUT = HERE / "output"
@@ -93,11 +93,7 @@ def plot(me, ref, path: Path, dpi: int = 90, show: bool = False):
                  fontsize=9)
     ax.legend(fontsize=8)
     ax.grid(alpha=0.3)
-    write_png(fig, path, dpi)
-    if show:
-        plt.show()
-    plt.close(fig)
-    return path
+    return finish(fig, path, dpi, show)
 
 
 def run(show_plot: bool = False, fmu_dir=None, impact: str = "me", drop_height: float = 0.3, v_min: float = 1e-2,

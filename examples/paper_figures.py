@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 
 import restitution as r
-from restitution.viz import write_png
+from restitution.viz import finish
 from restitution.cosim import FmuInstance, build_default_fmu
 from restitution.fmu.models.sphere_plate_impact.variables import TABLE, fmu_values
 from restitution.materials import table4_case
@@ -141,14 +141,6 @@ _COLORS = {"brass_260": "tab:orange", "tungsten_carbide": "tab:blue", "s2_tool_s
            "borosilicate_glass": "tab:green"}
 
 
-def _save(fig, path, dpi, show, plt):
-    write_png(fig, path, dpi)
-    if show:
-        plt.show()
-    plt.close(fig)
-    return path
-
-
 def plot_figures(f4, f5, f6, f7, out_dir: Path, dpi: int = 90, show: bool = False) -> dict:
     import matplotlib
     if not show:
@@ -173,7 +165,7 @@ def plot_figures(f4, f5, f6, f7, out_dir: Path, dpi: int = 90, show: bool = Fals
     ax.axhline(0, color="0.5", lw=0.6)
     ax.legend(fontsize=8)
     ax.grid(alpha=0.3)
-    paths["fig4"] = _save(fig, out_dir / "paper_fig4.png", dpi, show, plt)
+    paths["fig4"] = finish(fig, out_dir / "paper_fig4.png", dpi, show)
 
     fig, ax = plt.subplots(figsize=size, layout="constrained")
     colors = plt.cm.tab10(np.arange(8))
@@ -187,7 +179,7 @@ def plot_figures(f4, f5, f6, f7, out_dir: Path, dpi: int = 90, show: bool = Fals
     ax.axhline(0, color="0.5", lw=0.6)
     ax.legend(fontsize=7, ncol=2, title="case (JGM asymptote)", title_fontsize=7)
     ax.grid(alpha=0.3)
-    paths["fig5"] = _save(fig, out_dir / "paper_fig5.png", dpi, show, plt)
+    paths["fig5"] = finish(fig, out_dir / "paper_fig5.png", dpi, show)
 
     fig, ax = plt.subplots(figsize=size, layout="constrained")
     for key, d6 in f6.items():
@@ -207,7 +199,7 @@ def plot_figures(f4, f5, f6, f7, out_dir: Path, dpi: int = 90, show: bool = Fals
     ax.axhline(0, color="0.5", lw=0.6)
     ax.legend(fontsize=7, ncol=2)
     ax.grid(alpha=0.3)
-    paths["fig6"] = _save(fig, out_dir / "paper_fig6.png", dpi, show, plt)
+    paths["fig6"] = finish(fig, out_dir / "paper_fig6.png", dpi, show)
 
     fig, ax = plt.subplots(figsize=size, layout="constrained")
     ax.semilogx(f7["V_star"], f7["e_ze"], ":", color="tab:blue", lw=1.8, label="Zener e_ze (plate waves)")
@@ -220,7 +212,7 @@ def plot_figures(f4, f5, f6, f7, out_dir: Path, dpi: int = 90, show: bool = Fals
     ax.title.set_fontsize(9)
     ax.legend(fontsize=8)
     ax.grid(alpha=0.3, which="both")
-    paths["fig7"] = _save(fig, out_dir / "paper_fig7.png", dpi, show, plt)
+    paths["fig7"] = finish(fig, out_dir / "paper_fig7.png", dpi, show)
     return paths
 
 

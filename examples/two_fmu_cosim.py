@@ -44,7 +44,7 @@ from pathlib import Path
 import numpy as np
 
 import restitution as r
-from restitution.viz import write_png
+from restitution.viz import finish
 from restitution.cosim import (FixedStepMaster, FmuInstance, ball_bounces, bounce, build_default_fmu,
                                fmu_rebound, impact_fmu_parameters)
 from restitution.cosim.fixed_step import BALL_IMPACT_CONNECTIONS, BALL_RECORD
@@ -170,11 +170,7 @@ def plot(rows, traces, exact, path: Path, dpi: int = 90, show: bool = False, t_e
     ax.legend(fontsize=7)
     fig.suptitle("BouncingBall.fmu + SpherePlateImpact.fmu: S2 ball (d = 6.35 mm) on Al 6061, t/d = 1, "
                  "first five bounces", fontsize=10)
-    write_png(fig, path, dpi)
-    if show:
-        plt.show()
-    plt.close(fig)
-    return path
+    return finish(fig, path, dpi, show)
 
 
 def masters_for(*fmus) -> tuple:

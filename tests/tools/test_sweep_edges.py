@@ -12,9 +12,10 @@ import pytest
 
 from restitution.sweep import SweepSpec, read_table, run_sweep
 from restitution.sweep.__main__ import main as sweep_cli
-from restitution.sweep.backends import PackageBackend
 from restitution.sweep.cluster import CASE_SECONDS, CLUSTER_SECONDS, serial_reason
 from restitution.sweep.run import SweepInterrupted
+
+from interrupting_backend import InterruptingBackend
 
 PYTHON = sys.executable
 ENV = {**os.environ, "PYTHONUNBUFFERED": "1"}
@@ -60,26 +61,13 @@ def test_cli_small_sweep_without_scheduler_runs_serially_and_says_so(tmp_path, c
 
 
 # --- --resume says what it reused -------------------------------------------------------------
-class _Interrupting(PackageBackend):
-    """The package back end raising KeyboardInterrupt (as Ctrl-C would) on its n-th chunk (never: 0)."""
-
-    def __init__(self, n):
-        super().__init__()
-        self.n, self.calls = n, 0
-
-    def evaluate(self, *args):
-        self.calls += 1
-        if self.calls == self.n:
-            raise KeyboardInterrupt
-        return super().evaluate(*args)
-
 
 def test_resume_reports_reused_chunks_and_rates_only_the_evaluated_cases(tmp_path):
     spec = SweepSpec(pairs=["s2_tool_steel/al_6061"], grid={"v": "geomspace:0.1:10:30", "t/d": "0.2,1,5"},
                      random={"sphere.E": {"normal_rel": 0.05}}, samples=5, seed=2)
     with pytest.raises(SweepInterrupted):
-        run_sweep(spec, _Interrupting(4), scheduler="serial", chunk_size=100, parts=tmp_path / "p")
-    counting = _Interrupting(0)
+        run_sweep(spec, InterruptingBackend(4), scheduler="serial", chunk_size=100, parts=tmp_path / "p")
+    counting = InterruptingBackend(0)
     res = run_sweep(spec, counting, scheduler="serial", parts=tmp_path / "p", resume=True)
     n_chunks = -(-spec.n_cases // 100)
     assert counting.calls == n_chunks - 3
@@ -99,7 +87,7 @@ def test_cli_resume_prints_the_reused_and_evaluated_counts(tmp_path, capsys):
             "--out", str(out), "--chunk-size", "40"]
     spec = SweepSpec(grid={"v": "linspace:0.5:3:50", "t/d": "0.2,1,5,8"})
     with pytest.raises(SweepInterrupted):
-        run_sweep(spec, _Interrupting(3), scheduler="serial", chunk_size=40, parts=out.with_name("s.csv.parts") / "package")
+        run_sweep(spec, InterruptingBackend(3), scheduler="serial", chunk_size=40, parts=out.with_name("s.csv.parts") / "package")
     assert sweep_cli([*args, "--resume"]) == 0
     text = capsys.readouterr().out
     assert f"over the {200 - 80} cases evaluated (2 chunk(s) of 80 cases reused from" in text, text

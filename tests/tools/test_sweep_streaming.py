@@ -200,35 +200,22 @@ def test_output_paths_are_checked_before_the_run(tmp_path):
 
 
 # --- streaming, interruption, resuming (in process) ----------------------------------------
-from restitution.sweep.backends import PackageBackend
+from interrupting_backend import InterruptingBackend
 
-
-class _Interrupting(PackageBackend):
-    """The package back end raising KeyboardInterrupt (as Ctrl-C would) on its n-th chunk."""
-
-    def __init__(self, n):
-        super().__init__()
-        self.n, self.calls = n, 0
-
-    def evaluate(self, *args):
-        self.calls += 1
-        if self.calls == self.n:
-            raise KeyboardInterrupt
-        return super().evaluate(*args)
 
 
 def test_serial_interrupt_keeps_finished_chunks_and_resume_completes(tmp_path):
     spec = SweepSpec(pairs=["s2_tool_steel/al_6061", "table4:A2"], grid={"v": "geomspace:0.1:10:30", "t/d": "0.2,1,5"},
                      random={"sphere.E": {"normal_rel": 0.05}}, samples=5, seed=2)
     whole = run_sweep(spec, scheduler="serial", chunk_size=100)
-    backend = _Interrupting(4)
+    backend = InterruptingBackend(4)
     with pytest.raises(SweepInterrupted) as info:
         run_sweep(spec, backend, scheduler="serial", chunk_size=100, parts=tmp_path / "p")
     partial = info.value.result
     assert len(partial) == 300 and info.value.missing == spec.n_cases - 300
     assert len(list((tmp_path / "p").glob("chunk-*.npz"))) == 3
     assert np.array_equal(partial["case"], np.arange(300))
-    counting = _Interrupting(0)  # never interrupts; counts the chunks it evaluates
+    counting = InterruptingBackend(0)  # never interrupts; counts the chunks it evaluates
     resumed = run_sweep(spec, counting, scheduler="serial", chunk_size=7, parts=tmp_path / "p", resume=True)
     assert resumed.info["processes"] == 1 and resumed.n_chunks == 9  # the parts' chunk size is kept
     assert counting.calls == 9 - 3  # only the missing chunks are evaluated
@@ -254,7 +241,7 @@ def test_table_on_disk_when_over_the_memory_budget(tmp_path):
                      random={"sphere.E": {"normal_rel": 0.05}}, samples=5, seed=2)
     whole = run_sweep(spec, scheduler="serial", chunk_size=100)
     with pytest.raises(SweepInterrupted) as info:
-        run_sweep(spec, _Interrupting(4), scheduler="serial", chunk_size=100, parts=tmp_path / "p", in_memory=False)
+        run_sweep(spec, InterruptingBackend(4), scheduler="serial", chunk_size=100, parts=tmp_path / "p", in_memory=False)
     partial = info.value.result
     assert isinstance(partial, DiskSweepResult) and partial.columns == {}
     assert len(partial) == 300 and info.value.missing == spec.n_cases - 300

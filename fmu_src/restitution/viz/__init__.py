@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-__all__ = ["write_png"]
+__all__ = ["write_png", "finish"]
 
 
 def write_png(fig, path: Path, dpi: int) -> Path:
@@ -36,4 +36,16 @@ def write_png(fig, path: Path, dpi: int) -> Path:
     finally:
         if os.path.exists(tmp):
             os.unlink(tmp)
+    return path
+
+
+def finish(fig, path: Path, dpi: int, show: bool = False) -> Path:
+    """What every example does with its figure: :func:`write_png` it to ``path``, show it on screen when
+    ``show`` (blocking until the window closes), close it; returns ``path``."""
+    import matplotlib.pyplot as plt
+
+    write_png(fig, path, dpi)
+    if show:
+        plt.show()
+    plt.close(fig)
     return path
