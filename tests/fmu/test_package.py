@@ -142,9 +142,10 @@ def test_installed_package_builds_the_fmus_and_runs_a_scene_outside_the_checkout
                            capture_output=True, text=True, check=True).stdout
     assert where.startswith(site), where
     installed = subprocess.run([str(py), "-c", "from importlib import metadata; m = metadata.metadata('restitution'); "
-                                "print(m['Version'], m['License-Expression'])"],
-                               cwd=work, capture_output=True, text=True, check=True).stdout.split()
-    assert installed == [r.__version__, "MIT"]
+                                "print(m['Version'], m['License-Expression']); print(m['Summary'])"],
+                               cwd=work, capture_output=True, text=True, check=True).stdout.splitlines()
+    assert installed[0].split() == [r.__version__, "MIT"]
+    assert "FMI 2.0 and 3.0" in installed[1] and "model exchange" in installed[1]  # what the FMUs now offer
     out = work / "fmus"
     proc = subprocess.run([str(venv / "bin" / "restitution-fmu"), "build", "--out", str(out)], cwd=work,
                           capture_output=True, text=True)
