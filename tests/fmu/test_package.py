@@ -122,9 +122,21 @@ def test_no_fmu_and_none_buildable_is_one_line_naming_fmu_path(tmp_path):
 
 
 @pytest.mark.slow
-def test_installed_package_builds_the_fmus_and_runs_a_scene_outside_the_checkout(tmp_path):
-    """pip install <repo> (not editable) into a fresh venv whose dependencies come from the test
-    environment; then, from another directory: restitution-fmu build, and a scene through it."""
+def test_the_release_installs_builds_the_fmus_and_runs_a_scene_outside_the_checkout(tmp_path):
+    """What an index would get: ``python -m build`` makes the sdist and, from it, the wheel (so the sdist
+    holds everything the wheel needs), both pass ``twine check``; the wheel installs into a fresh venv
+    whose dependencies come from the test environment; then, from another directory: restitution-fmu
+    build, and a scene through it."""
+    dist = tmp_path / "release"
+    proc = subprocess.run([sys.executable, "-m", "build", "--no-isolation", "--outdir", str(dist), str(ROOT)],
+                          capture_output=True, text=True, cwd=tmp_path)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    sdist, = dist.glob("restitution-*.tar.gz")
+    wheel, = dist.glob("restitution-*-py3-none-any.whl")
+    assert sdist.name == f"restitution-{r.__version__}.tar.gz"
+    proc = subprocess.run([sys.executable, "-m", "twine", "check", "--strict", str(sdist), str(wheel)],
+                          capture_output=True, text=True)
+    assert proc.returncode == 0 and proc.stdout.count("PASSED") == 2, proc.stdout + proc.stderr
     venv = tmp_path / "venv"
     subprocess.run([sys.executable, "-m", "venv", str(venv)], check=True)
     py = venv / "bin" / "python"
@@ -134,7 +146,7 @@ def test_installed_package_builds_the_fmus_and_runs_a_scene_outside_the_checkout
     # the test environment's packages as plain path entries: its .pth files (the editable install of
     # this checkout) are not processed, so only the copy installed below can provide restitution
     (Path(site) / "test_env_deps.pth").write_text(str(deps) + "\n")
-    subprocess.run([str(py), "-m", "pip", "install", "--quiet", "--no-deps", str(ROOT)],
+    subprocess.run([str(py), "-m", "pip", "install", "--quiet", "--no-deps", str(wheel)],
                    check=True, capture_output=True)
     work = tmp_path / "elsewhere"
     work.mkdir()
