@@ -7,7 +7,7 @@ shipped with the package so that an installed package can build FMUs that carry 
 """
 from pathlib import Path
 
-VERSION = "0.2.0"
+VERSION = "0.3.0"
 AUTHOR = "restitution developers"
 LICENSE = "MIT"  # SPDX identifier
 COPYRIGHT = "Copyright (c) 2026 the restitution developers"
