@@ -1,4 +1,4 @@
-"""Sphinx configuration of the documentation site (issue 33).
+"""Sphinx configuration of the documentation site.
 
     sphinx-build -W --keep-going -b html docs OUT        (needs the ``docs`` extra)
 

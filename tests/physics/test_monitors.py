@@ -125,7 +125,7 @@ def test_the_edge_distance_takes_units():
 
 
 def test_each_departure_names_its_quantity_value_and_limit():
-    """The thin plate of issue 30 (0.5 mm at 3 m/s: lambda = 17, e < 0) with a near edge."""
+    """A thin plate (0.5 mm at 3 m/s: lambda = 17, e < 0) with a near edge."""
     res = r.impact(3.0, **{**params(), "plate_t": 0.5e-3}, plate_edge_distance=0.01)
     said = dict(departures(res.as_dict()))
     assert set(said) == {"lambda", "e_negative", "edge_echo"}

@@ -1,4 +1,4 @@
-"""Sweep rough edges (issue 33): a small sweep given no scheduler runs serially (a LocalCluster would
+"""Sweep rough edges: a small sweep given no scheduler runs serially (a LocalCluster would
 not win back its start), a Ctrl-C of a Dask sweep prints the one interrupt line and nothing else
 whenever it comes, and --resume says what it reused and rates only the cases it evaluated."""
 import os
@@ -151,5 +151,5 @@ def test_ctrl_c_of_a_dask_sweep_is_one_line_whenever_it_comes(tmp_path, impact_f
     # as the FMU is instantiated on the workers: the end-of-sweep release_fmus() met it (No module named ...)
     _ctrl_c(tmp_path / "fmu", [*SLOW, "--backend", "fmu", "--fmu", str(impact_fmu)], "first")
     _ctrl_c(tmp_path / "chunks", SLOW, 3)  # while chunks compute
-    for i in range(3):  # while chunks are taken from the workers: the race of issue 33, repeated
+    for i in range(3):  # while chunks are taken from the workers: the race that printed CommClosedError, repeated
         _ctrl_c(tmp_path / f"gather{i}", FAST, 5 + 7 * i)
