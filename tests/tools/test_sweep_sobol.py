@@ -83,26 +83,58 @@ def test_additive_model_gives_each_input_its_share_of_the_variance():
             assert_close(section["sobol"][key][name], {"S1": share, "ST": share}, name)
 
 
-def test_ishigami_function_matches_its_known_indices():
-    # Ishigami (a = 7, b = 0.1) on three inputs drawn uniform on [-pi, pi]: first-order and total indices
-    # from its variance decomposition (x3 acts only through its interaction with x1).
-    a, b = 7.0, 0.1
+#: The Ishigami function (a = 7, b = 0.1) on three inputs drawn uniform on [-pi, pi], the inputs' sweep names
+ISHIGAMI_A, ISHIGAMI_B = 7.0, 0.1
+ISHIGAMI_INPUTS = ("v_approach", "plate.Sy", "sphere.nu")
+
+
+def ishigami_exact():
+    """First-order and total indices of the Ishigami function from its variance decomposition (x3 acts only
+    through its interaction with x1)."""
+    a, b = ISHIGAMI_A, ISHIGAMI_B
     v1 = b * math.pi**4 / 5 + b**2 * math.pi**8 / 50 + 0.5
     v2 = a**2 / 8
     v13 = b**2 * math.pi**8 / 18 - b**2 * math.pi**8 / 50
     var = v1 + v2 + v13
-    exact = {"v_approach": {"S1": v1 / var, "ST": (v1 + v13) / var}, "plate.Sy": {"S1": v2 / var, "ST": v2 / var},
-             "sphere.nu": {"S1": 0.0, "ST": v13 / var}}
-    names = list(exact)
-    spec = dict(random={name: f"uniform:{-math.pi!r}:{math.pi!r}" for name in names}, samples=4096, seed=5)
+    x1, x2, x3 = ISHIGAMI_INPUTS
+    return {x1: {"S1": v1 / var, "ST": (v1 + v13) / var}, x2: {"S1": v2 / var, "ST": v2 / var},
+            x3: {"S1": 0.0, "ST": v13 / var}}
 
-    def model(cases):
-        x1, x2, x3 = (cases[name] for name in names)
-        return np.sin(x1) + a * np.sin(x2) ** 2 + b * x3**4 * np.sin(x1)
 
-    section = indices_of(spec, model, chunk_size=7777)
-    for name in names:
+def ishigami(cases):
+    x1, x2, x3 = (cases[name] for name in ISHIGAMI_INPUTS)
+    return np.sin(x1) + ISHIGAMI_A * np.sin(x2) ** 2 + ISHIGAMI_B * x3**4 * np.sin(x1)
+
+
+def ishigami_spec(samples, seed):
+    return dict(random={name: f"uniform:{-math.pi!r}:{math.pi!r}" for name in ISHIGAMI_INPUTS}, samples=samples,
+                seed=seed)
+
+
+def test_ishigami_function_matches_its_known_indices():
+    exact = ishigami_exact()
+    section = indices_of(ishigami_spec(4096, 5), ishigami, chunk_size=7777)
+    for name in ISHIGAMI_INPUTS:
         assert_close(section["sobol"]["e"][name], exact[name], name)
+
+
+def test_the_intervals_cover_the_true_indices_over_many_designs():
+    """The 95 % bootstrap intervals (SALib's, 100 resamples) of the Ishigami indices over 100 designs, each
+    scrambled with its own seed (N = 512): for every index that is not zero the interval holds the true value
+    in at least 90 of them (measured: 96 to 100; on a scrambled Sobol' sequence the estimates scatter less than
+    the bootstrap, which resamples them as if random, assumes). An index that is exactly zero (x3 alone) is
+    covered less often (measured: 84): docs/sweeps.md says so; here at least 75."""
+    exact = ishigami_exact()
+    covered = {(name, field): 0 for name in ISHIGAMI_INPUTS for field in ("S1", "ST")}
+    n_designs = 100
+    for seed in range(1, n_designs + 1):
+        indices = indices_of(ishigami_spec(512, seed), ishigami, chunk_size=100_000)["sobol"]["e"]
+        for (name, field) in covered:
+            s = indices[name]
+            covered[(name, field)] += abs(s[field] - exact[name][field]) <= s[f"{field}_conf"]
+    for (name, field), hits in covered.items():
+        floor = 75 if exact[name][field] == 0.0 else 90
+        assert hits >= floor, (name, field, hits, n_designs)
 
 
 def test_the_design_does_not_depend_on_chunks_and_resumed_chunks_are_collected(tmp_path, monkeypatch):
