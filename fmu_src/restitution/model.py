@@ -17,7 +17,8 @@ from ._num import is_scalar, minimum, where
 from .fusion import apparent_restitution, mass_ratio
 from .jgm import restitution_e44, restitution_e45, vstar_in_fit_range
 from .quantities import si_only, with_units
-from .validation import check_choice, check_nonnegative, check_poisson, check_positive
+from .validation import (check_choice, check_nonnegative, check_nonnegative_or_infinite, check_poisson,
+                         check_positive)
 from .zener import (TAU0_HERTZ, ZENER_METHODS, edge_clear, lambda_from_terms, lambda_in_studied_range,
                     lambda_material_terms, wave_delay, waves_concurrent, zener_linear, zener_paper_fit, zener_solution)
 
@@ -75,20 +76,7 @@ def check_edge_distance(value):
     """The distance [m] from the impact point to the plate's nearest edge: >= 0, where 0 and +inf
     both mean an unbounded plate (Zener's assumption; 0 is how the FMUs say it, their values being
     finite); ValueError otherwise (negative, NaN)."""
-    if value.__class__ is float and value >= 0.0:  # fast path, +inf included
-        return value
-    if is_scalar(value):
-        v = float(value)
-        if not v >= 0.0:
-            raise ValueError(f"plate.edge_distance = {v!r} m is outside the allowed range: >= 0 "
-                             "(0 or inf: an unbounded plate)")
-        return v
-    arr = np.asarray(value, dtype=float)
-    if not np.all(arr >= 0.0):
-        bad = float(arr[~(arr >= 0.0)].flat[0])
-        raise ValueError(f"plate.edge_distance = {bad!r} m is outside the allowed range: >= 0 "
-                         "(0 or inf: an unbounded plate)")
-    return arr
+    return check_nonnegative_or_infinite("plate.edge_distance", value, "m", ">= 0 (0 or inf: an unbounded plate)")
 
 
 _PARAMETER_CHECKS = tuple((name, name.replace("_", ".", 1), unit, kind) for name, unit, kind in PARAMETERS)

@@ -7,7 +7,7 @@ import numpy as np
 
 from ._num import is_scalar
 
-__all__ = ["check_positive", "check_nonnegative", "check_poisson", "check_choice"]
+__all__ = ["check_positive", "check_nonnegative", "check_nonnegative_or_infinite", "check_poisson", "check_choice"]
 
 
 def _check(name, value, unit, ok_scalar, ok_array, allowed):
@@ -41,6 +41,14 @@ def check_nonnegative(name: str, value, unit: str = ""):
     u = f" {unit}" if unit else ""
     return _check(name, value, u, lambda v: math.isfinite(v) and v >= 0.0,
                   lambda a: np.isfinite(a) & (a >= 0.0), "finite and >= 0")
+
+
+def check_nonnegative_or_infinite(name: str, value, unit: str = "", allowed: str = ">= 0"):
+    """Require values >= 0, +inf included (NaN refused); ``allowed`` says what the range means."""
+    if value.__class__ is float and value >= 0.0:  # fast path, same result
+        return value
+    u = f" {unit}" if unit else ""
+    return _check(name, value, u, lambda v: v >= 0.0, lambda a: a >= 0.0, allowed)
 
 
 def check_poisson(name: str, value):

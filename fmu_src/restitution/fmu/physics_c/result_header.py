@@ -2,7 +2,8 @@
 (:data:`restitution.model.RECORD_REALS` and :data:`restitution.model.RECORD_FLAGS`, the fields of
 :class:`restitution.ImpactResult`): a ``double`` for each real and an ``int`` for each flag, in the same
 order and under the same names, and the two lists as X-macros (``RST_IMPACT_RESULT_REALS(X)``,
-``RST_IMPACT_RESULT_FLAGS(X)``) for the code that treats every field alike. So the C physics fills the
+``RST_IMPACT_RESULT_FLAGS(X)``) for the code that treats every field alike, and the cap the FMUs publish for
+an infinite edge echo (``RST_EDGE_ECHO_PUBLISHED_MAX``). So the C physics fills the
 fields the package defines, and a new field is one edit of ``ImpactResult`` (docs/adding_an_output.md).
 Generated at build time beside the physics, never edited, never committed; the tests' ctypes view reads
 the same two lists.
@@ -13,7 +14,7 @@ from __future__ import annotations
 
 import sys
 
-from ...model import RECORD_FLAGS, RECORD_REALS
+from ...model import EDGE_ECHO_PUBLISHED_MAX, RECORD_FLAGS, RECORD_REALS
 
 __all__ = ["RESULT_HEADER", "result_header"]
 
@@ -35,7 +36,10 @@ def result_header() -> str:
     lines += ["typedef struct {"]
     lines += [f"    double {name};" for name in RECORD_REALS]
     lines += [f"    int {name};" for name in RECORD_FLAGS]
-    lines += ["} rst_impact_result;", "", "#endif", ""]
+    lines += ["} rst_impact_result;", ""]
+    # what the FMUs publish for the record's infinite edge echo (restitution.model.published)
+    lines += ["/* restitution.model.EDGE_ECHO_PUBLISHED_MAX [1] */",
+              f"#define RST_EDGE_ECHO_PUBLISHED_MAX {EDGE_ECHO_PUBLISHED_MAX!r}", "", "#endif", ""]
     return "\n".join(lines)
 
 

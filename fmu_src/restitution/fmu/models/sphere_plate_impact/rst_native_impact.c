@@ -9,7 +9,6 @@
 
 #define VR(name) RST_SPHEREPLATEIMPACT_VR_##name
 #define CODE(name) RST_SPHEREPLATEIMPACT_##name
-#define RST_EDGE_ECHO_PUBLISHED_MAX 1e9 /* restitution.model.EDGE_ECHO_PUBLISHED_MAX [1] */
 
 /* The FMU's codes are the physics' (both follow restitution.model): checked when compiling. */
 #define SAME(fmu_code, physics_code) ((int)CODE(fmu_code) == (int)(physics_code))
