@@ -187,8 +187,8 @@ def _cost_class(spec) -> int:
             values = spec._fixed[name]
         elif name in spec.grid:
             values = spec.axes[name]
-        elif name in spec._dists:
-            kind, args = spec._dists[name]
+        elif name in spec.distributions:
+            kind, args = spec.distributions[name]
             values = args if kind == "choice" else (code,)  # a continuous draw of a code: assume the worst
         else:
             values = (START[name],)

@@ -115,13 +115,13 @@ class SobolSpec(SweepSpec):
 
     def __post_init__(self):
         super().__post_init__()
-        if not self._dists:
+        if not self.distributions:
             raise SobolError("--sobol needs the inputs to vary: give each with --random NAME=DIST")
         if self.grid or len(self.pairs) > 1:
             axes = [f"--grid {k}" for k in self.grid] + (["several --pair"] if len(self.pairs) > 1 else [])
             raise SobolError(f"--sobol samples the --random inputs at one point: {', '.join(axes)} makes a "
                              f"grid; give those values with --set (or one --pair) and sweep each point on its own")
-        self.problem = salib_problem(self._dists)
+        self.problem = salib_problem(self.distributions)
         n = self.base_samples
         if n < 2 or n & (n - 1):
             above = 2 ** max(1, math.ceil(math.log2(max(n, 1))))

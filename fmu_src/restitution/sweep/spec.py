@@ -230,6 +230,11 @@ class SweepSpec:
                                 f"(each worker builds it): use a coarser axis or a random draw")
 
     @property
+    def distributions(self) -> dict:
+        """The random inputs as parsed: name -> (kind, parameters in SI), e.g. ("uniform_rel", (0.15,))."""
+        return self._dists
+
+    @property
     def _axes(self) -> dict:
         if self._axes_built is None:
             self._axes_built = {k: args if kind == "values" else range_values(k, kind, args)

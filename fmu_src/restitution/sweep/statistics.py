@@ -264,7 +264,7 @@ class SweepStatistics:
     def _describe_spec(self) -> dict:
         spec = self.spec
         random = {}
-        for name, (kind, args) in spec._dists.items():
+        for name, (kind, args) in spec.distributions.items():
             unit = "1" if kind.endswith("_rel") or name == T_OVER_D else (unit_of(name) or "1")
             random[name] = {"given": spec.random[name], "distribution": kind, "parameters": list(args),
                             "unit": unit, **({"relative_to": "the value the case has without the draw"}
