@@ -226,12 +226,28 @@ def main(argv=None) -> int:
         print(_list())
         return 0
     try:
-        return _main(parser, args)
+        status = _main(parser, args)
     except KeyboardInterrupt:  # outside the sweep itself (which writes what is done): nothing to keep
         print("\ninterrupted before the sweep started or after its table was written", file=sys.stderr)
-        return EXIT_INTERRUPTED
+        status = EXIT_INTERRUPTED
     except OSError as exc:  # an I/O error outside the outputs (the FMU extracted to a full /tmp, ...)
         return _error(describe_os_error(exc), EXIT_IO_ERROR)
+    if status == EXIT_INTERRUPTED:
+        _ignore_further_interrupts()
+    return status
+
+
+def _ignore_further_interrupts() -> None:
+    """SIGINT ignored once the interpreter shuts down, after the sweep decided to exit interrupted.
+
+    A SIGINT still pending then (blocked in the cluster's threads) would be delivered after Python
+    has put back the default action and kill the process by the signal (status -2) after it said what
+    it kept, instead of the 130 it reports. An exit hook, not an immediate change, so a caller who
+    runs main() in process keeps its Ctrl-C."""
+    import atexit
+    import signal
+
+    atexit.register(signal.signal, signal.SIGINT, signal.SIG_IGN)
 
 
 def _main(parser, args) -> int:
