@@ -18,9 +18,10 @@ previous one, so one is outstanding at a time and each must come back as one exc
 code: none may give fmi2Fatal or be lost, none may escape the loop, and the values stay right.
 
 * SIGINT with Python's default handler (KeyboardInterrupt), SIGINT and SIGTERM with Python handlers that
-  raise: 250 signals each, 1,000 in all, about 0.3 s of signals per scenario;
-* SIGINT and SIGTERM with the default action: the process dies of the signal at once, even inside a
-  call (the guard holds back only signals the host handles).
+  raise, and SIGTERM with a handler the host installed after the guard's first call (in the place of the
+  guard's relay): 250 signals each, 1,250 in all, about 0.3 s of signals per scenario;
+* SIGINT and SIGTERM with the default action, from the start or set back after a handler: the process
+  dies of the signal at once, even inside a call (the guard holds back only signals the host handles).
 """
 from __future__ import annotations
 
@@ -53,9 +54,24 @@ class Terminated(Exception):
     pass
 
 
-if HANDLER == "raise":
+class Stale(Exception):
+    pass
+
+
+if HANDLER in ("raise", "changed"):
     def on_signal(signum, frame):
         raise Terminated(signum)
+    if HANDLER == "changed":
+        # the guard's relay takes the place of a first handler at the first call; the host then installs
+        # its own between calls: that one must be the one signals reach (a Stale escapes the loop)
+        def stale(signum, frame):
+            raise Stale(signum)
+        signal.signal(SIGNUM, stale)
+        first = instance("first")
+        first.setReal([VR["x"]], [2.0])
+        first.doStep(0.0, H)
+        first.terminate()
+        first.freeInstance()
     signal.signal(SIGNUM, on_signal)
 EXPECTED = KeyboardInterrupt if HANDLER == "default" else Terminated
 
@@ -189,8 +205,11 @@ def interrupt_fmu(tmp_path_factory):
     return fmu, extract(str(fmu), str(work / "unzipped"))
 
 
-#: (signal, the host's handler, seed): 250 random moments each, 1,000 in all (about 0.3 s per scenario).
-SCENARIOS = [("SIGINT", "default", 1), ("SIGINT", "default", 2), ("SIGINT", "raise", 3), ("SIGTERM", "raise", 4)]
+#: (signal, the host's handler, seed): 250 random moments each, 1,250 in all (about 0.3 s per scenario).
+#: "changed": the host replaces a handler by its own after the guard's first call (what the guard holds
+#: back is then the new one's).
+SCENARIOS = [("SIGINT", "default", 1), ("SIGINT", "default", 2), ("SIGINT", "raise", 3), ("SIGTERM", "raise", 4),
+             ("SIGTERM", "changed", 5)]
 N_SIGNALS = 250
 
 
@@ -208,10 +227,16 @@ def test_random_signals_never_give_fatal(interrupt_fmu, signame, handler, seed):
 
 DEFAULT_ACTION_CODE = r"""
 import signal
-signal.signal(getattr(signal, ARGS[0]), signal.SIG_DFL)
+SIGNUM = getattr(signal, ARGS[0])
 s = instance("defaulted")
-print("RUNNING", flush=True)
 t = 0.0
+if ARGS[1] == "after_a_handler":  # the guard's relay in the place of a handler first, then the default action
+    signal.signal(SIGNUM, lambda signum, frame: None)
+    s.setReal([VR["x"]], [2.0])
+    s.doStep(t, 1e-3)
+    t += 1e-3
+signal.signal(SIGNUM, signal.SIG_DFL)
+print("RUNNING", flush=True)
 while True:
     s.setReal([VR["x"]], [2.0])
     s.doStep(t, 1e-3)
@@ -220,12 +245,15 @@ while True:
 """
 
 
-@pytest.mark.parametrize("signame, delay", [("SIGTERM", 0.013), ("SIGTERM", 0.171), ("SIGINT", 0.089)])
-def test_a_signal_with_the_default_action_ends_the_process(interrupt_fmu, signame, delay):
-    """Nothing is held back then (no Python code would run for it): the process ends at once."""
+@pytest.mark.parametrize("signame, delay, before", [("SIGTERM", 0.013, "none"), ("SIGTERM", 0.171, "none"),
+                                                    ("SIGINT", 0.089, "none"), ("SIGTERM", 0.052, "after_a_handler"),
+                                                    ("SIGINT", 0.127, "after_a_handler")])
+def test_a_signal_with_the_default_action_ends_the_process(interrupt_fmu, signame, delay, before):
+    """Nothing is held back then (no Python code would run for it): the process ends at once, also when
+    the host had a handler at the guard's first calls and set the default action back since."""
     fmu, unzip = interrupt_fmu
     script = PRELUDE + "\n" + textwrap.dedent(DEFAULT_ACTION_CODE)
-    proc = subprocess.Popen([sys.executable, "-c", script, str(fmu), str(unzip), signame],
+    proc = subprocess.Popen([sys.executable, "-c", script, str(fmu), str(unzip), signame, before],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
         assert proc.stdout.readline().startswith("RUNNING")

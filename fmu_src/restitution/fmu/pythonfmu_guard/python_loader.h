@@ -32,8 +32,8 @@ const pythonfmu_api *pyloader_ensure_ready(rst_instance *inst, const char *resou
  * thread when this module started the interpreter). */
 void pyloader_attach_thread(void);
 
-/* Around every call into pythonfmu in a Python host (fmpy, libcosimpy), after the host's signal handlers
- * have been set aside (pythonfmu_backend.c): pyloader_enter_call takes the GIL and runs, on the
+/* Around every call into pythonfmu in a Python host (fmpy, libcosimpy), once the held signals are only
+ * noted (pythonfmu_backend.c): pyloader_enter_call takes the GIL and runs, on the
  * interpreter's main thread, the Python signal handlers and pending calls that were already due, so that
  * they cannot run inside the slave's code; what they raise is kept in `call`. pyloader_leave_call has it
  * raised again in the host's code (at the interpreter's next check, between two FMI calls) and releases
