@@ -65,10 +65,16 @@ PARAMETERS, impact, published = _model.PARAMETERS, _model.impact, _model.publish
 si_only = _support.submodule(_restitution, "quantities").si_only
 departures = _support.submodule(_restitution, "assumptions").departures
 
-#: FMU name of each Real output, by ImpactResult key
-_REAL_OUTPUTS = {v.key: v.name for v in TABLE.outputs if v.type == "Real"}
-# one C call for the step's finiteness check instead of a Python loop over the outputs
-_real_output_values = operator.itemgetter(*_REAL_OUTPUTS)
+#: The outputs of each FMI type, in value-reference order (every output is a Real or a Boolean).
+_OUTPUTS = {vtype: tuple(v for v in TABLE.outputs if v.type == vtype) for vtype in ("Real", "Boolean")}
+#: What the outputs of each type read while they are invalid (the last evaluation failed).
+_INVALID = {"Real": (math.nan,) * len(_OUTPUTS["Real"]), "Boolean": (False,) * len(_OUTPUTS["Boolean"])}
+# published values -> the Real outputs in order, one C call
+_real_values = operator.itemgetter(*(v.key for v in _OUTPUTS["Real"]))
+# "valid" is a property of the result, not one of its fields: where it sits among the Boolean outputs,
+# and the getter of the others
+_VALID_AT = [v.key for v in _OUTPUTS["Boolean"]].index("valid")
+_flag_values = operator.itemgetter(*(v.key for v in _OUTPUTS["Boolean"] if v.key != "valid"))
 #: impact() without its unit layer: the FMU's values are SI floats
 _impact_si = si_only(impact)
 
@@ -79,13 +85,27 @@ _PHYSICAL = tuple(TABLE.by_key()[key].name for key, _unit, _check in PARAMETERS)
 _FMI_CAUSALITY = {"input": Fmi2Causality.input, "parameter": Fmi2Causality.parameter, "output": Fmi2Causality.output}
 
 
-def nonfinite_outputs(outputs: dict) -> list[str]:
-    """The Real outputs that are NaN or infinite (``name = value`` texts). Every output is finite
-    (``outputs`` as :func:`restitution.model.published` gives them): anything else is an evaluation
-    failure."""
-    if math.isfinite(sum(_real_output_values(outputs))):  # the usual case, one C loop (a NaN or inf, or an overflow, falls through)
+def nonfinite_outputs(reals: tuple) -> list[str]:
+    """The Real outputs that are NaN or infinite (``name = value`` texts), ``reals`` being their values in
+    value-reference order. Every output is finite (:func:`restitution.model.published`): anything else
+    is an evaluation failure."""
+    if math.isfinite(sum(reals)):  # the usual case, one C loop (a NaN or inf, or an overflow, falls through)
         return []
-    return [f"{name} = {outputs[key]!r}" for key, name in _REAL_OUTPUTS.items() if not math.isfinite(outputs[key])]
+    return [f"{var.name} = {value!r}" for var, value in zip(_OUTPUTS["Real"], reals) if not math.isfinite(value)]
+
+
+def output_reader(positions: list, count: int):
+    """values (the ``count`` outputs of one type, in order) -> the list of those at ``positions``: what a
+    get request of these outputs returns."""
+    if positions == list(range(count)):  # every output of the type, in order: what hosts ask for
+        return list
+    if len(positions) == 1:  # itemgetter of one key gives the value itself, of none is an error
+        (at,) = positions
+        return lambda values: [values[at]]
+    if not positions:
+        return lambda values: []
+    pick = operator.itemgetter(*positions)
+    return lambda values: list(pick(values))
 
 
 class SpherePlateImpact(Fmi2Slave):
@@ -97,14 +117,18 @@ class SpherePlateImpact(Fmi2Slave):
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
         self._values = {}  # name -> current value of every input and parameter
-        self._outputs = {}
         self._stale = True  # an input or parameter changed since the last evaluation
         self._call = None  # impact()'s arguments but v, built when a parameter changed
         self._used = None  # the parameters with each body's material preset applied, when a parameter changed
         self._failure = None  # message of the last evaluation that raised
         self._warned = set()  # the conditions of restitution.assumptions logged (pythonfmu's reset makes a new slave)
-        self._output_keys = {}  # (Real|Boolean, value reference) -> ImpactResult key, for get_real/get_boolean
-        self._last_read = {"Real": (None, None), "Boolean": (None, None)}  # type -> (vrs, reader) of the last get
+        # the outputs of each type, in order, as of the last evaluation (invalid until the first)
+        self._current = dict(_INVALID)
+        # per type: value reference -> position among the outputs of that type
+        self._positions = {vtype: {} for vtype in _OUTPUTS}
+        # per type: (value references, reader) of the last get request; reader None: not only outputs
+        self._request = {vtype: (None, None) for vtype in _OUTPUTS}
+        self._real_setters = {}  # value reference -> checked setter of each Real input and parameter
         for var in TABLE:
             kind = {"Real": Real, "Integer": Integer, "Boolean": Boolean}[var.type]
             variability = getattr(Fmi2Variability, var.variability)
@@ -115,17 +139,21 @@ class SpherePlateImpact(Fmi2Slave):
                     getter=self._used_getter(var.name)), nested=False)
                 continue
             if var.causality == "output":
+                positions = self._positions[var.type]
                 fmi_var = kind(var.name, causality=Fmi2Causality.output, variability=variability,
                                initial=Fmi2Initial.calculated, description=var.description,
-                               getter=self._output_getter(var.key, var.type))
+                               getter=self._output_getter(var.type, len(positions)))
                 self.register_variable(fmi_var, nested=False)
-                self._output_keys.setdefault(var.type, {})[fmi_var.value_reference] = var.key
+                positions[fmi_var.value_reference] = len(positions)
                 continue
             self._values[var.name] = var.start
-            self.register_variable(kind(
-                var.name, causality=_FMI_CAUSALITY[var.causality], variability=variability, start=var.start,
-                description=var.description, getter=self._input_getter(var.name),
-                setter=checked_setter(self, var, self._values, self._changed)), nested=False)
+            setter = checked_setter(self, var, self._values, self._changed)
+            fmi_var = kind(var.name, causality=_FMI_CAUSALITY[var.causality], variability=variability,
+                           start=var.start, description=var.description, getter=self._input_getter(var.name),
+                           setter=setter)
+            self.register_variable(fmi_var, nested=False)
+            if var.type == "Real":
+                self._real_setters[fmi_var.value_reference] = setter
         self._schema = state_schema("SpherePlateImpact", list(self._values))
 
     # --- variable access -------------------------------------------------------------
@@ -149,63 +177,63 @@ class SpherePlateImpact(Fmi2Slave):
             self._call = None
             self._used = None
 
-    def _output_getter(self, key, vtype):
-        nan = math.nan if vtype == "Real" else False
-
+    def _output_getter(self, vtype, position):
+        """One output, for pythonfmu's per-variable path (requests mixing outputs with other variables):
+        NaN (Real) or False (Boolean) while the outputs are invalid."""
         def get_value():
-            if self._stale or self._failure is not None:
-                outputs = self._evaluate()
-                return outputs.get(key, nan) if outputs is not None else nan
-            return self._outputs[key]  # the common case: cached, valid
+            if self._stale:
+                self._evaluate()
+            return self._current[vtype][position]
         return get_value
 
-    # fmi2GetReal/fmi2GetBoolean: pythonfmu's versions call one getter per variable (and each
-    # getter checks the cache); for outputs only, evaluate once and read them in one pass. The
-    # values are those of the getters: NaN (Real) or False (Boolean) while the outputs are invalid.
-    # Requests that include inputs or parameters take pythonfmu's path, with its checks.
-    # A host asks for the same list step after step: the reader of the last list is kept, so a
-    # repeated request costs one list comparison instead of a lookup per value reference.
+    # fmi2SetReal: pythonfmu's version looks each variable up and checks its type; the setters of the
+    # Real inputs and parameters are kept by value reference instead. Anything else takes pythonfmu's
+    # path, with its checks.
+    def set_real(self, vrs, values):
+        setters = self._real_setters
+        for vr, value in zip(vrs, values):
+            setter = setters.get(vr)
+            if setter is None:
+                super().set_real([vr], [value])
+            else:
+                setter(value)
+
+    # fmi2GetReal/fmi2GetBoolean: pythonfmu's versions call one getter per variable; for outputs only,
+    # evaluate once (if anything changed) and read them in one pass from the values kept per type. A
+    # host asks for the same list step after step: the reader of the last list is kept, so a repeated
+    # request costs one list comparison. Requests that include inputs or parameters take pythonfmu's
+    # path, with its checks.
     def get_real(self, vrs):
-        return self._get_outputs("Real", vrs, math.nan, super().get_real)
+        return self._get_outputs("Real", vrs, super().get_real)
 
     def get_boolean(self, vrs):
-        return self._get_outputs("Boolean", vrs, False, super().get_boolean)
+        return self._get_outputs("Boolean", vrs, super().get_boolean)
 
-    def _get_outputs(self, vtype, vrs, invalid_value, general_get):
-        last_vrs, read = self._last_read[vtype]
+    def _get_outputs(self, vtype, vrs, general_get):
+        last_vrs, read = self._request[vtype]
         if vrs != last_vrs:
             read = self._remember_reader(vtype, vrs)
         if read is None:
             return general_get(vrs)
-        outputs = self._evaluate()
-        return read(outputs) if outputs is not None else [invalid_value] * len(vrs)
+        if self._stale:
+            self._evaluate()
+        return read(self._current[vtype])
 
     def _remember_reader(self, vtype, vrs):
-        """outputs -> the list of values of ``vrs``, or None when ``vrs`` names anything but outputs
-        of type ``vtype``; kept as the reader of ``vtype``'s last request."""
-        keys = self._output_keys[vtype]
+        """The reader (:func:`output_reader`) of the request ``vrs``, or None when it names anything but
+        outputs of type ``vtype``; kept as the reader of ``vtype``'s last request."""
+        positions = self._positions[vtype]
         try:
-            names = [keys[vr] for vr in vrs]
-        except KeyError:
-            names = None
-        if names is None:
+            read = output_reader([positions[vr] for vr in vrs], len(positions))
+        except (KeyError, TypeError):
             read = None
-        elif len(names) < 2:  # itemgetter of one key gives the value itself, of none is an error
-            def read(outputs):
-                return [outputs[name] for name in names]
-        else:
-            values = operator.itemgetter(*names)
-
-            def read(outputs):
-                return list(values(outputs))
-        self._last_read[vtype] = (list(vrs), read)
+        self._request[vtype] = (list(vrs), read)
         return read
 
     # --- evaluation --------------------------------------------------------------------
     def _evaluate(self):
-        """Outputs for the current inputs, recomputed only when an input or parameter changed."""
-        if not self._stale:
-            return self._outputs if self._failure is None else None
+        """The outputs for the current inputs (called when an input or parameter changed): kept in
+        ``_current``, invalid (NaN, False) when the evaluation fails."""
         self._stale = False
         v = self._values
         try:
@@ -218,17 +246,22 @@ class SpherePlateImpact(Fmi2Slave):
                          plate_edge_distance=float(v["plate.edge_distance"]), validate=False))
             args, kwargs = self._call
             result = _impact_si(float(v["v_approach"]), *args, **kwargs)
+            outputs = published(vars(result))  # the result's fields, not copied: neither changes them
+            reals = _real_values(outputs)
+            flags = _flag_values(outputs)
+            valid = result.valid
         except Exception as exc:  # a numerical failure must not become fmi2Fatal
-            return self._fail(f"{type(exc).__name__}: {exc}")
-        outputs = published(result.as_dict())
-        bad = nonfinite_outputs(outputs)
-        if bad:
-            return self._fail("non-finite output " + ", ".join(bad))
+            self._fail(f"{type(exc).__name__}: {exc}")
+            return
+        if not math.isfinite(sum(reals)):  # rare (a NaN or inf, or an overflow of the sum): which ones
+            bad = nonfinite_outputs(reals)
+            if bad:
+                self._fail("non-finite output " + ", ".join(bad))
+                return
         self._failure = None
-        self._outputs = outputs
-        if not (outputs["valid"] and outputs["edge_clear"] and not outputs["e_negative"]):  # rare: say it once
-            self._log_departures(outputs)
-        return self._outputs
+        self._current = {"Real": reals, "Boolean": flags[:_VALID_AT] + (valid,) + flags[_VALID_AT:]}
+        if not (valid and outputs["edge_clear"] and not outputs["e_negative"]):  # rare: say it once
+            self._log_departures(dict(outputs, valid=valid))
 
     def _log_departures(self, outputs):
         for name, message in departures(outputs):
@@ -238,18 +271,21 @@ class SpherePlateImpact(Fmi2Slave):
 
     def _fail(self, reason):
         self._failure = f"evaluation failed for {self._describe_inputs()}: {reason}"
+        self._current = dict(_INVALID)
         self.log(self._failure, Fmi2Status.error)
-        return None
 
     def _describe_inputs(self):
         return ", ".join(f"{k} = {val!r}" for k, val in self._values.items())
 
     # --- FMI calls -------------------------------------------------------------------------
     def exit_initialization_mode(self):
-        self._evaluate()
+        if self._stale:
+            self._evaluate()
 
     def do_step(self, current_time: float, step_size: float) -> bool:
-        if self._evaluate() is None:
+        if self._stale:
+            self._evaluate()
+        if self._failure is not None:
             self.log("fmi2DoStep discarded: the model could not be evaluated for the current inputs "
                      "(see the error above)", Fmi2Status.discard)
             return False
@@ -262,7 +298,7 @@ class SpherePlateImpact(Fmi2Slave):
         self._call = None
         self._used = None
         self._failure = None
-        self._outputs = {}
+        self._current = dict(_INVALID)
 
     # --- FMU state: the inputs and parameters, with a schema tag, validated before restoring ---
     def _get_fmu_state(self):
