@@ -34,7 +34,7 @@
  *   once the call returns. Either way the host sees its exception between two FMI calls (fmpy:
  *   KeyboardInterrupt in fmpy's code right after the call) and the instance goes on. A single long call
  *   is not interrupted. Cost: two system calls per call (the two dispositions, see "Signals held back"
- *   below), about 0.45 us.
+ *   below).
  * - FMU states: the front keeps them (the store's state variables, validated on restore), so
  *   pythonfmu's state functions, which leak and accept anything, are never called.
  */
@@ -92,8 +92,8 @@ typedef struct {
  * it again. Each call checks, with one system call per signal, that `relay` is still the disposition: when
  * the host has installed another handler since (Python's signal.signal, or C code), that one becomes the
  * host's and `relay` takes its place again; a default or ignored disposition is left alone. Swapping the
- * host's handler out and back in around every call instead cost three system calls per call, 0.7 us on a
- * 3 us call. The guard is never unloaded (pyloader_pin_self) while `relay` may be installed. */
+ * host's handler out and back in around every call instead cost three system calls per call. The guard is
+ * never unloaded (pyloader_pin_self) while `relay` may be installed. */
 static const int held[] = {SIGINT, SIGTERM};
 #define N_HELD ((int)(sizeof held / sizeof held[0]))
 
