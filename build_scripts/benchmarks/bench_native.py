@@ -5,7 +5,8 @@
 
 builds, in a scratch directory, the pythonfmu FMU (behind the C guard), the native FMU, a *floor*
 FMU (the same C front and generated interface table with a backend that does nothing) and two C
-programs, then measures, every ratio in this one run:
+programs (the timing host, with the *precomputed C floor* in it: the C physics with its parameter-only
+terms computed once, no FMI), then measures, every ratio in this one run:
 
 1. one impact (set v_approach, doStep, get all 11 Real and 6 Boolean outputs) through fmpy's
    ``FMU2Slave``, raw calls: native against the floor (goal <= 1.5x), and the pythonfmu FMU;
@@ -13,7 +14,10 @@ programs, then measures, every ratio in this one run:
    >= 30x faster), the native FMU's absolute figure (goal < 1 us), the native FMI 3.0 FMU against the
    native FMI 2.0 one (goal <= 1.1x), the floor, and the floor's four calls one by one (where the
    front's time goes);
-3. the C physics (``rst_impact``) against the package's scalar ``restitution.impact``.
+3. one impact as a simulation needs it (set v_approach, doStep, get e and v_rebound) in the plain C host:
+   native against the precomputed C floor (goal <= 3x), and the floor FMU against it (what of that
+   ratio is the C front; the rest is the physics and its glue);
+4. the C physics (``rst_impact``) against the package's scalar ``restitution.impact``.
 
 Prints the headline next to the goals and writes DIR/native_cost.md (DIR defaults to docs/).
 ``--quick`` (used by tests/tools/test_bench_native.py) measures 3 short repeats; the full run takes about a
@@ -90,17 +94,21 @@ def run(quick: bool = False, out_dir: Path | None = None, verbose: bool = True) 
         res["fmpy"] = timing.fmpy_round_trips(built, page.FMU_ROWS, reps, seconds)
         say("C host round trips ...")
         res["c_host"] = timing.c_host_round_trips(built, page.C_HOST_ROWS, reps, seconds)
+        say("C host, e and v_rebound: native, the floor FMU and the precomputed C floor ...")
+        res["impact"] = timing.c_host_round_trips(built, page.IMPACT_ROWS, reps, seconds,
+                                                  outputs=timing.IMPACT_OUTPUTS)
         say("C host, the floor's calls one by one ...")
         res["calls"] = timing.c_host_round_trips(built, ("floor",), reps, seconds / 2, each_call=True)
         say("C physics against the package ...")
         res["physics"] = timing.physics_against_package(built, reps, seconds / 2)
-    fm, ch, ph = res["fmpy"], res["c_host"], res["physics"]
+    fm, ch, ph, im = res["fmpy"], res["c_host"], res["physics"], res["impact"]
     native = ch.batches["native"]
     res["headline"] = {
         "native_over_floor_fmpy": (fm.ratio("native", "floor"), fm.spread("native", "floor")),
         "python_over_native_c_host": (ch.ratio("pythonfmu", "native"), ch.spread("pythonfmu", "native")),
         "native_c_host": (statistics.median(native), (min(native), max(native))),
         "fmi3_over_native_c_host": (ch.ratio("fmi3", "native"), ch.spread("fmi3", "native")),
+        "native_over_precomputed_c_host": (im.ratio("native", "precomputed"), im.spread("native", "precomputed")),
         "package_over_c_physics": (ph.ratio("package exact", "C exact"), ph.spread("package exact", "C exact")),
     }
     res["machine"]["load_end"] = os.getloadavg()[0]

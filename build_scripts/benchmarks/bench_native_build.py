@@ -8,7 +8,10 @@
   flags (``build_native.compile_binary``), with a glue file (``bench_c/floor_fmu.c``) whose backend
   does nothing: every hook returns at once and every output is a constant. What the native FMU costs
   above it is the physics and its glue; the floor itself is what the C front costs;
-* the plain C timing host (``bench_c/timing_host.c``) and the C-physics loop (``bench_c/physics_loop.c``).
+* the plain C timing host (``bench_c/timing_host.c``), with the *precomputed C floor* linked in
+  (``bench_c/precomputed_floor.c``: the C physics with its parameter-only terms computed once,
+  ``rst_impact_terms_of``, and only ``rst_impact_with_terms`` per impact, no FMI: the least one impact
+  can cost), and the C-physics loop (``bench_c/physics_loop.c``).
 
 Each FMU is returned unzipped (``binaries/linux64/<model>.so`` or, FMI 3.0, ``binaries/x86_64-linux/<model>.so``,
 ``resources/``, modelDescription.xml).
@@ -44,10 +47,17 @@ FLOOR_GLUE = BENCH_C / "floor_fmu.c"
 #: calling thread (CLOCK_THREAD_CPUTIME_ID): every FMU here computes in the caller's thread.
 #: ``each_call`` instead of ``round_trip`` times each of the four calls alone, batch after batch.
 #:
+#: An empty BOOL_VRS: no GetBoolean in the round trip. An FMU given as ``LABEL 0 - - -`` is the precomputed C
+#: floor (:data:`PRECOMPUTED_FLOOR`), timed as the FMUs are, batches interleaved with theirs.
+#:
 #: usage: bench_host round_trip|each_call BATCH_SECONDS REPS VR_V REAL_VRS BOOL_VRS
-#:        {LABEL 2|3 BINARY RESOURCE_URI|RESOURCE_PATH GUID|TOKEN}...
+#:        {LABEL 2|3 BINARY RESOURCE_URI|RESOURCE_PATH GUID|TOKEN | LABEL 0 - - -}...
 #: (VRS comma-separated); prints "BATCH <label>[/<call>] <rep> <seconds per round trip or call>" per batch.
 TIMING_HOST = BENCH_C / "timing_host.c"
+
+#: The precomputed C floor, linked into the timing host: ``rst_impact_terms_of`` once for the native FMU's start
+#: values, then per impact ``rst_impact_with_terms`` at the round trip's speed, e and v_rebound kept.
+PRECOMPUTED_FLOOR = BENCH_C / "precomputed_floor.c"
 
 #: The C physics alone: rst_impact in a loop, v changing every call so nothing is cached.
 #: usage: physics_loop SECONDS METHOD_CODE; runs SECONDS / 10 untimed, then SECONDS timed (CPU time of
@@ -136,7 +146,7 @@ def compile_host(out: Path, sources: list[Path], includes: list[Path], libs: lis
 def build_all(work: Path, log=None) -> Built:
     """Build everything the benchmark times into ``work`` (an empty scratch directory)."""
     from restitution.fmu.build import build_one
-    from restitution.fmu.build.native import build_native_one, fmi_include_dir
+    from restitution.fmu.build.native import build_native_one, fmi_include_dir, write_backend
     from restitution.fmu.build.compile import prepare_sources
 
     log = log or (lambda message: None)
@@ -153,9 +163,10 @@ def build_all(work: Path, log=None) -> Built:
     fmi3 = _unzip(fmi3_fmu, work / "fmi3", "fmi3", guid=native.guid, version=3)  # the token is the GUID
     _same_value_references(native_fmu, fmi3_fmu)
     floor = Unzipped("floor", build_floor(work, xml), native.guid)
-    host = compile_host(work / "bench_host", [TIMING_HOST], sorted({fmi_include_dir("2.0"), fmi_include_dir("3.0")}),
-                    ["-ldl"])
     src = prepare_sources(work / "physics")
+    write_backend(MODEL, src)  # the interface header: the precomputed floor reads its start values
+    host = compile_host(work / "bench_host", [TIMING_HOST, PRECOMPUTED_FLOOR, src / "rst_physics.c"],
+                        [BENCH_C, src, *sorted({fmi_include_dir("2.0"), fmi_include_dir("3.0")})], ["-ldl", "-lm"])
     loop = compile_host(work / "physics_loop", [PHYSICS_LOOP, src / "rst_physics.c"],
                     [src], ["-lm"])
     return Built(python, native, fmi3, floor, host, loop, xml)

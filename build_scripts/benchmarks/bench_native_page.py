@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import math
+import statistics
 
 from bench_native_timing import METHODS
 
@@ -17,6 +18,9 @@ TARGETS = {
         "native, one impact in a plain C host (absolute)", "< 1 us", lambda x: x < 1e-6),
     "fmi3_over_native_c_host": (
         "native FMI 3.0 / native FMI 2.0, one impact in a plain C host", "<= 1.1x", lambda x: x <= 1.1),
+    "native_over_precomputed_c_host": (
+        "native / precomputed C floor (no FMI, terms computed once), one impact getting e and v_rebound in a "
+        "plain C host", "<= 3x", lambda x: x <= 3.0),
     "package_over_c_physics": (
         "package scalar `impact` / C physics `rst_impact`, one impact (`exact`)", "none (was ~50x)", None),
 }
@@ -25,6 +29,8 @@ FMU_ROWS = ("native", "floor", "pythonfmu")
 #: The C host's rows: the same and the native FMI 3.0 FMU.
 C_HOST_ROWS = ("native", "fmi3", "floor", "pythonfmu")
 CALLS = ("fmi2SetReal", "fmi2DoStep", "fmi2GetReal", "fmi2GetBoolean")
+#: The rows of the section against the precomputed C floor (one impact getting e and v_rebound).
+IMPACT_ROWS = ("native", "floor", "precomputed")
 
 
 def fmt_time(seconds: float) -> str:
@@ -58,12 +64,29 @@ def headline_rows(res: dict) -> list[tuple[str, str, str, str, str]]:
     return rows
 
 
+def split_over_precomputed(series) -> tuple[float, float]:
+    """native / precomputed split into its two parts, medians over the repeats of the per-repeat values:
+    (floor FMU / precomputed: the C front, the host's FMI calls and the floor itself; (native - floor FMU) /
+    precomputed: what the native physics and its glue add)."""
+    native, floor, pre = (series.batches[k] for k in ("native", "floor", "precomputed"))
+    return (statistics.median(f / p for f, p in zip(floor, pre)),
+            statistics.median((n - f) / p for n, f, p in zip(native, floor, pre)))
+
+
+def _split_text(res: dict) -> str:
+    front, rest = split_over_precomputed(res["impact"])
+    return (f"native / precomputed = {fmt_ratio(res['headline']['native_over_precomputed_c_host'][0])} = "
+            f"{fmt_ratio(front)} the floor FMU (the C front and FMI calls with a do-nothing backend) "
+            f"+ {fmt_ratio(rest)} the native physics and its glue above the floor FMU")
+
+
 def console(res: dict) -> str:
     """The headline as printed: the measured values next to the goals."""
     rows = headline_rows(res)
     width = max(len(r[0]) for r in rows)
     lines = [f"{'target':<{width}}  {'measured':>9}  {'range over repeats':>19}  {'goal':>15}  met"]
     lines += [f"{t:<{width}}  {m:>9}  {s:>19}  {g:>15}  {ok.strip('*')}" for t, m, s, g, ok in rows]
+    lines += ["", _split_text(res)]
     return "\n".join(lines)
 
 
@@ -86,6 +109,7 @@ def _fmu_table(series, reference: str, note: dict, labels=FMU_ROWS) -> list[str]
 
 FMU_NOTE = {"native": "C front + C physics", "fmi3": "native FMI 3.0: the same core behind the fmi3 layer",
             "floor": "C front, backend does nothing",
+            "precomputed": "no FMI: rst_impact_with_terms, the terms computed once",
             "pythonfmu": "C guard + pythonfmu + the package"}
 
 
@@ -157,6 +181,22 @@ def render(res: dict) -> str:
         "",
         *_table(["call", "per call (median)", "share of their sum"],
                 _call_rows(res["calls"]), "lrr"),
+        "",
+        "## Against the precomputed C floor",
+        "",
+        "One impact as a simulation uses it: `fmi2SetReal` of `v_approach`, `fmi2DoStep`, `fmi2GetReal` of `e` and "
+        "`v_rebound` (no `fmi2GetBoolean`), in the same C host, against the *precomputed C floor* "
+        "(`build_scripts/benchmarks/bench_c/precomputed_floor.c`, linked into the host and timed as one of its "
+        "variants, batches interleaved with the FMUs'): the same physics with no FMI at all and its "
+        "parameter-only terms computed once (`rst_impact_terms_of` at the FMU's start values), only "
+        "`rst_impact_with_terms` per impact, e and v_rebound kept: the physics' own cost per impact. The native "
+        "FMU caches the same terms per instance, so per step it does the same physics plus the FMI front "
+        "and its glue.",
+        "",
+        *_fmu_table(res["impact"], "precomputed", FMU_NOTE, IMPACT_ROWS),
+        "",
+        _split_text(res) + ": the first part is outside the physics (the C front, `fmu_src/restitution/fmu/cfront/`), "
+        "the second is the backend (`models/sphere_plate_impact/`) and the physics per step.",
         "",
         "## The C physics against the package",
         "",

@@ -46,8 +46,13 @@ class Series:
         return min(r), max(r)
 
 
-def _interfaces(model_description: str):
-    """(value reference of v_approach, Real output vrs, Boolean output vrs), from the modelDescription."""
+#: The outputs of the impact the goal against the precomputed C floor is about: e and v_rebound.
+IMPACT_OUTPUTS = ("e", "v_rebound")
+
+
+def _interfaces(model_description: str, only=None):
+    """(value reference of v_approach, Real output vrs, Boolean output vrs), from the modelDescription;
+    ``only``: just the outputs of these names."""
     from xml.etree import ElementTree as ET
 
     root = ET.fromstring(model_description)
@@ -56,7 +61,7 @@ def _interfaces(model_description: str):
         vr, kind = int(sv.get("valueReference")), sv[0].tag
         if sv.get("name") == "v_approach":
             v = vr
-        elif sv.get("causality") == "output":
+        elif sv.get("causality") == "output" and (only is None or sv.get("name") in only):
             (reals if kind == "Real" else bools).append(vr)
     return v, reals, bools
 
@@ -141,17 +146,23 @@ def fmpy_round_trips(built: Built, labels: tuple, reps: int, seconds: float) -> 
 # ------------------------------------------------------------------------------------------------
 # Round trips in the plain C host (one process, every FMU instantiated once, batches interleaved)
 # ------------------------------------------------------------------------------------------------
-def c_host_round_trips(built: Built, labels: tuple, reps: int, seconds: float, each_call: bool = False) -> Series:
+def c_host_round_trips(built: Built, labels: tuple, reps: int, seconds: float, each_call: bool = False,
+                       outputs=None) -> Series:
     """Seconds per round trip in the C timing host, run as tests/hosts/test_c_host_impact.py runs its host:
     ``env -i PATH=/usr/bin:/bin`` (no virtual environment, PYTHONPATH or LD_PRELOAD; the pythonfmu
     FMU's guard finds its interpreter from resources/python_env.txt). ``each_call``: seconds per call
     of each of the four calls made alone (labels ``<fmu>/<fmi2 function>``). ``fmi3`` is the native FMI 3.0
-    FMU, timed through its own fmi3 functions in the same process, batches interleaved with the others."""
+    FMU, timed through its own fmi3 functions in the same process, batches interleaved with the others;
+    ``precomputed`` the precomputed C floor (no FMU: the physics with its terms computed once). ``outputs``:
+    the names of the outputs a round trip gets (default: every output; without a Boolean one, no GetBoolean)."""
     fmus = {"native": built.native, "floor": built.floor, "pythonfmu": built.python, "fmi3": built.fmi3}
-    v, reals, bools = _interfaces(built.model_description)
+    v, reals, bools = _interfaces(built.model_description, outputs)
     cmd = ["env", "-i", "PATH=/usr/bin:/bin", str(built.host), "each_call" if each_call else "round_trip",
            repr(seconds), str(reps), str(v), ",".join(map(str, reals)), ",".join(map(str, bools))]
     for label in labels:
+        if label == "precomputed":
+            cmd += [label, "0", "-", "-", "-"]
+            continue
         f = fmus[label]
         cmd += [label, str(f.version), str(f.binary), f.resource_uri, f.guid]
     done = subprocess.run(cmd, capture_output=True, text=True, env={"PATH": "/usr/bin:/bin"},

@@ -94,6 +94,38 @@ def test_values_through_the_interface_equal_the_package(backend, method):
         assert not problems, f"case {i} {options}: {problems}"
 
 
+def test_a_cache_kept_across_speeds_gives_the_package_values(backend):
+    """rst_impact_evaluate_cached with one cache per parameter set (all zero: stale, so the first call fills
+    it) and the speed changed in the store between calls, as the FMU steps: every output is the package's,
+    within each output's conditioning (the cached terms are the parameters' and nothing else)."""
+    backend.rst_impact_evaluate_cached.argtypes = (ctypes.c_void_p, ctypes.POINTER(ctypes.c_double), ctypes.c_char_p,
+                                                   ctypes.c_size_t)
+    rng = np.random.default_rng(77)
+    _, params = random_cases(rng, 12)
+    speeds = np.concatenate([[0.0], np.geomspace(1e-6, 1e3, 7)])
+    for i in range(12):
+        case = {n: float(params[n][i]) for n in NAMES}
+        method, model = 1 + i % 3, 1 + (i // 3) % 2
+        store = (ctypes.c_double * len(TABLE))(*([SENTINEL] * len(TABLE)))
+        for v in TABLE.values():
+            if v.causality in ("parameter", "input"):
+                store[v.vr] = float(v.start)
+        for name, value in case.items():
+            store[TABLE[name.replace("_", ".", 1)].vr] = value
+        store[TABLE["zener_method"].vr], store[TABLE["restitution_model"].vr] = method, model
+        cache = ctypes.create_string_buffer(1024)  # zeroed, larger than rst_impact_cache
+        message = ctypes.create_string_buffer(512)
+        options = dict(restitution_model=r.RESTITUTION_MODELS[model - 1], zener_method=r.ZENER_METHODS[method - 1])
+        for v in speeds:
+            store[TABLE["v_approach"].vr] = v
+            assert backend.rst_impact_evaluate_cached(cache, store, message, 512) == 0, message.value
+            got = type("R", (), {**{FMU_REALS[k]: store[TABLE[k].vr] for k in FMU_REALS},
+                                  **{FMU_FLAGS[k]: bool(store[TABLE[k].vr]) for k in FMU_FLAGS}})
+            expected = type("E", (), published(r.impact(v, **case, **options).as_dict()))
+            problems = disagreements(got, expected, *tolerances(v, case, **options))
+            assert not problems, f"case {i}, v = {v}, {options}: {problems}"
+
+
 def test_defaults_are_the_paper_checkpoint(backend):
     """The interface's start values (S2 tool steel on Al 6061) at 2.3 m/s: V_c = 0.0265 m/s, V* = 86.9
     (Green 2022, Sec. 7)."""

@@ -15,6 +15,7 @@ the same kinds of cases in a child process.
 """
 from __future__ import annotations
 
+import ctypes
 import itertools
 import math
 import shutil
@@ -25,9 +26,9 @@ import numpy as np
 import pytest
 
 import restitution as r
-from restitution.agreement import disagreements, tolerances
+from restitution.agreement import FLAGS, REALS, disagreements, tolerances
 from restitution.fmu.build.compile import CFLAGS, compile_shared, prepare_sources
-from physics_ctypes import METHOD_CODE, MODE_CODE, MODEL_CODE, UNSUPPORTED, NativePhysics
+from physics_ctypes import METHOD_CODE, MODE_CODE, MODEL_CODE, UNSUPPORTED, Inputs, NativePhysics, Result
 
 from cases import NAMES, PAIRS, SPEEDS, T_OVER_D, params_for, random_cases
 
@@ -91,6 +92,41 @@ def test_paper_checkpoint(native):
     assert out.V_c == pytest.approx(0.0265, abs=5e-5)
     assert out.V_star == pytest.approx(86.9, abs=0.05)
     assert out.valid and out.vstar_in_range and out.plasticity_used
+
+
+@pytest.mark.parametrize("method", NATIVE_METHODS)
+def test_terms_computed_once_serve_every_speed(native, method):
+    """rst_impact_terms_of once per parameter set, then rst_impact_with_terms at 12 speeds from 0 to the
+    domain's top (what the FMU does between parameter changes): the package's numbers at every speed,
+    within each output's conditioning, for random parameter sets, both models and every effect mode."""
+    lib = native.lib
+    lib.rst_impact_terms_of.argtypes = (ctypes.POINTER(Inputs), ctypes.c_void_p)
+    lib.rst_impact_with_terms.argtypes = (ctypes.c_void_p, ctypes.c_double, ctypes.POINTER(Result))
+    lib.rst_impact_with_terms.restype = ctypes.c_int
+    terms = ctypes.create_string_buffer(1024)  # larger than rst_impact_terms
+    rng = np.random.default_rng([31, METHOD_CODE[method]])
+    _, params = random_cases(rng, 24)
+    speeds = np.concatenate([[0.0, 1e-300], np.geomspace(1e-9, r.model.DOMAIN["v"][1], 10)])
+    for i in range(24):
+        case = {n: float(params[n][i]) for n in NAMES}
+        model, plasticity, plate_waves = (r.RESTITUTION_MODELS[i % 2], list(MODE_CODE)[i % 3],
+                                          list(MODE_CODE)[(i // 3) % 3])
+        options = dict(restitution_model=model, zener_method=method, plasticity=plasticity, plate_waves=plate_waves)
+        inp = Inputs(v=math.nan, **case, plate_edge_distance=math.inf, restitution_model=MODEL_CODE[model],
+                     zener_method=METHOD_CODE[method], plasticity=MODE_CODE[plasticity],
+                     plate_waves=MODE_CODE[plate_waves], effect_tolerance=1e-6, ode_rtol=1e-10)
+        lib.rst_impact_terms_of(ctypes.byref(inp), terms)  # v is not read: NaN would show
+        got = {n: [] for n in (*REALS, *FLAGS)}
+        for v in speeds:
+            out = Result()
+            assert lib.rst_impact_with_terms(terms, float(v), ctypes.byref(out)) == 0
+            for n in got:
+                got[n].append(getattr(out, n))
+        result = type("R", (), {n: np.array(x, dtype=bool if n in FLAGS else float) for n, x in got.items()})
+        expected = r.impact(speeds, **case, **options)
+        tol, flips = tolerances(speeds, case, **options)
+        problems = disagreements(result, expected, tol, flips)
+        assert not problems, f"case {i} {options}: {problems[:5]}"
 
 
 def test_ode_and_bad_codes_are_rejected(native):

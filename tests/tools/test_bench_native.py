@@ -29,7 +29,8 @@ def test_quick_run_writes_the_page_with_every_row(quick):
     res, out = quick
     md = (out / "native_cost.md").read_text(encoding="utf-8")
     for heading in ("# What the native FMU costs", "## Headline", "## Through fmpy", "## In a plain C host",
-                    "### Each call alone", "## The C physics against the package", "Machine:",
+                    "### Each call alone", "## Against the precomputed C floor", "## The C physics against the package",
+                    "Machine:",
                     "**A shared machine**", "quick run"):
         assert heading in md, heading
     lines = md.splitlines()
@@ -42,9 +43,11 @@ def test_quick_run_writes_the_page_with_every_row(quick):
     for text, goal, _ in page.TARGETS.values():  # every headline row, with its goal
         (line,) = row(text)
         assert f"| {goal} |" in line
-    for label in page.FMU_ROWS:  # fmpy and C host tables
-        assert len(row(f"{label} (")) == 2, label
+    for label in page.FMU_ROWS:  # fmpy and C host tables, and native and floor against the precomputed C floor
+        assert len(row(f"{label} (")) == 2 + (label in page.IMPACT_ROWS), label
     assert len(row("fmi3 (")) == 1  # the native FMI 3.0 FMU: C host table only
+    assert len(row("precomputed (")) == 1
+    assert "the native physics and its glue above the floor FMU" in md  # native / precomputed split in two
     for call in page.CALLS:
         row(f"`{call}`")
     for method in timing.METHODS:
@@ -60,6 +63,6 @@ def test_quick_run_writes_the_page_with_every_row(quick):
 def test_every_repeat_of_every_variant_was_measured(quick):
     res, _ = quick
     reps = res["config"]["reps"]
-    for series in ("fmpy", "c_host", "calls", "physics"):
+    for series in ("fmpy", "c_host", "impact", "calls", "physics"):
         batches = res[series].batches
         assert batches and all(len(v) == reps for v in batches.values()), series

@@ -8,15 +8,18 @@
 
 #include "fmi2FunctionTypes.h"
 #include "fmi3FunctionTypes.h"
+#include "precomputed_floor.h"
 
 #define MAX_FMUS 8
 #define MAX_VRS 64
 
 /* One FMU of either FMI version: the four calls of a round trip through the version's own functions
- * (FMI 3.0: fmi3SetFloat64, fmi3DoStep with its out-arguments, fmi3GetFloat64, fmi3GetBoolean with C bool). */
+ * (FMI 3.0: fmi3SetFloat64, fmi3DoStep with its out-arguments, fmi3GetFloat64, fmi3GetBoolean with C bool);
+ * or (version 0) the precomputed C floor, the physics called directly with its terms computed once. */
 typedef struct {
     const char *label;
-    int version; /* 2 or 3 */
+    int version; /* 2 or 3; 0: the precomputed C floor */
+    rst_impact_terms terms; /* version 0 */
     void *dl;
     void *c;
     fmi2SetRealTYPE *set_real;
@@ -126,10 +129,25 @@ static int round_trips3(fmu *f, int calls, long n)
     return bad;
 }
 
-/* n round trips made of the `calls` (ROUND_TRIP: all four); the status of every call OR-ed together
- * (0: every call returned fmi2OK) */
+/* n impacts of the precomputed C floor at the round trips' speeds: e and v_rebound, nothing else */
+static int round_trips0(fmu *f, long n)
+{
+    long i;
+    for (i = 0; i < n; i++) {
+        double v_rebound, e = precomputed_floor_impact(&f->terms, 0.1 + 1e-6 * (double)(f->k++ % 1000000), &v_rebound);
+        sink += e + v_rebound;
+    }
+    return 0;
+}
+
+/* n round trips made of the `calls` (ROUND_TRIP: all four; with no Boolean outputs asked for, no
+ * GetBoolean); the status of every call OR-ed together (0: every call returned fmi2OK) */
 static int round_trips(fmu *f, int calls, long n)
 {
+    if (n_bools == 0)
+        calls &= ~GET_BOOLEAN;
+    if (f->version == 0)
+        return round_trips0(f, n);
     if (f->version == 3)
         return round_trips3(f, calls, n);
     fmi2Real reals[MAX_VRS];
@@ -223,7 +241,7 @@ static int open3(fmu *f, const char *resource_path, const char *token)
     return enter_init(f->c, fmi3False, 0.0, 0.0, fmi3False, 0.0) != fmi3OK || exit_init(f->c) != fmi3OK;
 }
 
-#define PER_FMU 5 /* LABEL FMI_VERSION BINARY RESOURCES GUID */
+#define PER_FMU 5 /* LABEL FMI_VERSION BINARY RESOURCES GUID (version 0: the precomputed C floor, the rest "-") */
 int main(int argc, char **argv)
 {
     fmu fmus[MAX_FMUS];
@@ -233,7 +251,7 @@ int main(int argc, char **argv)
     if (argc < 7 + PER_FMU || (argc - 7) % PER_FMU != 0 || (argc - 7) / PER_FMU > MAX_FMUS
             || (strcmp(argv[1], "round_trip") != 0 && strcmp(argv[1], "each_call") != 0)) {
         fprintf(stderr, "usage: %s round_trip|each_call BATCH_SECONDS REPS VR_V REAL_VRS BOOL_VRS "
-                "{LABEL 2|3 BINARY RESOURCE_URI|RESOURCE_PATH GUID|TOKEN}...\n", argv[0]);
+                "{LABEL 2|3 BINARY RESOURCE_URI|RESOURCE_PATH GUID|TOKEN | LABEL 0 - - -}...\n", argv[0]);
         return 1;
     }
     each = strcmp(argv[1], "each_call") == 0;
@@ -247,8 +265,15 @@ int main(int argc, char **argv)
         memset(f, 0, sizeof *f);
         f->label = argv[i];
         f->version = atoi(argv[i + 1]);
+        if (f->version == 0) {
+            if (precomputed_floor_open(&f->terms) != 0) {
+                fprintf(stderr, "%s: the precomputed C floor cannot evaluate the start values\n", f->label);
+                return 3;
+            }
+            continue;
+        }
         if (f->version != 2 && f->version != 3) {
-            fprintf(stderr, "%s: FMI version %s is not 2 or 3\n", f->label, argv[i + 1]);
+            fprintf(stderr, "%s: FMI version %s is not 0, 2 or 3\n", f->label, argv[i + 1]);
             return 1;
         }
         f->dl = dlopen(argv[i + 2], RTLD_NOW | RTLD_LOCAL);
@@ -277,6 +302,8 @@ int main(int argc, char **argv)
             }
         }
     for (i = 0; i < m; i++) {
+        if (fmus[i].version == 0)
+            continue;
         if (fmus[i].version == 3) {
             fmus[i].terminate3(fmus[i].c);
             fmus[i].free_instance3(fmus[i].c);

@@ -1,7 +1,9 @@
 /* The SpherePlateImpact model in C99: see rst_physics.h. Each function names the Python function it
  * transcribes; equation numbers are those of I. Green, Nonlinear Dyn (2022). Operations keep the
- * Python package's order of evaluation (left to right), so the two differ only where libm and
- * numpy/CPython's math differ in the last bit, amplified by the output's conditioning. */
+ * Python package's order of evaluation (left to right), but for what is split into a parameter-only
+ * term computed once (rst_impact_terms_of) and a speed factor: lambda = (lambda / v^(1/5)) v^(1/5) and
+ * T = (T v^(1/5)) / v^(1/5), the same numbers within a few ulps. So the two differ only by a few ulps,
+ * amplified by each output's conditioning (restitution.agreement's tolerances). */
 #include "rst_physics.h"
 
 #include <math.h>
@@ -33,28 +35,11 @@ static double num_max(double a, double b) { return a >= b ? a : b; }
 /* E_i' = E_i / (1 - nu_i^2) [Pa], Eq. (1) right. */
 static double reduced_modulus(double E, double nu) { return E / (1.0 - nu * nu); }
 
-/* E' = E_a' E_b' / (E_a' + E_b') [Pa], Eq. (1) left. */
-static double effective_modulus(double E_a, double nu_a, double E_b, double nu_b)
-{
-    double Ea = reduced_modulus(E_a, nu_a), Eb = reduced_modulus(E_b, nu_b);
-    return Ea * Eb / (Ea + Eb);
-}
+/* E' = E_a' E_b' / (E_a' + E_b') [Pa], Eq. (1) left, from the reduced moduli E_a', E_b' [Pa]. */
+static double effective_modulus(double Ea, double Eb) { return Ea * Eb / (Ea + Eb); }
 
 /* C(nu) = 1.295 exp(0.736 nu) [1], Eq. (2). */
 static double poisson_coefficient(double nu) { return 1.295 * num_exp(0.736 * nu); }
-
-/* C S_y = min[C(nu_a) S_ya, C(nu_b) S_yb] [Pa], Eq. (2). */
-static double critical_pressure(double nu_a, double Sy_a, double nu_b, double Sy_b)
-{
-    return num_min(poisson_coefficient(nu_a) * Sy_a, poisson_coefficient(nu_b) * Sy_b);
-}
-
-/* eps_y = S_y / E' [1], Eq. (3), S_y of the body that yields first (C(nu_a) S_ya <= C(nu_b) S_yb: sphere). */
-static double yield_strain(double E_prime, double nu_a, double Sy_a, double nu_b, double Sy_b)
-{
-    int sphere_first = poisson_coefficient(nu_a) * Sy_a <= poisson_coefficient(nu_b) * Sy_b;
-    return (sphere_first ? Sy_a : Sy_b) / E_prime;
-}
 
 /* omega_c = (pi C S_y / (2 E'))^2 R [m], Eq. (4). */
 static double critical_interference(double CSy, double E_prime, double R)
@@ -76,17 +61,21 @@ static double sphere_mass(double rho_a, double d) { return rho_a * RST_PI * d * 
 /* V_c = sqrt(4 omega_c P_c / (5 m_a)) [m/s], Eq. (6). */
 static double critical_velocity(double omega_c, double P_c, double m_a) { return sqrt(0.8 * omega_c * P_c / m_a); }
 
+/* ln 0.0361 - 0.114 ln eps_y [1]: the part of Eq. (8)'s log-loss that depends on the materials only
+ * (eps_y [1], Eq. 3); the first two terms of restitution_e45's sum, in the same order. */
+static double e45_log_factor(double eps_y) { return log(0.0361) - 0.114 * log(eps_y); }
+
 /* e45 [1], Eq. (8) (JGM Eq. 45), restitution.jgm.restitution_e45: the plastic loss
  * 0.0361 eps_y^-0.114 ln(V*) (V* - 1)^(9.5 eps_y) as one exp of the sum of logarithms (no underflow
- * just above V* = 1, no overflow for brittle pairs); 1 for V* <= 1; floored at 0 beyond the fit. */
-static double restitution_e45(double v_star, double eps_y)
+ * just above V* = 1, no overflow for brittle pairs); 1 for V* <= 1; floored at 0 beyond the fit.
+ * log_factor = e45_log_factor(eps_y) [1], exponent = 9.5 eps_y [1]. */
+static double restitution_e45(double v_star, double log_factor, double exponent)
 {
-    int above = v_star > 1.0;
-    double vm1 = above ? v_star - 1.0 : 1.0;
-    double log_v = log(above ? v_star : 2.0);
-    double log_loss = log(0.0361) - 0.114 * log(eps_y) + log(log_v) + 9.5 * eps_y * log(vm1);
-    double e = 1.0 - num_exp(num_min(log_loss, RST_EXP_ARG_CAP));
-    return above ? num_max(e, 0.0) : 1.0;
+    double log_loss;
+    if (!(v_star > 1.0))
+        return 1.0;
+    log_loss = log_factor + log(log(v_star)) + exponent * log(v_star - 1.0);
+    return num_max(1.0 - num_exp(num_min(log_loss, RST_EXP_ARG_CAP)), 0.0);
 }
 
 /* e44 [1], Eq. (7) (JGM Eqs. 43-44), restitution.jgm.restitution_e44, second branch reconstructed
@@ -106,24 +95,25 @@ static double restitution_e44(double v_star)
 
 /* --- Zener, Eqs. (9)-(13a), (22) (restitution.zener, restitution.zener_exact) -------------------- */
 
-/* lambda [1], Eq. (12): pi^(3/5)/sqrt(3) ((d/2)/t)^2 (v0/v')^(1/5) (rho_a/rho_b)^(3/5) (E_a'/(E_a'+E_b'))^(2/5),
- * v' = sqrt(E_b'/rho_b) [m/s]. */
-static double inelasticity_parameter(double v0, double E_a, double nu_a, double rho_a, double d,
-                                     double E_b, double nu_b, double rho_b, double t)
+/* lambda / v0^(1/5) [(s/m)^(1/5)], Eq. (12) without its speed factor:
+ * pi^(3/5)/sqrt(3) ((d/2)/t)^2 v'^(-1/5) (rho_a/rho_b)^(3/5) (E_a'/(E_a'+E_b'))^(2/5), from the reduced
+ * moduli E_a', E_b' [Pa], the densities [kg/m3], d and t [m]; v' = sqrt(E_b'/rho_b) [m/s] (Eq. 11).
+ * lambda = lambda_per_speed v0^(1/5) (restitution.zener.lambda_from_terms). */
+static double lambda_per_speed(double Ea, double Eb, double rho_a, double rho_b, double d, double t)
 {
-    double Ea = reduced_modulus(E_a, nu_a), Eb = reduced_modulus(E_b, nu_b);
     double r_over_t = 0.5 * d / t;
-    double wave_speed = sqrt(reduced_modulus(E_b, nu_b) / rho_b);
+    double wave_speed = sqrt(Eb / rho_b);
     double prefactor = pow(RST_PI, 0.6) / sqrt(3.0);
-    return prefactor * r_over_t * r_over_t * pow(v0 / wave_speed, 0.2) * pow(rho_a / rho_b, 0.6)
+    return prefactor * r_over_t * r_over_t * pow(1.0 / wave_speed, 0.2) * pow(rho_a / rho_b, 0.6)
            * pow(Ea / (Ea + Eb), 0.4);
 }
 
 /* k = (4/3) (d/2)^(1/2) E' [N/m^1.5], the Hertz stiffness under Eq. (10). */
 static double hertz_stiffness(double E_prime, double d) { return (4.0 / 3.0) * sqrt(0.5 * d) * E_prime; }
 
-/* T = (m_a / (k v0^(1/2)))^(2/5) [s], Eq. (9). */
-static double time_scale(double m_a, double k, double v0) { return pow(m_a / (k * sqrt(v0)), 0.4); }
+/* T v0^(1/5) = (m_a / k)^(2/5) [s (m/s)^(1/5)], Eq. (9) T = (m_a / (k v0^(1/2)))^(2/5) without its
+ * speed factor; m_a [kg], k [N/m^1.5]. */
+static double time_scale_per_speed(double m_a, double k) { return pow(m_a / k, 0.4); }
 
 /* `exact`, 0 <= lambda <= 100: the Hermite piece of the generated table (zener_exact._table_scalar). */
 static void zener_exact_table(double lam, double *e_ze, double *deficit, double *tau0)
@@ -223,13 +213,13 @@ static double dilatational_slowness(double E_b, double nu_b, double rho_b)
     return sqrt(rho_b * (1.0 + nu_b) * (1.0 - 2.0 * nu_b) / (E_b * (1.0 - nu_b)));
 }
 
-/* (2 a / c_L) / t_contact [1] (zener.edge_echo_ratio): +inf for an unbounded plate (a = 0 or +inf) or no
- * contact, 0 where the contact never ends. */
-static double edge_echo_ratio(double edge_distance, double slowness, double t_contact)
+/* (2 a / c_L) / t_contact [1] (zener.edge_echo_ratio) from echo_time = 2 a / c_L [s] and t_contact [s]:
+ * +inf for an unbounded plate (a = 0 or +inf) or no contact, 0 where the contact never ends. */
+static double edge_echo_ratio(int unbounded, double echo_time, double t_contact)
 {
-    if (edge_distance == 0.0 || edge_distance == INFINITY || t_contact == 0.0)
+    if (unbounded || t_contact == 0.0)
         return INFINITY;
-    return 2.0 * edge_distance * slowness / t_contact;
+    return echo_time / t_contact;
 }
 
 /* --- Fusion, Eqs. (17)-(20) (restitution.fusion) ------------------------------------------------ */
@@ -261,64 +251,93 @@ static void fail(rst_impact_result *out)
 #undef CLEARED
 }
 
-/* restitution.model._pipeline for one impact. */
-int rst_impact(const rst_impact_inputs *in, rst_impact_result *out)
+/* The codes of `in` are those of rst_physics.h: RST_PHYSICS_OK, RST_PHYSICS_BAD_CODE or RST_PHYSICS_UNSUPPORTED. */
+static int check_codes(const rst_impact_inputs *in)
 {
-    double E_prime, CSy, R, k, e_ep, lam, e_ze, deficit, tau0, skipped_tau0, e;
-    int needed, status;
     if ((in->restitution_model != RST_E45 && in->restitution_model != RST_E44)
         || in->plasticity < RST_EFFECT_OFF || in->plasticity > RST_EFFECT_AUTO
         || in->plate_waves < RST_EFFECT_OFF || in->plate_waves > RST_EFFECT_AUTO
-        || in->zener_method < RST_ZENER_EXACT || in->zener_method > RST_ZENER_ODE) {
-        fail(out);
+        || in->zener_method < RST_ZENER_EXACT || in->zener_method > RST_ZENER_ODE)
         return RST_PHYSICS_BAD_CODE;
-    }
-    if (in->zener_method == RST_ZENER_ODE) {
+    return in->zener_method == RST_ZENER_ODE ? RST_PHYSICS_UNSUPPORTED : RST_PHYSICS_OK;
+}
+
+/* restitution.model._material_terms and the other parameter-only parts of restitution.model._pipeline:
+ * JGM Eqs. (1)-(6), the Hertz stiffness and time unit of Eq. (9) without the speed, Eq. (12) without
+ * the speed, the edge echo's travel time. Each C(nu) once (two exp), each reduced modulus once. */
+void rst_impact_terms_of(const rst_impact_inputs *in, rst_impact_terms *terms)
+{
+    double Ea = reduced_modulus(in->sphere_E, in->sphere_nu), Eb = reduced_modulus(in->plate_E, in->plate_nu);
+    double E_prime = effective_modulus(Ea, Eb);
+    double CSy_a = poisson_coefficient(in->sphere_nu) * in->sphere_Sy; /* Eq. (2), per body */
+    double CSy_b = poisson_coefficient(in->plate_nu) * in->plate_Sy;
+    double CSy = num_min(CSy_a, CSy_b);
+    double R = 0.5 * in->sphere_d;
+    int sphere_first = CSy_a <= CSy_b; /* the body that yields first gives S_y of Eq. (3) */
+    terms->status = check_codes(in);
+    terms->restitution_model = in->restitution_model;
+    terms->zener_method = in->zener_method;
+    terms->plasticity = in->plasticity;
+    terms->plate_waves = in->plate_waves;
+    terms->effect_tolerance = in->effect_tolerance;
+    terms->eps_y = (sphere_first ? in->sphere_Sy : in->plate_Sy) / E_prime; /* Eq. (3) */
+    terms->m_a = sphere_mass(in->sphere_rho, in->sphere_d);
+    terms->V_c = critical_velocity(critical_interference(CSy, E_prime, R), critical_load(CSy, E_prime, R), terms->m_a);
+    terms->e45_log_factor = e45_log_factor(terms->eps_y);
+    terms->e45_exponent = 9.5 * terms->eps_y;
+    terms->lambda_per_v = lambda_per_speed(Ea, Eb, in->sphere_rho, in->plate_rho, in->sphere_d, in->plate_t);
+    terms->time_per_v = time_scale_per_speed(terms->m_a, hertz_stiffness(E_prime, in->sphere_d));
+    terms->unbounded = in->plate_edge_distance == 0.0 || in->plate_edge_distance == INFINITY;
+    terms->echo_time = 2.0 * in->plate_edge_distance * dilatational_slowness(in->plate_E, in->plate_nu, in->plate_rho);
+    terms->tau0_half_space = tau0_at_lambda0(in->zener_method);
+    terms->skipped_tau0 = in->plate_waves == RST_EFFECT_AUTO ? terms->tau0_half_space : RST_TAU0_HERTZ;
+}
+
+/* restitution.model._pipeline for one impact at v [m/s], its parameter-only terms precomputed. */
+int rst_impact_with_terms(const rst_impact_terms *terms, double v, rst_impact_result *out)
+{
+    double speed_factor, e_ep, lam, e_ze, deficit, tau0, e;
+    int needed, status;
+    if (terms->status != RST_PHYSICS_OK) {
         fail(out);
-        return RST_PHYSICS_UNSUPPORTED;
+        return terms->status;
     }
+    speed_factor = pow(v, 0.2); /* v^(1/5) [(m/s)^(1/5)]: lambda's (Eq. 12) and T's (Eq. 9) dependence on v */
 
     /* JGM, Eqs. (1)-(8) */
-    E_prime = effective_modulus(in->sphere_E, in->sphere_nu, in->plate_E, in->plate_nu);
-    CSy = critical_pressure(in->sphere_nu, in->sphere_Sy, in->plate_nu, in->plate_Sy);
-    out->eps_y = yield_strain(E_prime, in->sphere_nu, in->sphere_Sy, in->plate_nu, in->plate_Sy);
-    R = 0.5 * in->sphere_d;
-    out->m_a = sphere_mass(in->sphere_rho, in->sphere_d);
-    out->V_c = critical_velocity(critical_interference(CSy, E_prime, R), critical_load(CSy, E_prime, R), out->m_a);
-    k = hertz_stiffness(E_prime, in->sphere_d);
-    out->V_star = in->v / out->V_c;
-    if (in->plasticity == RST_EFFECT_OFF) {
+    out->eps_y = terms->eps_y;
+    out->m_a = terms->m_a;
+    out->V_c = terms->V_c;
+    out->V_star = v / terms->V_c;
+    if (terms->plasticity == RST_EFFECT_OFF) {
         e_ep = 1.0;
     } else {
-        e_ep = in->restitution_model == RST_E45 ? restitution_e45(out->V_star, out->eps_y)
-                                                : restitution_e44(out->V_star);
-        if (in->plasticity == RST_EFFECT_AUTO && 1.0 - e_ep < in->effect_tolerance)
+        e_ep = terms->restitution_model == RST_E45
+                   ? restitution_e45(out->V_star, terms->e45_log_factor, terms->e45_exponent)
+                   : restitution_e44(out->V_star);
+        if (terms->plasticity == RST_EFFECT_AUTO && 1.0 - e_ep < terms->effect_tolerance)
             e_ep = 1.0;
     }
 
     /* Zener, Eqs. (9)-(13a) */
-    lam = inelasticity_parameter(in->v, in->sphere_E, in->sphere_nu, in->sphere_rho, in->sphere_d,
-                                 in->plate_E, in->plate_nu, in->plate_rho, in->plate_t);
-    if (in->plate_waves == RST_EFFECT_AUTO) {
-        needed = RST_ZENER_SLOPE_BOUND * lam >= in->effect_tolerance;
-        skipped_tau0 = tau0_at_lambda0(in->zener_method);
-    } else {
-        needed = in->plate_waves == RST_EFFECT_ON;
-        skipped_tau0 = RST_TAU0_HERTZ;
-    }
+    lam = terms->lambda_per_v * speed_factor;
+    if (terms->plate_waves == RST_EFFECT_AUTO)
+        needed = RST_ZENER_SLOPE_BOUND * lam >= terms->effect_tolerance;
+    else
+        needed = terms->plate_waves == RST_EFFECT_ON;
     if (needed) {
-        status = rst_zener_solution(lam, in->zener_method, &e_ze, &deficit, &tau0);
-        if (status != RST_PHYSICS_OK) {
+        status = rst_zener_solution(lam, terms->zener_method, &e_ze, &deficit, &tau0);
+        if (status != RST_PHYSICS_OK) { /* unreachable: terms->status vetted the method */
             fail(out);
             return status;
         }
     } else {
         e_ze = 1.0;
         deficit = 0.0;
-        tau0 = skipped_tau0;
+        tau0 = terms->skipped_tau0;
     }
-    if (in->v > 0.0) {
-        out->T = time_scale(out->m_a, k, in->v);
+    if (v > 0.0) {
+        out->T = terms->time_per_v / speed_factor;
         out->t_contact = out->T * tau0;
     } else {
         out->T = INFINITY;
@@ -328,14 +347,14 @@ int rst_impact(const rst_impact_inputs *in, rst_impact_result *out)
     /* Fusion, Eqs. (17)-(20) */
     e = apparent_restitution(e_ep, e_ze);
     out->e = e;
-    out->v_rebound = e * in->v;
+    out->v_rebound = e * v;
     out->e_ep = e_ep;
     out->e_ze = e_ze;
     out->lam = lam;
     out->tau0 = tau0;
-    out->m_eff = equivalent_plate_mass(out->m_a, e_ze, deficit);
+    out->m_eff = equivalent_plate_mass(terms->m_a, e_ze, deficit);
     out->mass_ratio = mass_ratio(e_ze, deficit);
-    out->v_plate = plate_velocity(in->v, e_ep, deficit);
+    out->v_plate = plate_velocity(v, e_ep, deficit);
     out->plasticity_used = e_ep < 1.0;
     out->plate_waves_used = needed;
     out->lambda_in_range = lam <= RST_LAMBDA_STUDIED_MAX;
@@ -343,11 +362,17 @@ int rst_impact(const rst_impact_inputs *in, rst_impact_result *out)
     out->e_negative = e < 0.0;
     out->contact_ends = tau0 < INFINITY;
     /* monitors (model._pipeline): the half-space contact is its own reference where Zener was skipped */
-    out->wave_delay = needed ? tau0 / tau0_at_lambda0(in->zener_method) : 1.0;
-    out->edge_echo = edge_echo_ratio(in->plate_edge_distance,
-                                     dilatational_slowness(in->plate_E, in->plate_nu, in->plate_rho), out->t_contact);
+    out->wave_delay = needed ? tau0 / terms->tau0_half_space : 1.0;
+    out->edge_echo = edge_echo_ratio(terms->unbounded, terms->echo_time, out->t_contact);
     out->concurrent = out->wave_delay <= RST_WAVE_DELAY_LIMIT;
     out->edge_clear = out->edge_echo >= 1.0;
     out->valid = out->lambda_in_range && out->vstar_in_range;
     return RST_PHYSICS_OK;
+}
+
+int rst_impact(const rst_impact_inputs *in, rst_impact_result *out)
+{
+    rst_impact_terms terms;
+    rst_impact_terms_of(in, &terms);
+    return rst_impact_with_terms(&terms, in->v, out);
 }

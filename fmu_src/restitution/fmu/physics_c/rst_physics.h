@@ -14,6 +14,8 @@
 #include "rst_prefix.h"
 #if defined(RST_PREFIXED)
 #define rst_impact RST_PREFIXED(rst_impact)
+#define rst_impact_terms_of RST_PREFIXED(rst_impact_terms_of)
+#define rst_impact_with_terms RST_PREFIXED(rst_impact_with_terms)
 #define rst_zener_solution RST_PREFIXED(rst_zener_solution)
 #endif
 
@@ -52,7 +54,37 @@ typedef struct {
  * and units, generated from the package's result record at build time. */
 #include "rst_impact_result.h"
 
-/* Evaluate the model; RST_PHYSICS_OK, or an error code with every real output NaN and every flag 0. */
+/* What an impact needs that depends on the parameters only (materials, geometry, options; not on v),
+ * computed once by rst_impact_terms_of so that a run of impacts at changing speeds pays only for the
+ * speed-dependent work (rst_impact_with_terms). SI units. Fill it only with rst_impact_terms_of. */
+typedef struct {
+    int status;            /* RST_PHYSICS_OK, or the code rst_impact_with_terms returns (bad code, ode) */
+    int restitution_model; /* the codes of rst_impact_inputs, as given (error messages quote them) */
+    int zener_method, plasticity, plate_waves;
+    double effect_tolerance; /* [1] */
+    double eps_y;            /* [1] yield strain, Eq. (3) */
+    double m_a;              /* [kg] sphere mass */
+    double V_c;              /* [m/s] critical velocity, Eq. (6) */
+    double e45_log_factor;   /* [1] ln 0.0361 - 0.114 ln eps_y: the parameter part of Eq. (8)'s log-loss */
+    double e45_exponent;     /* [1] 9.5 eps_y: the exponent of (V* - 1) in Eq. (8) */
+    double lambda_per_v;     /* [(s/m)^(1/5)] lambda / v^(1/5), Eq. (12) */
+    double time_per_v;       /* [s (m/s)^(1/5)] T v^(1/5) = (m_a / k)^(2/5), Eq. (9) */
+    double echo_time;        /* [s] 2 a / c_L, the edge echo's travel time (unused for an unbounded plate) */
+    int unbounded;           /* plate_edge_distance 0 or +inf: no edge echo */
+    double tau0_half_space;  /* [1] tau0 of the method at lambda = 0 (the wave delay's reference) */
+    double skipped_tau0;     /* [1] tau0 reported where the plate-wave effect is skipped */
+} rst_impact_terms;
+
+/* The parameter-only terms of `in` (in->v is not read). Never fails: a bad or unsupported code is
+ * recorded in terms->status. */
+void rst_impact_terms_of(const rst_impact_inputs *in, rst_impact_terms *terms);
+
+/* One impact at approach speed v [m/s] >= 0 with the terms of rst_impact_terms_of; RST_PHYSICS_OK, or
+ * terms->status with every real output NaN and every flag 0. */
+int rst_impact_with_terms(const rst_impact_terms *terms, double v, rst_impact_result *out);
+
+/* Evaluate the model: rst_impact_terms_of then rst_impact_with_terms at in->v; RST_PHYSICS_OK, or an
+ * error code with every real output NaN and every flag 0. */
 int rst_impact(const rst_impact_inputs *in, rst_impact_result *out);
 
 /* Zener's (e_ze, 1 - e_ze, tau0) [1] for lambda >= 0 [1] by the `exact`, `paper_fit` or `linear`

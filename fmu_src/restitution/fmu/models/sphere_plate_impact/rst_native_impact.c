@@ -93,13 +93,12 @@ static void resolve_materials(double *values)
     }
 }
 
-int rst_impact_evaluate(double *values, char *message, size_t size)
+/* The terms of the store's parameters (rst_impact_terms_of), after resolving the materials. */
+static void refresh_terms(rst_impact_cache *cache, double *values)
 {
     rst_impact_inputs in;
-    rst_impact_result r;
-    int status, k;
     resolve_materials(values);
-    in.v = values[VR(V_APPROACH)];
+    in.v = values[VR(V_APPROACH)]; /* not read by rst_impact_terms_of */
     in.sphere_E = values[VR(SPHERE_USED_E)];
     in.sphere_nu = values[VR(SPHERE_USED_NU)];
     in.sphere_Sy = values[VR(SPHERE_USED_SY)];
@@ -117,31 +116,44 @@ int rst_impact_evaluate(double *values, char *message, size_t size)
     in.plate_waves = to_code(values[VR(PLATE_WAVES)]);
     in.effect_tolerance = values[VR(EFFECT_TOLERANCE)];
     in.ode_rtol = values[VR(ZENER_ODE_TOLERANCE)];
-    status = rst_impact(&in, &r);
+    rst_impact_terms_of(&in, &cache->terms);
+    cache->fresh = 1;
+}
+
+int rst_impact_evaluate_cached(rst_impact_cache *cache, double *values, char *message, size_t size)
+{
+    rst_impact_result r;
+    int status, finite, k;
+    if (!cache->fresh)
+        refresh_terms(cache, values);
+    status = rst_impact_with_terms(&cache->terms, values[VR(V_APPROACH)], &r);
     if (status != RST_PHYSICS_OK) {
+        const rst_impact_terms *t = &cache->terms;
         if (status == RST_PHYSICS_UNSUPPORTED)
             snprintf(message, size, "%s", ODE_REFUSED);
         else
             snprintf(message, size, "invalid code: restitution_model = %d, zener_method = %d, plasticity = %d, "
-                     "plate_waves = %d", in.restitution_model, in.zener_method, in.plasticity, in.plate_waves);
+                     "plate_waves = %d", t->restitution_model, t->zener_method, t->plasticity, t->plate_waves);
         invalidate(values);
         return status;
     }
-    /* every output of the table from the result field its row names (its key) */
+    /* the record as restitution.model.published publishes it: tau0, t_contact and the wave delay read 0
+     * where the contact never ends, the edge echo (+inf for an unbounded plate) is capped */
+    if (!r.contact_ends)
+        r.tau0 = 0.0, r.t_contact = 0.0, r.wave_delay = 0.0;
+    if (r.edge_echo > RST_EDGE_ECHO_PUBLISHED_MAX)
+        r.edge_echo = RST_EDGE_ECHO_PUBLISHED_MAX;
+    /* every output of the table from the result field its row names (its key); whether each Real is finite
+     * (no branch per output: the scan naming the culprit runs only when one is not) */
+    finite = 1;
 #define PUBLISH(vr, field) values[vr] = (double)r.field;
+#define FINITE(vr, field) finite &= isfinite(r.field) != 0;
     RST_SPHEREPLATEIMPACT_REAL_OUTPUTS(PUBLISH)
     RST_SPHEREPLATEIMPACT_BOOLEAN_OUTPUTS(PUBLISH)
+    RST_SPHEREPLATEIMPACT_REAL_OUTPUTS(FINITE)
 #undef PUBLISH
-    /* as restitution.model.published: tau0, t_contact and the wave delay read 0 where the contact never ends,
-     * the edge echo (+inf for an unbounded plate) is capped */
-    if (!r.contact_ends) {
-        values[VR(ZENER_TAU0)] = 0.0;
-        values[VR(ZENER_T_CONTACT)] = 0.0;
-        values[VR(MONITOR_WAVE_DELAY)] = 0.0;
-    }
-    if (r.edge_echo > RST_EDGE_ECHO_PUBLISHED_MAX)
-        values[VR(MONITOR_EDGE_ECHO)] = RST_EDGE_ECHO_PUBLISHED_MAX;
-    if ((k = first_nonfinite(values)) >= 0) {
+#undef FINITE
+    if (!finite && (k = first_nonfinite(values)) >= 0) {
         double bad = values[REAL_OUTPUTS[k]];
         snprintf(message, size, "non-finite output %s = %s", RST_SPHEREPLATEIMPACT_VARIABLES[REAL_OUTPUTS[k]].name,
                  isnan(bad) ? "nan" : bad > 0 ? "inf" : "-inf");
@@ -149,4 +161,11 @@ int rst_impact_evaluate(double *values, char *message, size_t size)
         return RST_IMPACT_NONFINITE;
     }
     return RST_PHYSICS_OK;
+}
+
+int rst_impact_evaluate(double *values, char *message, size_t size)
+{
+    rst_impact_cache fresh_start;
+    fresh_start.fresh = 0;
+    return rst_impact_evaluate_cached(&fresh_start, values, message, size);
 }

@@ -3,8 +3,10 @@
  * (restitution.fmu.describe.c_header: RST_SPHEREPLATEIMPACT_VR_*, and the codes of the choices).
  *
  * Front-independent on purpose: the C FMI front (cfront/) owns the state machine, the argument and
- * range checks, logging and the value store; it calls rst_impact_evaluate whenever an input or
- * parameter changed. No global mutable state. */
+ * range checks, logging and the value store; its glue (rst_native_impact_fmu.c) calls
+ * rst_impact_evaluate_cached whenever an input or parameter changed, with the instance's cache of the
+ * parameter-only terms, which it marks stale whenever anything but v_approach may have changed. No
+ * global mutable state. */
 #ifndef RST_NATIVE_IMPACT_H
 #define RST_NATIVE_IMPACT_H
 
@@ -12,9 +14,12 @@
 #if defined(RST_PREFIXED)
 #define rst_impact_accept RST_PREFIXED(rst_impact_accept)
 #define rst_impact_evaluate RST_PREFIXED(rst_impact_evaluate)
+#define rst_impact_evaluate_cached RST_PREFIXED(rst_impact_evaluate_cached)
 #endif
 
 #include <stddef.h>
+
+#include "rst_physics.h"
 
 /* Return code of rst_impact_evaluate besides rst_physics.h's: an output is NaN or infinite (every
  * published output is finite: an evaluation failure: every output NaN/false). */
@@ -29,5 +34,19 @@ int rst_impact_accept(unsigned int vr, double value, char *message, size_t size)
  * otherwise the physics' error code, every Real output NaN, every Boolean 0, and `message` says why
  * (zener_method = 4 names the Python FMU, which integrates Eq. (10)). */
 int rst_impact_evaluate(double *values, char *message, size_t size);
+
+/* What an instance keeps between evaluations: the parameter-only terms (rst_impact_terms_of) of the
+ * store's parameters, while `fresh`. All zero (as the front allocates backend data) is stale. Whoever
+ * owns it sets fresh = 0 whenever a store slot other than v_approach may have changed (a parameter set,
+ * a reset, a restored FMU state): a fresh cache is trusted without looking at the store. */
+typedef struct {
+    int fresh;
+    rst_impact_terms terms;
+} rst_impact_cache;
+
+/* rst_impact_evaluate with a cache: where the cache is stale, resolves the materials (writes the
+ * calculated parameters <body>.used.*) and recomputes the terms; then evaluates at the store's
+ * v_approach. Same results, return codes and messages as rst_impact_evaluate. */
+int rst_impact_evaluate_cached(rst_impact_cache *cache, double *values, char *message, size_t size);
 
 #endif

@@ -1,6 +1,8 @@
 /* The native SpherePlateImpact FMU: the C front (cfront/rst_front.h) bound to the native backend
  * (rst_native_impact.h). The front checks every call and value; this file only decides when to
- * evaluate: lazily, when an output is read or a step taken after an input or parameter changed.
+ * evaluate: lazily, when an output is read or a step taken after an input or parameter changed; and
+ * when the parameter-only terms must be recomputed: after anything but v_approach was set, a reset or
+ * a restored FMU state (a run of impacts at changing speeds pays only for the speed-dependent work).
  * The same holds for model exchange, where the model has no states and no events. */
 #include "rst_front.h"
 
@@ -12,14 +14,17 @@
 
 typedef struct {
     int stale;         /* an input or parameter changed since the last evaluation */
+    rst_impact_cache cache; /* the parameter-only terms; stale (fresh = 0) after anything but v_approach changed */
     int failed;        /* the last evaluation failed: outputs are NaN/false */
     unsigned int warned; /* the conditions of log_departures logged since instantiation or reset (bits) */
 } impact_backend;
 
 static rst_status instantiate(rst_instance *inst, const char *resource_dir, int visible)
 {
+    impact_backend *b = (impact_backend *)rst_backend(inst);
     (void)resource_dir, (void)visible; /* no resources, no user interface */
-    ((impact_backend *)rst_backend(inst))->stale = 1;
+    b->stale = 1;
+    b->cache.fresh = 0;
     return RST_OK;
 }
 
@@ -83,7 +88,7 @@ static void evaluate(rst_instance *inst)
     if (!b->stale)
         return;
     b->stale = 0;
-    b->failed = rst_impact_evaluate(rst_store(inst), message, sizeof message) != 0;
+    b->failed = rst_impact_evaluate_cached(&b->cache, rst_store(inst), message, sizeof message) != 0;
     if (b->failed) {
         describe_inputs(inst, inputs, sizeof inputs);
         rst_log(inst, RST_ERROR, "evaluation failed for %s: %s", inputs, message);
@@ -102,9 +107,12 @@ static rst_status accept(rst_instance *inst, const rst_variable *var, double val
     return RST_OK;
 }
 
+/* Any slot of the store may have changed (a reset, a restored FMU state): evaluate again, terms too. */
 static rst_status changed(rst_instance *inst)
 {
-    ((impact_backend *)rst_backend(inst))->stale = 1;
+    impact_backend *b = (impact_backend *)rst_backend(inst);
+    b->stale = 1;
+    b->cache.fresh = 0;
     return RST_OK;
 }
 
@@ -116,11 +124,18 @@ static rst_status reset(rst_instance *inst)
     return changed(inst);
 }
 
+/* New inputs or parameters: evaluate again; the terms only if something else than v_approach was set. */
 static rst_status set(rst_instance *inst, rst_type type, const rst_vr vr[], size_t n,
                       const double values[])
 {
-    (void)type, (void)vr, (void)n, (void)values;
-    return changed(inst);
+    impact_backend *b = (impact_backend *)rst_backend(inst);
+    size_t i;
+    (void)type, (void)values;
+    b->stale = 1;
+    for (i = 0; i < n; i++)
+        if (vr[i] != RST_SPHEREPLATEIMPACT_VR_V_APPROACH)
+            b->cache.fresh = 0;
+    return RST_OK;
 }
 
 static rst_status exit_initialization(rst_instance *inst)
