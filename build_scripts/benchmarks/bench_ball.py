@@ -141,7 +141,7 @@ def paired_ratio(top: list, bottom: list) -> float:
     return statistics.median(a / b for a, b in zip(top, bottom))
 
 
-def report(times: dict, has_reference: bool) -> list[str]:
+def report(times: dict) -> list[str]:
     """The lines the run prints: the median times, then each ratio beside its goal."""
     lines = []
     for operation, text in OPERATIONS.items():
@@ -184,7 +184,8 @@ def page(lines: list[str], seconds: float, reps: int, command: str) -> str:
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[1])
-    parser.add_argument("--reference-fmus", type=Path, help=f"a Reference-FMUs checkout (default: ${ENVIRONMENT_VARIABLE})")
+    parser.add_argument("--reference-fmus", type=Path,
+                        help=f"a Reference-FMUs checkout (default: ${ENVIRONMENT_VARIABLE})")
     parser.add_argument("--seconds", type=float, default=0.2, help="CPU seconds per batch (default 0.2)")
     parser.add_argument("--reps", type=int, default=9, help="repetitions (default 9)")
     parser.add_argument("--quick", action="store_true", help="a short run (0.01 s batches, 2 repetitions): it works")
@@ -211,7 +212,7 @@ def main(argv=None) -> int:
         host = compile_host(work / "ball_timing", [HOST], sorted({fmi_include_dir("2.0"), fmi_include_dir("3.0")}),
                             ["-ldl"])
         times = run_host(host, fmus, all_settings, all_hv, seconds, reps)
-    lines = report(times, source is not None)
+    lines = report(times)
     print("\n".join(lines))
     if args.page:
         command = "bench_ball.py" + (" --reference-fmus DIR" if source is not None else "") + \
