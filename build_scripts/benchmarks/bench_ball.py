@@ -120,6 +120,23 @@ def build_reference(source: Path, work: Path) -> tuple:
     return 2, binary, resources.resolve().as_uri(), token
 
 
+def reference_commit(source: Path) -> str:
+    """The commit of a Reference-FMUs git checkout, or what to say where it is none."""
+    done = subprocess.run(["git", "-C", str(source), "rev-parse", "HEAD"], capture_output=True, text=True)
+    return done.stdout.strip() if done.returncode == 0 else "not a git checkout: commit unknown"
+
+
+def machine() -> str:
+    """The machine as the page names it: architecture, CPU model (Linux), CPU count."""
+    model = ""
+    try:
+        model = next((line.split(":", 1)[1].strip() for line in Path("/proc/cpuinfo").read_text().splitlines()
+                      if line.startswith("model name")), "")
+    except OSError:
+        pass
+    return ", ".join(x for x in (platform.machine(), model or platform.processor(), f"{os.cpu_count()} CPUs") if x)
+
+
 def run_host(host: Path, fmus: dict, settings: dict, hv: dict, seconds: float, reps: int) -> dict:
     """(label, operation) -> [seconds per operation, one per repetition]."""
     cmd = [str(host), repr(seconds), str(reps)]
@@ -164,16 +181,22 @@ def report(times: dict) -> list[str]:
     return lines
 
 
-def page(lines: list[str], seconds: float, reps: int, command: str) -> str:
+def page(lines: list[str], seconds: float, reps: int, command: str, reference: str) -> str:
     when = datetime.now(timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
     return "\n".join([
         "# What the C front costs a BouncingBall",
         "",
-        f"Written by `build_scripts/benchmarks/bench_ball.py` on {when} ({platform.machine()}, "
-        f"{platform.processor() or platform.system()}, {os.cpu_count()} CPUs, shared: only the ratios, measured "
-        f"interleaved in one run, count; {reps} repetitions of {seconds:g} s batches of thread CPU time), with "
-        f"`{command}`. The host (`build_scripts/benchmarks/bench_c/ball_timing.c`) loads each binary with "
-        "dlopen and makes the same calls with the same arguments on each; see the script's docstring.",
+        f"Written by `build_scripts/benchmarks/bench_ball.py` on {when} ({machine()}, shared with other work: "
+        f"only the ratios, measured interleaved in one run, count; {reps} repetitions of {seconds:g} s batches "
+        f"of thread CPU time), with `{command}`. The host (`build_scripts/benchmarks/bench_c/ball_timing.c`) "
+        "loads each binary with dlopen and makes the same calls with the same arguments on each; see the "
+        f"script's docstring. Reference FMUs: {reference}.",
+        "",
+        "The step is 1 ms, the Reference ball's fixed internal (explicit Euler) step, so that it makes one solver "
+        "step per DoStep and what is compared is mostly the two FMI fronts; ours moves the ball in closed form. "
+        "Every call of ours passes the checks of [host_contract.md](host_contract.md) and takes the instance's "
+        "lock (one compare-and-swap and one exchange where no other thread holds it); the Reference FMUs' calls "
+        "take no lock.",
         "",
         "```",
         *lines,
@@ -217,7 +240,9 @@ def main(argv=None) -> int:
     if args.page:
         command = "bench_ball.py" + (" --reference-fmus DIR" if source is not None else "") + \
                   ("" if args.quick else f" --seconds {seconds:g} --reps {reps}")
-        PAGE.write_text(page(lines, seconds, reps, command), encoding="utf-8")
+        reference = (f"github.com/modelica/Reference-FMUs at {reference_commit(source)}, BouncingBall (FMI 2.0, "
+                     "gcc -O2)") if source is not None else "not given (no Reference ratios)"
+        PAGE.write_text(page(lines, seconds, reps, command, reference), encoding="utf-8")
     return 0
 
 
