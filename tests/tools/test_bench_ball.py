@@ -29,6 +29,7 @@ def _quick(tmp_path, *args, reference=None):
                           timeout=600, cwd=tmp_path, env=env)
 
 
+@pytest.mark.slow
 def test_quick_run_without_the_reference_source(tmp_path):
     done = _quick(tmp_path)
     assert done.returncode == 0, done.stdout[-2000:] + done.stderr[-4000:]
@@ -44,6 +45,7 @@ def test_quick_run_without_the_reference_source(tmp_path):
         assert sum(x.strip().startswith(label) and x.strip().endswith(" ns") for x in lines) == 3, done.stdout
 
 
+@pytest.mark.slow
 def test_a_folder_that_is_no_checkout_is_named_and_skipped(tmp_path):
     """RESTITUTION_REFERENCE_FMUS naming a folder without the Reference BouncingBall's sources: one line
     naming it, our own figures only."""
