@@ -57,9 +57,10 @@ OPERATIONS = {"step": "co-simulation step (DoStep 1 ms, get h and v)",
               "rhs+z": "the same right-hand side, then get the event indicator"}
 
 
-def our_settings() -> str:
-    """What the host sets in our ball before initialization: the Reference ball's drop (h0 = 1 m, g = 9.81,
-    e = 0.7), rebounding inside the step (contact_mode immediate); value references from the interface table."""
+def our_settings() -> tuple[str, str]:
+    """(what the host sets in our ball before initialization, the value references of h and v): the Reference
+    ball's drop (h0 = 1 m, g = 9.81, e = 0.7), rebounding inside the step (contact_mode immediate); value
+    references from the interface table."""
     from restitution.fmu.models.bouncing_ball.variables import CONTACT_MODES, TABLE
 
     vr = {row.name: row.vr for row in TABLE.rows}
