@@ -34,16 +34,19 @@ static const rst_api FMI2 = {
     "fmi2SerializedFMUstateSize", {"Real", "Integer", "Boolean", "Integer"}, 0, emit};
 
 /* Converters between FMI 2.0's arrays and the core's doubles. */
-static double read_real(const void *v, size_t i) { return ((const fmi2Real *)v)[i]; }
-static double read_integer(const void *v, size_t i) { return (double)((const fmi2Integer *)v)[i]; }
-static double read_boolean(const void *v, size_t i) { return (double)((const fmi2Boolean *)v)[i]; }
-static void write_real(void *v, size_t i, double x) { ((fmi2Real *)v)[i] = x; }
+static double real_to_double(fmi2Real x) { return x; }
+static double integer_to_double(fmi2Integer x) { return (double)x; }
+static double boolean_to_double(fmi2Boolean x) { return (double)x; }
+static fmi2Real double_to_real(double x) { return x; }
 /* an Integer or Boolean held as a double, converted without undefined behaviour for any double */
-static void write_integer(void *v, size_t i, double x)
+static fmi2Integer double_to_integer(double x)
 {
-    ((fmi2Integer *)v)[i] = (x >= -2147483648.0 && x <= 2147483647.0) ? (fmi2Integer)x : 0;
+    return (x >= -2147483648.0 && x <= 2147483647.0) ? (fmi2Integer)x : 0;
 }
-static void write_boolean(void *v, size_t i, double x) { ((fmi2Boolean *)v)[i] = x != 0.0 && !isnan(x); }
+static fmi2Boolean double_to_boolean(double x) { return x != 0.0 && !isnan(x); }
+RST_CONVERTERS(read_real, write_real, fmi2Real, real_to_double, double_to_real)
+RST_CONVERTERS(read_integer, write_integer, fmi2Integer, integer_to_double, double_to_integer)
+RST_CONVERTERS(read_boolean, write_boolean, fmi2Boolean, boolean_to_double, double_to_boolean)
 
 /* ------------------------------------------------------------------------------------------------ */
 /* Life cycle                                                                                       */

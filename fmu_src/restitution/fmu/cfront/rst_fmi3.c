@@ -29,21 +29,25 @@ static const rst_api FMI3 = {
     "fmi3SerializedFMUStateSize", {"Float64", "Int32", "Boolean", "Enumeration"}, 1, emit};
 
 /* Converters between FMI 3.0's arrays and the core's doubles. */
-static double read_float64(const void *v, size_t i) { return ((const fmi3Float64 *)v)[i]; }
-static double read_int32(const void *v, size_t i) { return (double)((const fmi3Int32 *)v)[i]; }
-static double read_int64(const void *v, size_t i) { return (double)((const fmi3Int64 *)v)[i]; }
-static double read_boolean(const void *v, size_t i) { return ((const fmi3Boolean *)v)[i] ? 1.0 : 0.0; }
-static void write_float64(void *v, size_t i, double x) { ((fmi3Float64 *)v)[i] = x; }
+static double float64_to_double(fmi3Float64 x) { return x; }
+static double int32_to_double(fmi3Int32 x) { return (double)x; }
+static double int64_to_double(fmi3Int64 x) { return (double)x; }
+static double boolean_to_double(fmi3Boolean x) { return x ? 1.0 : 0.0; }
+static fmi3Float64 double_to_float64(double x) { return x; }
 /* integers held as doubles, converted without undefined behaviour for any double */
-static void write_int32(void *v, size_t i, double x)
+static fmi3Int32 double_to_int32(double x)
 {
-    ((fmi3Int32 *)v)[i] = (x >= -2147483648.0 && x <= 2147483647.0) ? (fmi3Int32)x : 0;
+    return (x >= -2147483648.0 && x <= 2147483647.0) ? (fmi3Int32)x : 0;
 }
-static void write_int64(void *v, size_t i, double x)
+static fmi3Int64 double_to_int64(double x)
 {
-    ((fmi3Int64 *)v)[i] = (x >= -9223372036854775808.0 && x < 9223372036854775808.0) ? (fmi3Int64)x : 0;
+    return (x >= -9223372036854775808.0 && x < 9223372036854775808.0) ? (fmi3Int64)x : 0;
 }
-static void write_boolean(void *v, size_t i, double x) { ((fmi3Boolean *)v)[i] = x != 0.0 && !isnan(x); }
+static fmi3Boolean double_to_boolean(double x) { return x != 0.0 && !isnan(x); }
+RST_CONVERTERS(read_float64, write_float64, fmi3Float64, float64_to_double, double_to_float64)
+RST_CONVERTERS(read_int32, write_int32, fmi3Int32, int32_to_double, double_to_int32)
+RST_CONVERTERS(read_int64, write_int64, fmi3Int64, int64_to_double, double_to_int64)
+RST_CONVERTERS(read_boolean, write_boolean, fmi3Boolean, boolean_to_double, double_to_boolean)
 
 #define ANY_MODE (RST_MODE_INSTANTIATED | RST_MODE_INITIALIZATION | RST_MODE_STEP_COMPLETE | RST_MODE_STEP_FAILED | \
                   RST_MODE_TERMINATED | RST_MODE_ERROR)
@@ -322,20 +326,20 @@ fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 currentCommunicationPoi
                       fmi3Boolean noSetFMUStatePriorToCurrentPoint, fmi3Boolean *eventHandlingNeeded,
                       fmi3Boolean *terminateSimulation, fmi3Boolean *earlyReturn, fmi3Float64 *lastSuccessfulTime)
 {
-    double last = 0.0;
     rst_status status;
     (void)noSetFMUStatePriorToCurrentPoint;
     if (eventHandlingNeeded == NULL || terminateSimulation == NULL || earlyReturn == NULL ||
         lastSuccessfulTime == NULL)
         return (fmi3Status)front_refuse(instance, "fmi3DoStep", ANY_MODE, "eventHandlingNeeded, terminateSimulation, "
                                         "earlyReturn and lastSuccessfulTime must not be NULL");
-    status = front_do_step(instance, "fmi3DoStep", currentCommunicationPoint, communicationStepSize, &last);
+    /* front_do_step writes lastSuccessfulTime where the step ran (its start after a discard) */
+    status = front_do_step(instance, "fmi3DoStep", currentCommunicationPoint, communicationStepSize,
+                           lastSuccessfulTime);
     if (status < RST_ERROR) {
         *eventHandlingNeeded = fmi3False;
         *earlyReturn = fmi3False; /* every step runs to its end */
         /* a discarded step leaves the instance unable to step on (fmi3Terminate, fmi3Reset or fmi3SetFMUState) */
         *terminateSimulation = status == RST_DISCARD;
-        *lastSuccessfulTime = last;
     }
     return (fmi3Status)status;
 }

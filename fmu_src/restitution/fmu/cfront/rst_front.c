@@ -55,36 +55,40 @@ const char *front_mode_name(const rst_instance *inst, rst_mode mode, char *buffe
 /* ------------------------------------------------------------------------------------------------ */
 /* Entering and leaving a call                                                                      */
 /* ------------------------------------------------------------------------------------------------ */
-rst_instance *front_instance(void *c)
+#if defined(RST_LOCK_ATOMIC)
+/* The lock word is taken (1 or 2): mark it 2 (a thread waits: whoever gives it back wakes one) and wait
+ * until the exchange finds it free. A waiter woken takes the word as 2, so the waiters still there are
+ * woken in turn; a thread that takes a word freed in between (1) leaves it at 2 for the waiter it
+ * skipped ahead of. */
+void front_lock_contended(rst_instance *inst)
 {
-    rst_instance *inst = (rst_instance *)c;
-    return (inst != NULL && inst->magic == RST_INSTANCE_MAGIC) ? inst : NULL;
-}
-
-void front_lock(rst_instance *inst)
-{
-#if defined(RST_LOCK_PTHREAD)
     pthread_mutex_lock(&inst->lock);
-#elif defined(RST_LOCK_WIN32)
-    AcquireSRWLockExclusive(&inst->lock);
-#endif
-    inst->in_call = 1;
+    while (__atomic_exchange_n(&inst->lock_word, 2, __ATOMIC_ACQUIRE) != 0)
+        pthread_cond_wait(&inst->waiters, &inst->lock);
+    pthread_mutex_unlock(&inst->lock);
 }
 
-void front_unlock(rst_instance *inst)
+/* A waiter marked the word 2 under `lock` before it waits, and waits without letting go of `lock` in
+ * between, so taking `lock` here finds it waiting (or gone with the word): no wake-up is lost. */
+void front_wake_waiter(rst_instance *inst)
+{
+    pthread_mutex_lock(&inst->lock);
+    pthread_cond_signal(&inst->waiters);
+    pthread_mutex_unlock(&inst->lock);
+}
+#else
+void front_lock_contended(rst_instance *inst) { (void)inst; }
+void front_wake_waiter(rst_instance *inst) { (void)inst; }
+#endif
+
+void front_unlock_and_deliver(rst_instance *inst)
 {
     rst_message *messages = front_take_messages(inst);
-    inst->in_call = 0;
-#if defined(RST_LOCK_PTHREAD)
-    pthread_mutex_unlock(&inst->lock);
-#elif defined(RST_LOCK_WIN32)
-    ReleaseSRWLockExclusive(&inst->lock);
-#endif
+    front_release(inst);
     front_deliver_messages(inst, messages);
 }
 
-/* Is `function` allowed in the instance's mode? Logs why not. */
-int front_allowed(rst_instance *inst, const char *function, unsigned int modes)
+int front_refuse_mode(rst_instance *inst, const char *function)
 {
     char buffer[80];
     if (inst->mode == RST_MODE_FATAL) {
@@ -92,13 +96,10 @@ int front_allowed(rst_instance *inst, const char *function, unsigned int modes)
                 "free it (%sFreeInstance)", function, inst->api->prefix, inst->api->prefix);
         return 0;
     }
-    if (!(modes & (unsigned int)inst->mode)) {
-        rst_log(inst, RST_ERROR, "%s is not allowed in %s (%s %s state machine)", function,
-                front_mode_name(inst, inst->mode, buffer, sizeof buffer), inst->api->standard,
-                inst->model_exchange ? "model-exchange" : "co-simulation");
-        return 0;
-    }
-    return 1;
+    rst_log(inst, RST_ERROR, "%s is not allowed in %s (%s %s state machine)", function,
+            front_mode_name(inst, inst->mode, buffer, sizeof buffer), inst->api->standard,
+            inst->model_exchange ? "model-exchange" : "co-simulation");
+    return 0;
 }
 
 /* A backend's answer: RST_ERROR puts the instance into the error mode, RST_FATAL latches it. */
@@ -161,6 +162,9 @@ static void free_memory(rst_instance *inst)
     rst_release_fn release = inst->release;
     front_free_states(inst);
     front_deliver_messages(inst, front_take_messages(inst));
+#if defined(RST_LOCK_ATOMIC)
+    pthread_cond_destroy(&inst->waiters);
+#endif
 #if defined(RST_LOCK_PTHREAD)
     pthread_mutex_destroy(&inst->lock);
 #endif
@@ -210,6 +214,9 @@ rst_instance *front_new_instance(const rst_api *api, void (*host_logger)(void), 
     for (i = 0; i < model->n_variables; i++)
         inst->n_state += model->variables[i].state != 0;
     inst->pending_end = &inst->pending;
+#if defined(RST_LOCK_ATOMIC)
+    pthread_cond_init(&inst->waiters, NULL);
+#endif
 #if defined(RST_LOCK_PTHREAD)
     pthread_mutex_init(&inst->lock, NULL);
 #elif defined(RST_LOCK_WIN32)

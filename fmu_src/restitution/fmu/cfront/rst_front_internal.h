@@ -4,12 +4,19 @@
 
 /* Every instance has a lock (FMI does not ask one instance to be thread-safe; these are), whatever
  * the build command: POSIX threads, or a slim reader/writer lock on Windows. RST_FRONT_NO_LOCK leaves
- * it out for a platform with neither. */
+ * it out for a platform with neither. With POSIX threads and a compiler with the GCC/Clang __atomic
+ * builtins (gcc, clang, zig cc) the lock is a word taken with one compare-and-swap and given back with
+ * one exchange where no other thread wants it (the common case: FMI asks nothing of a host that calls
+ * one instance from several threads); a thread that finds it taken waits on a POSIX condition variable
+ * (RST_LOCK_ATOMIC, below). Elsewhere it is a plain pthread mutex. */
 #if !defined(RST_FRONT_NO_LOCK)
 #if defined(_WIN32)
 #define RST_LOCK_WIN32
 #else
 #define RST_LOCK_PTHREAD
+#if (defined(__GNUC__) || defined(__clang__)) && defined(__ATOMIC_ACQUIRE) && !defined(RST_FRONT_PLAIN_MUTEX)
+#define RST_LOCK_ATOMIC
+#endif
 #if !defined(_POSIX_C_SOURCE)
 #define _POSIX_C_SOURCE 200809L
 #endif
@@ -19,10 +26,10 @@
 #include "rst_front.h"
 
 #if defined(RST_PREFIXED)
-#define front_instance RST_PREFIXED(front_instance)
-#define front_lock RST_PREFIXED(front_lock)
-#define front_unlock RST_PREFIXED(front_unlock)
-#define front_allowed RST_PREFIXED(front_allowed)
+#define front_lock_contended RST_PREFIXED(front_lock_contended)
+#define front_wake_waiter RST_PREFIXED(front_wake_waiter)
+#define front_unlock_and_deliver RST_PREFIXED(front_unlock_and_deliver)
+#define front_refuse_mode RST_PREFIXED(front_refuse_mode)
 #define front_mode_name RST_PREFIXED(front_mode_name)
 #define front_backend_status RST_PREFIXED(front_backend_status)
 #define front_in_range RST_PREFIXED(front_in_range)
@@ -154,7 +161,11 @@ struct rst_instance {
     int in_call;              /* set while a call holds the instance: its messages wait in `pending` */
     rst_message *pending;     /* in the order they were logged */
     rst_message **pending_end;
-#if defined(RST_LOCK_PTHREAD)
+#if defined(RST_LOCK_ATOMIC)
+    int lock_word;            /* 0 free, 1 held, 2 held and a thread may be waiting for it */
+    pthread_mutex_t lock;     /* guards the waiting: threads that found the word taken wait on `waiters` */
+    pthread_cond_t waiters;
+#elif defined(RST_LOCK_PTHREAD)
     pthread_mutex_t lock;
 #elif defined(RST_LOCK_WIN32)
     SRWLOCK lock;
@@ -175,15 +186,32 @@ typedef struct {
     double stop_time;
 } rst_experiment;
 
-/* Converters between the version's value arrays and the core's doubles (element i). */
-typedef double (*rst_read_fn)(const void *values, size_t i);
-typedef void (*rst_write_fn)(void *values, size_t i, double x);
+/* Converters between the version's value arrays and the core's doubles: elements first ... first + n - 1
+ * of `values`, a whole run per call (a get or set of many values pays one indirect call per run, not one
+ * per value). RST_CONVERTERS defines a pair from the conversion of one element. */
+typedef void (*rst_read_fn)(const void *values, size_t first, size_t n, double out[]);
+typedef void (*rst_write_fn)(void *values, size_t first, size_t n, const double in[]);
+#define RST_CONVERTERS(read_name, write_name, c_type, to_double, from_double)                   \
+    static void read_name(const void *values, size_t first, size_t n, double out[])             \
+    {                                                                                           \
+        const c_type *in_ = (const c_type *)values + first;                                     \
+        size_t i_;                                                                              \
+        for (i_ = 0; i_ < n; i_++)                                                              \
+            out[i_] = to_double(in_[i_]);                                                       \
+    }                                                                                           \
+    static void write_name(void *values, size_t first, size_t n, const double in[])             \
+    {                                                                                           \
+        c_type *out_ = (c_type *)values + first;                                                \
+        size_t i_;                                                                              \
+        for (i_ = 0; i_ < n; i_++)                                                              \
+            out_[i_] = from_double(in[i_]);                                                     \
+    }
 
-/* Entering and leaving an FMI call (rst_front.c). */
-rst_instance *front_instance(void *c); /* NULL unless c is one of our live instances */
-void front_lock(rst_instance *inst);
-void front_unlock(rst_instance *inst); /* then delivers the messages the call logged */
-int front_allowed(rst_instance *inst, const char *function, unsigned int modes); /* logs why not */
+/* Entering and leaving an FMI call: the common path inline (below), the rest in rst_front.c. */
+void front_lock_contended(rst_instance *inst);     /* waits for the lock another thread holds */
+void front_wake_waiter(rst_instance *inst);        /* after giving the lock back: wakes a waiting thread */
+void front_unlock_and_deliver(rst_instance *inst); /* unlocks, then delivers the messages the call logged */
+int front_refuse_mode(rst_instance *inst, const char *function); /* logs why the mode refuses; 0 */
 /* The mode as messages name it; `buffer` holds the text of the modes that name a function. */
 const char *front_mode_name(const rst_instance *inst, rst_mode mode, char *buffer, size_t size);
 rst_status front_backend_status(rst_instance *inst, rst_status status);       /* Error, Fatal: change mode */
@@ -264,6 +292,60 @@ rst_status front_serialized_size(void *c, const char *function, void *state, siz
 rst_status front_serialize(void *c, const char *function, void *state, unsigned char bytes[], size_t size);
 rst_status front_deserialize(void *c, const char *function, const unsigned char bytes[], size_t size,
                              void **state);
+
+/* NULL unless c is one of our live instances. */
+static inline rst_instance *front_instance(void *c)
+{
+    rst_instance *inst = (rst_instance *)c;
+    return (inst != NULL && inst->magic == RST_INSTANCE_MAGIC) ? inst : NULL;
+}
+
+static inline void front_lock(rst_instance *inst)
+{
+#if defined(RST_LOCK_ATOMIC)
+    int free_word = 0;
+    if (!__atomic_compare_exchange_n(&inst->lock_word, &free_word, 1, 0, __ATOMIC_ACQUIRE, __ATOMIC_RELAXED))
+        front_lock_contended(inst);
+#elif defined(RST_LOCK_PTHREAD)
+    pthread_mutex_lock(&inst->lock);
+#elif defined(RST_LOCK_WIN32)
+    AcquireSRWLockExclusive(&inst->lock);
+#endif
+    inst->in_call = 1;
+}
+
+/* Gives the lock back, without delivering messages (front_unlock does). */
+static inline void front_release(rst_instance *inst)
+{
+    inst->in_call = 0;
+#if defined(RST_LOCK_ATOMIC)
+    if (__atomic_exchange_n(&inst->lock_word, 0, __ATOMIC_RELEASE) == 2)
+        front_wake_waiter(inst);
+#elif defined(RST_LOCK_PTHREAD)
+    pthread_mutex_unlock(&inst->lock);
+#elif defined(RST_LOCK_WIN32)
+    ReleaseSRWLockExclusive(&inst->lock);
+#endif
+}
+
+/* The end of a call: the lock given back, then the messages the call logged (if any) handed to the
+ * logger, which may call this instance again. */
+static inline void front_unlock(rst_instance *inst)
+{
+    if (inst->pending == NULL)
+        front_release(inst);
+    else
+        front_unlock_and_deliver(inst);
+}
+
+/* Is `function` allowed in the instance's mode (one of the `modes`; never after a fatal error)? Logs
+ * why not. */
+static inline int front_allowed(rst_instance *inst, const char *function, unsigned int modes)
+{
+    if (modes & (unsigned int)inst->mode & ~(unsigned int)RST_MODE_FATAL)
+        return 1;
+    return front_refuse_mode(inst, function);
+}
 
 /* The start of every FMI function of an instance: `inst` checked, locked, the call allowed in its
  * mode (else an error); LEAVE(status) unlocks and returns. (`status_` is an int: the version layers
