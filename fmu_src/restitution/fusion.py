@@ -10,10 +10,13 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from ._num import where
 from .quantities import with_units
 
-__all__ = ["apparent_restitution", "equivalent_plate_mass", "mass_ratio", "velocities_after_impact"]
+__all__ = ["apparent_restitution", "equivalent_plate_mass", "mass_ratio", "velocities_after_impact",
+           "plate_velocity_after_impact"]
 
 
 def apparent_restitution(e_ep, e_ze):
@@ -41,6 +44,8 @@ def equivalent_plate_mass(m_a, e_ze, deficit=None):
     1 - e_ze, exact only where e_ze is exact (a given value, not a computed one).
     """
     gap = 1.0 - e_ze if deficit is None else deficit
+    if np.ndim(gap) and gap.size and gap.min() > 0.0:  # arrays with no half-space case: no masks
+        return (1.0 + e_ze) * m_a / gap
     positive = gap > 0.0
     return where(positive, (1.0 + e_ze) * m_a / where(positive, gap, 1.0), math.inf)
 
@@ -68,6 +73,10 @@ def velocities_after_impact(v_a1, e_ep, e_ze, deficit=None):
     proportional to it, condition number 1 in d).
     """
     gap = 1.0 - e_ze if deficit is None else deficit
-    v_a2 = -apparent_restitution(e_ep, e_ze) * v_a1
-    v_b2 = 0.5 * (1.0 + e_ep) * gap * v_a1
-    return v_a2, v_b2
+    return -apparent_restitution(e_ep, e_ze) * v_a1, plate_velocity_after_impact(v_a1, e_ep, gap)
+
+
+def plate_velocity_after_impact(v_a1, e_ep, deficit):
+    """v_b2 = (1 + e_ep)(1 - e_ze)/2 v_a1 [m/s], the plate's velocity after impact, Eq. (17) with m_b from
+    Eq. (19) (see :func:`velocities_after_impact`); ``deficit``: 1 - e_ze [1] as the Zener method computed it."""
+    return 0.5 * (1.0 + e_ep) * deficit * v_a1

@@ -8,6 +8,8 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from ._num import exp, log, minimum, maximum, sqrt, where
 from .quantities import si_only, with_units
 
@@ -124,11 +126,35 @@ def restitution_e45(v_star, eps_y):
     ~ 1e-307, an underflow) or overflow (brittle pairs, eps_y ~ 10); in log space the loss is
     0 exactly below exp's range (no underflow flag) and capped above it.
     """
+    if np.ndim(v_star) or np.ndim(eps_y):
+        return _restitution_e45_array(np.asarray(v_star, dtype=float), eps_y)
     above, vm1 = _above_one(v_star)
     log_v = log(where(above, v_star, 2.0))  # ln V* > 0 wherever it is used
     log_loss = _LOG_E45_COEFFICIENT - 0.114 * log(eps_y) + log(log_v) + 9.5 * eps_y * log(vm1)
     e = 1.0 - exp(minimum(log_loss, _EXP_ARG_CAP))
     return where(above, maximum(e, 0.0), 1.0)
+
+
+def _restitution_e45_array(v_star, eps_y):
+    """:func:`restitution_e45` of arrays, in place and without masks: V* is clamped at 1 first, where
+    ln(V* - 1) = ln(ln V*) = -inf, so the log of the loss is -inf and e = 1 - exp(-inf) = 1 exactly, the
+    value Eq. (8) takes for V* <= 1. Above the clamp every operation is the scalar form's (the sum of
+    the logarithms in another order: a few ulps of ln(loss), the rounding the conditioning bounds
+    allow). An exp that overflows (loss > e^709) gives e = 1 - inf, floored at 0 as the capped
+    exponent is; one that underflows gives a loss below 1e-307, where 1 - loss is 1 either way."""
+    shape = np.broadcast_shapes(v_star.shape, np.shape(eps_y))
+    clamped = np.maximum(v_star, 1.0, out=np.empty(shape))
+    with np.errstate(divide="ignore", over="ignore", under="ignore"):
+        log_loss = np.subtract(clamped, 1.0)
+        np.log(log_loss, out=log_loss)
+        log_loss *= 9.5 * eps_y
+        np.log(clamped, out=clamped)
+        np.log(clamped, out=clamped)
+        log_loss += clamped
+        log_loss += _LOG_E45_COEFFICIENT - 0.114 * log(eps_y)
+        e = np.exp(log_loss, out=log_loss)
+        np.subtract(1.0, e, out=e)
+    return np.maximum(e, 0.0, out=e)
 
 
 _LOG_E45_COEFFICIENT = math.log(0.0361)

@@ -169,24 +169,35 @@ def _scalar_general(lam):
     return _asym(x)
 
 
-def _horner_cubic(piece, first, t):
-    """c[first] + t (c[first+1] + t (c[first+2] + t c[first+3])) of each case's piece (index array
-    ``piece``), the columns gathered one at a time, in place."""
-    out = _COEF_COLS[first + 3].take(piece)
-    out *= t
-    out += _COEF_COLS[first + 2].take(piece)
-    out *= t
-    out += _COEF_COLS[first + 1].take(piece)
-    out *= t
-    out += _COEF_COLS[first].take(piece)
-    return out
-
-
 def _table_array(lam):
+    """(e_ze, 1 - e_ze, tau0) of an array 0 <= lambda <= LAMBDA_TABLE_MAX: the pieces of
+    :func:`_table_scalar`, with one cell index and one local coordinate t shared by both cubics.
+
+    Each coefficient column is gathered once (9 gathers, not one per coefficient of the three cubics),
+    and the deficit is not a third cubic: its pieces are (1 - a0, -a1, -a2, -a3), so with
+    q = t (a1 + t (a2 + t a3)) the e_ze cubic is a0 + q and the deficit's is (1 - a0) - q, the same
+    floating-point operations as Horner on the deficit's own pieces (negation is exact) and
+    1 - a0 the same number as its column ``c0`` (both are that one subtraction). In place:
+    every temporary is a buffer the next step overwrites."""
     x = lam * _INV_H
     piece = x.astype(np.intp)
-    t = x - _COEF_COLS[0].take(piece)
-    return _horner_cubic(piece, 1, t), _horner_cubic(piece, 5, t), _horner_cubic(piece, 9, t)
+    x -= _COEF_COLS[0].take(piece)  # now t, in [0, w) of the piece
+    t = x
+    q = _COEF_COLS[4].take(piece)
+    q *= t
+    q += _COEF_COLS[3].take(piece)
+    q *= t
+    q += _COEF_COLS[2].take(piece)
+    q *= t
+    a0 = _COEF_COLS[1].take(piece)
+    deficit = np.subtract(1.0, a0)
+    deficit -= q
+    a0 += q
+    tau0 = _COEF_COLS[12].take(piece)
+    for column in (11, 10, 9):
+        tau0 *= t
+        tau0 += _COEF_COLS[column].take(piece)
+    return a0, deficit, tau0
 
 
 def _array(lam):
