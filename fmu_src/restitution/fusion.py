@@ -16,7 +16,7 @@ from ._num import where
 from .quantities import with_units
 
 __all__ = ["apparent_restitution", "equivalent_plate_mass", "mass_ratio", "velocities_after_impact",
-           "plate_velocity_after_impact"]
+           "plate_velocity_after_impact", "plate_mass_from_ratio"]
 
 
 def apparent_restitution(e_ep, e_ze):
@@ -42,12 +42,22 @@ def equivalent_plate_mass(m_a, e_ze, deficit=None):
     m_b in the deficit: 1 + d/(2 - d) <= 2; by subtraction, 1 - e_ze would bring in ~ 1/(1 - e_ze)
     (1.3 % between two CPUs' last-bit exp at e_ze within an ulp of 1). Without ``deficit`` it is
     1 - e_ze, exact only where e_ze is exact (a given value, not a computed one).
+    Computed as m_a over :func:`mass_ratio` (:func:`plate_mass_from_ratio`).
     """
-    gap = 1.0 - e_ze if deficit is None else deficit
-    if np.ndim(gap) and gap.size and gap.min() > 0.0:  # arrays with no half-space case: no masks
-        return (1.0 + e_ze) * m_a / gap
-    positive = gap > 0.0
-    return where(positive, (1.0 + e_ze) * m_a / where(positive, gap, 1.0), math.inf)
+    return plate_mass_from_ratio(m_a, mass_ratio(e_ze, deficit))
+
+
+def plate_mass_from_ratio(m_a, ratio):
+    """m_b = m_a / (m_a / m_b) [kg], Eq. (19) from :func:`mass_ratio` (``ratio`` [1]); +inf where the
+    ratio is 0 (a half-space). One division per case: the model computes the ratio, an output itself,
+    once for both."""
+    if np.ndim(ratio) == 0:
+        return m_a / ratio if ratio > 0.0 else math.inf
+    with np.errstate(divide="ignore"):  # a positive mass over a ratio of 0: +inf, the half-space
+        m_b = np.divide(m_a, ratio)
+    if not (ratio.size and ratio.min() > 0.0):  # a ratio <= 0 (or NaN) anywhere: the half-space's +inf there
+        np.copyto(m_b, math.inf, where=~(ratio > 0.0))
+    return m_b
 
 
 def mass_ratio(e_ze, deficit=None):

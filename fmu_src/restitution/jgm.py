@@ -137,23 +137,22 @@ def restitution_e45(v_star, eps_y):
 
 def _restitution_e45_array(v_star, eps_y):
     """:func:`restitution_e45` of arrays, in place and without masks: V* is clamped at 1 first, where
-    ln(V* - 1) = ln(ln V*) = -inf, so the log of the loss is -inf and e = 1 - exp(-inf) = 1 exactly, the
-    value Eq. (8) takes for V* <= 1. Above the clamp every operation is the scalar form's (the sum of
-    the logarithms in another order: a few ulps of ln(loss), the rounding the conditioning bounds
-    allow). An exp that overflows (loss > e^709) gives e = 1 - inf, floored at 0 as the capped
-    exponent is; one that underflows gives a loss below 1e-307, where 1 - loss is 1 either way."""
+    (V* - 1)^(9.5 eps_y) = 0 and ln V* = 0, so the loss is 0 and e = 1 exactly, the value Eq. (8) takes
+    for V* <= 1. Above the clamp the loss is the product of its factors, the power as
+    exp(9.5 eps_y ln(V* - 1)): the scalar form's logarithms (a few ulps of the loss apart, the rounding
+    the conditioning bounds allow). Where the product underflows (below 1e-307) 1 - loss is 1 either way,
+    and where the power overflows (loss = inf) e = 1 - inf is floored at 0 as the scalar form's capped
+    exponent is; numpy's floating-point flags for both are not raised to the caller."""
     shape = np.broadcast_shapes(v_star.shape, np.shape(eps_y))
     clamped = np.maximum(v_star, 1.0, out=np.empty(shape))
     with np.errstate(divide="ignore", over="ignore", under="ignore"):
-        log_loss = np.subtract(clamped, 1.0)
-        np.log(log_loss, out=log_loss)
-        log_loss *= 9.5 * eps_y
-        np.log(clamped, out=clamped)
-        np.log(clamped, out=clamped)
-        log_loss += clamped
-        log_loss += _LOG_E45_COEFFICIENT - 0.114 * log(eps_y)
-        e = np.exp(log_loss, out=log_loss)
-        np.subtract(1.0, e, out=e)
+        loss = np.subtract(clamped, 1.0)
+        np.log(loss, out=loss)  # -inf at V* <= 1
+        loss *= 9.5 * eps_y
+        np.exp(loss, out=loss)  # (V* - 1)^(9.5 eps_y)
+        loss *= np.log(clamped, out=clamped)
+        loss *= 0.0361 * eps_y ** -0.114
+        e = np.subtract(1.0, loss, out=loss)
     return np.maximum(e, 0.0, out=e)
 
 

@@ -13,8 +13,8 @@ from functools import lru_cache
 import numpy as np
 
 from . import fusion, jgm, zener
-from ._num import is_scalar, minimum, where
-from .fusion import apparent_restitution, mass_ratio, plate_velocity_after_impact
+from ._num import fifth_root, is_scalar, minimum, where
+from .fusion import apparent_restitution, mass_ratio, plate_mass_from_ratio, plate_velocity_after_impact
 from .jgm import restitution_e44, restitution_e45, vstar_in_fit_range
 from .quantities import si_only, with_units
 from .validation import (check_choice, check_nonnegative, check_nonnegative_or_infinite, check_poisson,
@@ -30,7 +30,6 @@ from .zener import (TAU0_HERTZ, ZENER_METHODS, edge_clear, lambda_from_root, lam
                                jgm.critical_velocity, jgm.effective_modulus, jgm.sphere_mass, jgm.yield_strain))
 (contact_duration, hertz_stiffness, dilatational_slowness, edge_echo_ratio) = map(
     si_only, (zener.contact_duration, zener.hertz_stiffness, zener.dilatational_slowness, zener.edge_echo_ratio))
-equivalent_plate_mass = si_only(fusion.equivalent_plate_mass)
 
 __all__ = ["ImpactResult", "impact", "published", "RESTITUTION_MODELS", "EFFECT_MODES", "ZENER_SLOPE_BOUND",
            "PARAMETERS", "DOMAIN", "validate_parameters", "RECORD_REALS", "RECORD_FLAGS", "EDGE_ECHO_PUBLISHED_MAX",
@@ -302,11 +301,16 @@ def _pipeline(v, params, edge_distance, scalar, restitution_model, zener_method,
         e_ep = (restitution_e45(V_star, eps_y) if restitution_model == "e45"
                 else restitution_e44(V_star))
         if plasticity == "auto":
-            e_ep = where(1.0 - e_ep < effect_tolerance, 1.0, e_ep)
+            e_ep = _skip_small_loss(e_ep, effect_tolerance, scalar)
 
     # --- Zener, Eqs. (9)-(13a)
-    v_root = v ** 0.2  # v^(1/5), in Eq. (12) and Eq. (9)
+    v_root = fifth_root(v)  # v^(1/5), in Eq. (12) and Eq. (9)
     lam = lambda_from_root(v_root, sphere_d, plate_t, lambda_factor)  # Eq. (12)
+    # Eq. (9), +inf at v = 0; for arrays into v_root's own memory where the shapes allow (one array
+    # fewer alive while Zener's table is read)
+    T = time_scale_from_root(time_factor, v_root, None if scalar or np.shape(time_factor) not in (
+        (), np.shape(v_root)) else v_root)
+    del v_root
     if plate_waves == "auto":
         needed = _waves_needed(lam, effect_tolerance, scalar)
         skipped_tau0 = _TAU0_AT_LAMBDA0[zener_method]
@@ -315,14 +319,13 @@ def _pipeline(v, params, edge_distance, scalar, restitution_model, zener_method,
         skipped_tau0 = TAU0_HERTZ
     e_ze, d_ze, tau0 = _zener_where_needed(lam, needed, zener_method, ode_rtol, skipped_tau0, scalar)
 
-    T = time_scale_from_root(time_factor, v_root)  # Eq. (9): +inf at v = 0
     moving = _moving(v, scalar)
     t_contact = where(moving, contact_duration(T, tau0), 0.0)  # T tau0 = inf where not moving: replaced
 
     # --- Fusion, Eqs. (17)-(20)
     e = apparent_restitution(e_ep, e_ze)
-    m_eff = equivalent_plate_mass(m_a, e_ze, d_ze)
     ratio = mass_ratio(e_ze, d_ze)
+    m_eff = plate_mass_from_ratio(m_a, ratio)
     v_plate = plate_velocity_after_impact(v, e_ep, d_ze)
 
     # --- Monitors of the assumptions (sections 3 and 4): where Zener was skipped or off, the
@@ -395,6 +398,15 @@ _material_terms_cached = lru_cache(maxsize=64)(_material_terms)
 def _float_or_array(x):
     """A scalar input as a Python float, anything else as a float array."""
     return float(x) if is_scalar(x) else np.asarray(x, dtype=float)
+
+
+def _skip_small_loss(e_ep, tolerance, scalar):
+    """``plasticity="auto"``: e_ep = 1 where the plastic loss 1 - e_ep is below ``tolerance``; an array
+    (a fresh result of Eq. 7 or 8, no one else's) in place."""
+    if scalar or np.ndim(e_ep) == 0:
+        return where(1.0 - e_ep < tolerance, 1.0, e_ep)
+    np.copyto(e_ep, 1.0, where=np.subtract(1.0, e_ep) < tolerance)
+    return e_ep
 
 
 def _moving(v, scalar):

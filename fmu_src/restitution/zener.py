@@ -68,10 +68,11 @@ def lambda_material_factor(E_a, nu_a, rho_a, E_b, nu_b, rho_b):
 def lambda_from_root(v0_root, d, t, material_factor):
     """lambda [1], Eq. (12), in SI from v0^(1/5) (``v0_root``, shared with Zener's time unit, Eq. (9),
     :func:`time_scale_from_root`), the sphere's diameter d [m], the plate's thickness t [m] and
-    :func:`lambda_material_factor`: (material_factor (d/2)^2) v0^(1/5) / t^2. The bracket holds what
+    :func:`lambda_material_factor`: (material_factor (d/2)^2) v0^(1/5) / t / t. The bracket holds what
     does not depend on the speed or the thickness, so one sphere on one pair of materials (a sweep in
-    v and t) computes it once, and an array of cases pays three operations per case."""
-    return material_factor * (0.25 * d * d) * v0_root / (t * t)
+    v and t) computes it once, and an array of cases pays three operations per case, in one array
+    (numpy reuses the temporary of each step; t^2 would be a second one)."""
+    return material_factor * (0.25 * d * d) * v0_root / t / t
 
 
 _LAMBDA_PREFACTOR = math.pi ** 0.6 / math.sqrt(3.0)
@@ -95,13 +96,15 @@ def time_scale_factor(m_a, k):
     return (m_a / k) ** 0.4
 
 
-def time_scale_from_root(factor, v0_root):
+def time_scale_from_root(factor, v0_root, out=None):
     """T = (m_a / k)^(2/5) / v0^(1/5) [s], Eq. (9), from :func:`time_scale_factor` and v0^(1/5)
-    (``v0_root``, shared with Eq. (12), :func:`lambda_from_root`). +inf at v0 = 0 (no impact)."""
+    (``v0_root``, shared with Eq. (12), :func:`lambda_from_root`). +inf at v0 = 0 (no impact).
+    ``out``: an array of the result's shape to write T into (the model passes v0_root's own, once
+    lambda no longer needs it)."""
     if is_scalar(v0_root):
         return factor / v0_root if v0_root > 0.0 else math.inf
     with np.errstate(divide="ignore"):  # a positive factor over v0 = 0: +inf, the value for no impact
-        return np.divide(factor, v0_root)
+        return np.divide(factor, v0_root, out=out)
 
 
 def lambda_in_studied_range(lam):

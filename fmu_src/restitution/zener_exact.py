@@ -181,22 +181,27 @@ def _table_array(lam):
     every temporary is a buffer the next step overwrites."""
     x = lam * _INV_H
     piece = x.astype(np.intp)
-    x -= _COEF_COLS[0].take(piece)  # now t, in [0, w) of the piece
+    gathered = np.empty_like(x)  # one buffer for the coefficients consumed at once: no fresh array per gather
+
+    def gather(column, out=gathered):  # mode "clip": indices are in range, and no bounds pass is buffered
+        return _COEF_COLS[column].take(piece, out=out, mode="clip")
+
+    x -= gather(0)  # now t, in [0, w) of the piece
     t = x
-    q = _COEF_COLS[4].take(piece)
+    q = gather(4, None)
     q *= t
-    q += _COEF_COLS[3].take(piece)
+    q += gather(3)
     q *= t
-    q += _COEF_COLS[2].take(piece)
+    q += gather(2)
     q *= t
-    a0 = _COEF_COLS[1].take(piece)
+    a0 = gather(1, None)
     deficit = np.subtract(1.0, a0)
     deficit -= q
     a0 += q
-    tau0 = _COEF_COLS[12].take(piece)
+    tau0 = gather(12, None)
     for column in (11, 10, 9):
         tau0 *= t
-        tau0 += _COEF_COLS[column].take(piece)
+        tau0 += gather(column)
     return a0, deficit, tau0
 
 
