@@ -51,7 +51,7 @@ def plate_mass_from_ratio(m_a, ratio):
     """m_b = m_a / (m_a / m_b) [kg], Eq. (19) from :func:`mass_ratio` (``ratio`` [1]); +inf where the
     ratio is 0 (a half-space). One division per case: the model computes the ratio, an output itself,
     once for both."""
-    if np.ndim(ratio) == 0:
+    if ratio.__class__ is float or np.ndim(ratio) == 0:
         return m_a / ratio if ratio > 0.0 else math.inf
     with np.errstate(divide="ignore"):  # a positive mass over a ratio of 0: +inf, the half-space
         m_b = np.divide(m_a, ratio)

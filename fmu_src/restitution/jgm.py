@@ -126,7 +126,7 @@ def restitution_e45(v_star, eps_y):
     ~ 1e-307, an underflow) or overflow (brittle pairs, eps_y ~ 10); in log space the loss is
     0 exactly below exp's range (no underflow flag) and capped above it.
     """
-    if np.ndim(v_star) or np.ndim(eps_y):
+    if not (v_star.__class__ is float and eps_y.__class__ is float) and (np.ndim(v_star) or np.ndim(eps_y)):
         return _restitution_e45_array(np.asarray(v_star, dtype=float), eps_y)
     above, vm1 = _above_one(v_star)
     log_v = log(where(above, v_star, 2.0))  # ln V* > 0 wherever it is used

@@ -284,14 +284,18 @@ def _pipeline(v, params, edge_distance, scalar, restitution_model, zener_method,
               effect_tolerance, ode_rtol) -> ImpactResult:
     """The model, written once for Python floats (``scalar``) and numpy arrays alike.
 
-    Every step goes through the float-or-array helpers of :mod:`restitution._num`; the only
-    differences are where results are stored (a memoised material step and a direct fill of the
-    result for floats; masked Zener evaluation and owned output arrays for arrays).
+    Every step goes through the float-or-array helpers of :mod:`restitution._num` and the equations'
+    own float-or-array forms; the differences are where results are stored and how many whole-array
+    passes a step takes. Floats: a memoised material step and a direct fill of the result. Arrays:
+    scalar parameters keep the material step in floats, computed once; each equation's array form
+    works in place on its own temporaries; the masks of speed 0, of the auto skip of Zener and of the
+    half-space are built only where one reduction (a minimum) shows a case needs them; owned output arrays.
     """
     sphere_E, sphere_nu, sphere_Sy, sphere_rho, sphere_d, plate_E, plate_nu, plate_Sy, plate_rho, plate_t = params
 
     # --- JGM, Eqs. (1)-(8)
-    material_terms = _material_terms_cached if all(x.__class__ is float for x in params) else _material_terms
+    material_terms = (_material_terms_cached if scalar or all(x.__class__ is float for x in params)
+                      else _material_terms)
     E_prime, eps_y, m_a, V_c, time_factor, lambda_factor, slowness = material_terms(
         sphere_E, sphere_nu, sphere_Sy, sphere_rho, sphere_d, plate_E, plate_nu, plate_Sy, plate_rho)
     V_star = v / V_c
@@ -301,10 +305,11 @@ def _pipeline(v, params, edge_distance, scalar, restitution_model, zener_method,
         e_ep = (restitution_e45(V_star, eps_y) if restitution_model == "e45"
                 else restitution_e44(V_star))
         if plasticity == "auto":
-            e_ep = _skip_small_loss(e_ep, effect_tolerance, scalar)
+            e_ep = (where(1.0 - e_ep < effect_tolerance, 1.0, e_ep) if scalar
+                    else _skip_small_loss(e_ep, effect_tolerance))
 
     # --- Zener, Eqs. (9)-(13a)
-    v_root = fifth_root(v)  # v^(1/5), in Eq. (12) and Eq. (9)
+    v_root = v ** 0.2 if scalar else fifth_root(v)  # v^(1/5), in Eq. (12) and Eq. (9)
     lam = lambda_from_root(v_root, sphere_d, plate_t, lambda_factor)  # Eq. (12)
     # Eq. (9), +inf at v = 0; for arrays into v_root's own memory where the shapes allow (one array
     # fewer alive while Zener's table is read)
@@ -312,14 +317,14 @@ def _pipeline(v, params, edge_distance, scalar, restitution_model, zener_method,
         (), np.shape(v_root)) else v_root)
     del v_root
     if plate_waves == "auto":
-        needed = _waves_needed(lam, effect_tolerance, scalar)
+        needed = ZENER_SLOPE_BOUND * lam >= effect_tolerance if scalar else _waves_needed(lam, effect_tolerance)
         skipped_tau0 = _TAU0_AT_LAMBDA0[zener_method]
     else:
         needed = plate_waves == "on"
         skipped_tau0 = TAU0_HERTZ
     e_ze, d_ze, tau0 = _zener_where_needed(lam, needed, zener_method, ode_rtol, skipped_tau0, scalar)
 
-    moving = _moving(v, scalar)
+    moving = v > 0.0 if scalar else _moving(v)
     t_contact = where(moving, contact_duration(T, tau0), 0.0)  # T tau0 = inf where not moving: replaced
 
     # --- Fusion, Eqs. (17)-(20)
@@ -400,31 +405,27 @@ def _float_or_array(x):
     return float(x) if is_scalar(x) else np.asarray(x, dtype=float)
 
 
-def _skip_small_loss(e_ep, tolerance, scalar):
-    """``plasticity="auto"``: e_ep = 1 where the plastic loss 1 - e_ep is below ``tolerance``; an array
-    (a fresh result of Eq. 7 or 8, no one else's) in place."""
-    if scalar or np.ndim(e_ep) == 0:
+def _skip_small_loss(e_ep, tolerance):
+    """``plasticity="auto"`` on arrays: e_ep = 1 where the plastic loss 1 - e_ep is below ``tolerance``, in
+    place (e_ep is a fresh result of Eq. 7 or 8, no one else's)."""
+    if np.ndim(e_ep) == 0:
         return where(1.0 - e_ep < tolerance, 1.0, e_ep)
     np.copyto(e_ep, 1.0, where=np.subtract(1.0, e_ep) < tolerance)
     return e_ep
 
 
-def _moving(v, scalar):
-    """v > 0 [m/s], an impact at all: a bool for one impact, one True for arrays whose every speed is
-    positive (the masks it selects by then cost nothing), else the mask."""
-    if scalar:
-        return v > 0.0
+def _moving(v):
+    """v > 0 [m/s], an impact at all, of an array: one True when every speed is positive (the masks it
+    selects by then cost nothing), else the mask."""
     if v.size and v.min() > 0.0:  # min propagates NaN: not > 0, and the mask decides
         return True
     return v > 0.0
 
 
-def _waves_needed(lam, tolerance, scalar):
-    """Where ``plate_waves="auto"`` computes Zener: ZENER_SLOPE_BOUND * lambda >= ``tolerance``. A bool for
-    one impact; for arrays one True when the smallest lambda passes (the product is non-decreasing in
-    lambda, so then every case does), else the mask."""
-    if scalar:
-        return ZENER_SLOPE_BOUND * lam >= tolerance
+def _waves_needed(lam, tolerance):
+    """Where ``plate_waves="auto"`` computes Zener on arrays: ZENER_SLOPE_BOUND * lambda >= ``tolerance``;
+    one True when the smallest lambda passes (the product is non-decreasing in lambda, so then every case
+    does), else the mask."""
     lam = np.asarray(lam)
     if lam.size and ZENER_SLOPE_BOUND * lam.min() >= tolerance:
         return True

@@ -172,7 +172,8 @@ def edge_echo_ratio(edge_distance, slowness, t_contact):
     :func:`dilatational_slowness`) is the fastest; the flexural waves that carry Zener's energy loss
     come back later. a = 0 or +inf means an unbounded plate (Zener's assumption): +inf, as for no
     contact (t_contact = 0); 0 where the contact never ends (t_contact = +inf)."""
-    if is_scalar(edge_distance) and is_scalar(slowness) and not is_scalar(t_contact):  # one plate, many contacts
+    if t_contact.__class__ is not float and not is_scalar(t_contact) and is_scalar(edge_distance) and is_scalar(
+            slowness):  # one plate, many contacts
         if edge_distance == 0.0 or edge_distance == math.inf:
             return math.inf  # the caller broadcasts it
         if slowness > 0.0:  # a positive echo time over t_contact is +inf at 0 and 0 at +inf: no masks
