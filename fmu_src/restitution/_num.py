@@ -54,8 +54,9 @@ def sqrt(x):
 
 
 def fifth_root(x):
-    """x^(1/5) of x >= 0: pow for floats; exp(ln(x) / 5) for arrays, a third cheaper than numpy's pow
-    with the same error (an ulp or two), and 0 at x = 0 (ln 0 = -inf, no divide-by-zero flag raised)."""
+    """x^(1/5) of x >= 0: pow for floats; exp(0.2 ln x) for arrays, a third cheaper than numpy's pow, within
+    eps (4 + |ln x| / 5) of the exact root (the rounding of ln x carried through exp), and 0 at x = 0
+    (ln 0 = -inf, no divide-by-zero flag raised)."""
     if x.__class__ is float or np.ndim(x) == 0:
         return float(x) ** 0.2
     with np.errstate(divide="ignore"):

@@ -175,7 +175,7 @@ def edge_echo_ratio(edge_distance, slowness, t_contact):
     if t_contact.__class__ is not float and not is_scalar(t_contact) and is_scalar(edge_distance) and is_scalar(
             slowness):  # one plate, many contacts
         if edge_distance == 0.0 or edge_distance == math.inf:
-            return math.inf  # the caller broadcasts it
+            return np.full(np.shape(t_contact), math.inf)
         if slowness > 0.0:  # a positive echo time over t_contact is +inf at 0 and 0 at +inf: no masks
             with np.errstate(divide="ignore"):
                 return np.divide(2.0 * edge_distance * slowness, t_contact)
