@@ -227,3 +227,27 @@ def test_good_arrays_at_the_ends_of_their_ranges_pass_the_checks():
     assert got.e.shape == (2,)
     empty = r.impact(np.array([]), **params_for("s2/al6061"))
     assert empty.e.shape == (0,) and empty.valid.shape == (0,)
+
+
+def test_exact_table_in_blocks_matches_the_scalar_evaluation():
+    """The exact method's array path works in blocks of cases (zener_exact._BLOCK): a length that is not
+    a multiple of the block, and a strided 2-D view, give each case what the scalar path gives, within
+    the rounding bound of a cubic in Horner form, 8 eps sum_i |c_i| t^i (c_i the case's piece), for e_ze,
+    1 - e_ze and tau0; the results own their memory and have lambda's shape."""
+    from restitution import zener_exact
+
+    rng = np.random.default_rng(5)
+    n = 2 * zener_exact._BLOCK + 7
+    flat = np.concatenate([[0.0, 100.0, 1e-300], rng.uniform(0.0, 100.0, n - 3)])
+    square = rng.uniform(0.0, 6.0, (64, 2 * 64))[:, ::2]  # not contiguous
+    for lam in (flat, square):
+        got = zener_exact.zener_exact_solution(lam)
+        assert all(g.shape == lam.shape and g.flags.owndata for g in got)
+        for idx in list(np.ndindex(lam.shape))[:: max(1, lam.size // 3000)] + [np.unravel_index(lam.size - 1, lam.shape)]:
+            x = float(lam[idx])
+            cell = zener_exact._COEF_ARR[int(x * zener_exact._INV_H)]
+            t = x * zener_exact._INV_H - cell[0]
+            powers = np.array([1.0, t, t * t, t * t * t])
+            for k, scalar in enumerate(zener_exact.zener_exact_solution(x)):
+                bound = 8 * EPS * float(np.abs(cell[1 + 4 * k:5 + 4 * k]) @ powers)
+                assert abs(got[k][idx] - scalar) <= bound, (x, k)
