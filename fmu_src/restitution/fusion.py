@@ -70,7 +70,10 @@ def mass_ratio(e_ze, deficit=None):
     1 + d/(2 - d) <= 2.
     """
     gap = 1.0 - e_ze if deficit is None else deficit
-    return gap / (1.0 + e_ze)
+    denominator = 1.0 + e_ze
+    if denominator.__class__ is np.ndarray and np.shape(gap) == denominator.shape:  # arrays: in its own temporary
+        return np.divide(gap, denominator, out=denominator)
+    return gap / denominator
 
 
 @with_units(v_a1="m/s")

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, fields
+from fractions import Fraction
 from functools import lru_cache
 
 import numpy as np
@@ -407,11 +408,26 @@ def _float_or_array(x):
 
 def _skip_small_loss(e_ep, tolerance):
     """``plasticity="auto"`` on arrays: e_ep = 1 where the plastic loss 1 - e_ep is below ``tolerance``, in
-    place (e_ep is a fresh result of Eq. 7 or 8, no one else's)."""
+    place (e_ep is a fresh result of Eq. 7 or 8, no one else's), by one comparison with
+    :func:`_loss_threshold`: the same cases as 1 - e_ep < tolerance, without the array of 1 - e_ep."""
     if np.ndim(e_ep) == 0:
         return where(1.0 - e_ep < tolerance, 1.0, e_ep)
-    np.copyto(e_ep, 1.0, where=np.subtract(1.0, e_ep) < tolerance)
+    threshold = _loss_threshold(tolerance)
+    np.copyto(e_ep, 1.0, where=(e_ep > threshold) if threshold is not None else np.subtract(1.0, e_ep) < tolerance)
     return e_ep
+
+
+@lru_cache(maxsize=8)
+def _loss_threshold(tolerance):
+    """The largest float below or at 1 - ``tolerance`` (exactly, not rounded to nearest), or None for a
+    tolerance above 1/2. For e_ep in [1/2, 1], 1 - e_ep is exact (Sterbenz), so the floating-point
+    1 - e_ep < tolerance holds exactly where e_ep > 1 - tolerance, i.e. where e_ep exceeds this float;
+    below 1/2 neither holds (1 - e_ep > 1/2 >= tolerance, and the threshold is >= 1/2); e_ep never exceeds 1."""
+    if not 0.0 <= tolerance <= 0.5:
+        return None
+    exact = Fraction(1) - Fraction(tolerance)
+    threshold = float(exact)  # rounded to nearest: one step down if that went up
+    return threshold if Fraction(threshold) <= exact else math.nextafter(threshold, -math.inf)
 
 
 def _moving(v):

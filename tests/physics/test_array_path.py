@@ -251,3 +251,25 @@ def test_exact_table_in_blocks_matches_the_scalar_evaluation():
             for k, scalar in enumerate(zener_exact.zener_exact_solution(x)):
                 bound = 8 * EPS * float(np.abs(cell[1 + 4 * k:5 + 4 * k]) @ powers)
                 assert abs(got[k][idx] - scalar) <= bound, (x, k)
+
+
+@pytest.mark.parametrize("tolerance", [0.0, 5e-324, 1e-17, 2.0 ** -53, 3e-16, 1e-6, 1e-3, 0.1, 0.25, 0.5])
+def test_auto_skip_of_small_losses_by_one_comparison_selects_what_the_subtraction_selects(tolerance):
+    """The array mode skips a plastic loss below ``effect_tolerance`` by comparing e_ep with one threshold
+    (model._loss_threshold) instead of computing 1 - e_ep: on e_ep in [0, 1] (uniform, near 1 within a few
+    tolerances, and the floats next to the threshold) it selects exactly the cases 1.0 - e_ep < tolerance
+    selects in floating point (a comparison of two exact decisions, not of two roundings)."""
+    from restitution.model import _loss_threshold
+
+    threshold = _loss_threshold(tolerance)
+    rng = np.random.default_rng(3)
+    e_ep = np.concatenate([rng.uniform(0.0, 1.0, 20000), 1.0 - rng.uniform(0.0, 3.0 * max(tolerance, 1e-15), 20000),
+                           [0.0, 0.5, np.nextafter(0.5, 0.0), 1.0, threshold, np.nextafter(threshold, 0.0),
+                            np.nextafter(threshold, 2.0)]])
+    e_ep = e_ep[e_ep <= 1.0]
+    assert np.array_equal(e_ep > threshold, (1.0 - e_ep) < tolerance)
+    assert _loss_threshold(0.75) is None  # above 1/2 the array mode subtracts
+    v, params, edge = mixed_cases()
+    got = r.impact(v, **params, plate_edge_distance=edge, effect_tolerance=0.75)
+    assert_agree(got, one_by_one(v, params, edge, effect_tolerance=0.75), v, params, "tolerance 0.75",
+                 effect_tolerance=0.75)
