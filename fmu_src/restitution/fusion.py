@@ -10,10 +10,13 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from ._num import where
 from .quantities import with_units
 
-__all__ = ["apparent_restitution", "equivalent_plate_mass", "mass_ratio", "velocities_after_impact"]
+__all__ = ["apparent_restitution", "equivalent_plate_mass", "mass_ratio", "velocities_after_impact",
+           "plate_velocity_after_impact", "plate_mass_from_ratio"]
 
 
 def apparent_restitution(e_ep, e_ze):
@@ -39,10 +42,22 @@ def equivalent_plate_mass(m_a, e_ze, deficit=None):
     m_b in the deficit: 1 + d/(2 - d) <= 2; by subtraction, 1 - e_ze would bring in ~ 1/(1 - e_ze)
     (1.3 % between two CPUs' last-bit exp at e_ze within an ulp of 1). Without ``deficit`` it is
     1 - e_ze, exact only where e_ze is exact (a given value, not a computed one).
+    Computed as m_a over :func:`mass_ratio` (:func:`plate_mass_from_ratio`).
     """
-    gap = 1.0 - e_ze if deficit is None else deficit
-    positive = gap > 0.0
-    return where(positive, (1.0 + e_ze) * m_a / where(positive, gap, 1.0), math.inf)
+    return plate_mass_from_ratio(m_a, mass_ratio(e_ze, deficit))
+
+
+def plate_mass_from_ratio(m_a, ratio):
+    """m_b = m_a / (m_a / m_b) [kg], Eq. (19) from :func:`mass_ratio` (``ratio`` [1]); +inf where the
+    ratio is 0 (a half-space). One division per case: the model computes the ratio, an output itself,
+    once for both."""
+    if ratio.__class__ is float or np.ndim(ratio) == 0:
+        return m_a / ratio if ratio > 0.0 else math.inf
+    with np.errstate(divide="ignore"):  # a positive mass over a ratio of 0: +inf, the half-space
+        m_b = np.divide(m_a, ratio)
+    if not (ratio.size and ratio.min() > 0.0):  # a ratio <= 0 (or NaN) anywhere: the half-space's +inf there
+        np.copyto(m_b, math.inf, where=~(ratio > 0.0))
+    return m_b
 
 
 def mass_ratio(e_ze, deficit=None):
@@ -55,7 +70,10 @@ def mass_ratio(e_ze, deficit=None):
     1 + d/(2 - d) <= 2.
     """
     gap = 1.0 - e_ze if deficit is None else deficit
-    return gap / (1.0 + e_ze)
+    denominator = 1.0 + e_ze
+    if denominator.__class__ is np.ndarray and np.shape(gap) == denominator.shape:  # arrays: in its own temporary
+        return np.divide(gap, denominator, out=denominator)
+    return gap / denominator
 
 
 @with_units(v_a1="m/s")
@@ -68,6 +86,10 @@ def velocities_after_impact(v_a1, e_ep, e_ze, deficit=None):
     proportional to it, condition number 1 in d).
     """
     gap = 1.0 - e_ze if deficit is None else deficit
-    v_a2 = -apparent_restitution(e_ep, e_ze) * v_a1
-    v_b2 = 0.5 * (1.0 + e_ep) * gap * v_a1
-    return v_a2, v_b2
+    return -apparent_restitution(e_ep, e_ze) * v_a1, plate_velocity_after_impact(v_a1, e_ep, gap)
+
+
+def plate_velocity_after_impact(v_a1, e_ep, deficit):
+    """v_b2 = (1 + e_ep)(1 - e_ze)/2 v_a1 [m/s], the plate's velocity after impact, Eq. (17) with m_b from
+    Eq. (19) (see :func:`velocities_after_impact`); ``deficit``: 1 - e_ze [1] as the Zener method computed it."""
+    return 0.5 * (1.0 + e_ep) * deficit * v_a1

@@ -8,6 +8,8 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from ._num import exp, log, minimum, maximum, sqrt, where
 from .quantities import si_only, with_units
 
@@ -124,11 +126,34 @@ def restitution_e45(v_star, eps_y):
     ~ 1e-307, an underflow) or overflow (brittle pairs, eps_y ~ 10); in log space the loss is
     0 exactly below exp's range (no underflow flag) and capped above it.
     """
+    if not (v_star.__class__ is float and eps_y.__class__ is float) and (np.ndim(v_star) or np.ndim(eps_y)):
+        return _restitution_e45_array(np.asarray(v_star, dtype=float), eps_y)
     above, vm1 = _above_one(v_star)
     log_v = log(where(above, v_star, 2.0))  # ln V* > 0 wherever it is used
     log_loss = _LOG_E45_COEFFICIENT - 0.114 * log(eps_y) + log(log_v) + 9.5 * eps_y * log(vm1)
     e = 1.0 - exp(minimum(log_loss, _EXP_ARG_CAP))
     return where(above, maximum(e, 0.0), 1.0)
+
+
+def _restitution_e45_array(v_star, eps_y):
+    """:func:`restitution_e45` of arrays, in place and without masks: V* is clamped at 1 first, where
+    (V* - 1)^(9.5 eps_y) = 0 and ln V* = 0, so the loss is 0 and e = 1 exactly, the value Eq. (8) takes
+    for V* <= 1. Above the clamp the loss is the product of its factors, the power as
+    exp(9.5 eps_y ln(V* - 1)): the scalar form's logarithms (a few ulps of the loss apart, the rounding
+    the conditioning bounds allow). Where the product underflows (below 1e-307) 1 - loss is 1 either way,
+    and where the power overflows (loss = inf) e = 1 - inf is floored at 0 as the scalar form's capped
+    exponent is; numpy's floating-point flags for both are not raised to the caller."""
+    shape = np.broadcast_shapes(v_star.shape, np.shape(eps_y))
+    clamped = np.maximum(v_star, 1.0, out=np.empty(shape))
+    with np.errstate(divide="ignore", over="ignore", under="ignore"):
+        loss = np.subtract(clamped, 1.0)
+        np.log(loss, out=loss)  # -inf at V* <= 1
+        loss *= 9.5 * eps_y
+        np.exp(loss, out=loss)  # (V* - 1)^(9.5 eps_y)
+        loss *= np.log(clamped, out=clamped)
+        loss *= 0.0361 * eps_y ** -0.114
+        e = np.subtract(1.0, loss, out=loss)
+    return np.maximum(e, 0.0, out=e)
 
 
 _LOG_E45_COEFFICIENT = math.log(0.0361)

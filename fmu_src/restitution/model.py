@@ -8,30 +8,29 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, fields
+from fractions import Fraction
 from functools import lru_cache
 
 import numpy as np
 
 from . import fusion, jgm, zener
-from ._num import is_scalar, minimum, where
-from .fusion import apparent_restitution, mass_ratio
+from ._num import fifth_root, is_scalar, minimum, where
+from .fusion import apparent_restitution, mass_ratio, plate_mass_from_ratio, plate_velocity_after_impact
 from .jgm import restitution_e44, restitution_e45, vstar_in_fit_range
 from .quantities import si_only, with_units
 from .validation import (check_choice, check_nonnegative, check_nonnegative_or_infinite, check_poisson,
                          check_positive)
-from .zener import (TAU0_HERTZ, ZENER_METHODS, edge_clear, lambda_from_terms, lambda_in_studied_range,
-                    lambda_material_terms, wave_delay, waves_concurrent, zener_linear, zener_paper_fit, zener_solution)
+from .zener import (TAU0_HERTZ, ZENER_METHODS, edge_clear, lambda_from_root, lambda_in_studied_range,
+                    lambda_material_factor, time_scale_factor, time_scale_from_root, wave_delay, waves_concurrent,
+                    zener_linear, zener_paper_fit, zener_solution)
 
 # The pipeline passes SI numbers it has checked: it calls the equations without their unit layer
 # (restitution.quantities), which would cost more than the equations on the scalar path.
 (critical_interference, critical_load, critical_pressure, critical_velocity, effective_modulus, sphere_mass,
  yield_strain) = map(si_only, (jgm.critical_interference, jgm.critical_load, jgm.critical_pressure,
                                jgm.critical_velocity, jgm.effective_modulus, jgm.sphere_mass, jgm.yield_strain))
-(contact_duration, hertz_stiffness, time_scale, dilatational_slowness, edge_echo_ratio) = map(
-    si_only, (zener.contact_duration, zener.hertz_stiffness, zener.time_scale, zener.dilatational_slowness,
-              zener.edge_echo_ratio))
-equivalent_plate_mass, velocities_after_impact = map(si_only, (fusion.equivalent_plate_mass,
-                                                              fusion.velocities_after_impact))
+(contact_duration, hertz_stiffness, dilatational_slowness, edge_echo_ratio) = map(
+    si_only, (zener.contact_duration, zener.hertz_stiffness, zener.dilatational_slowness, zener.edge_echo_ratio))
 
 __all__ = ["ImpactResult", "impact", "published", "RESTITUTION_MODELS", "EFFECT_MODES", "ZENER_SLOPE_BOUND",
            "PARAMETERS", "DOMAIN", "validate_parameters", "RECORD_REALS", "RECORD_FLAGS", "EDGE_ECHO_PUBLISHED_MAX",
@@ -273,10 +272,11 @@ def impact(v, sphere_E, sphere_nu, sphere_Sy, sphere_rho, sphere_d,
             v, params, plate_edge_distance = float(v), tuple(map(float, params)), float(plate_edge_distance)
         else:
             # No up-front broadcast: what depends on the parameters only is computed once per
-            # distinct parameter value (a scalar parameter stays a scalar), not once per case.
+            # distinct parameter value, and a scalar parameter stays a Python float, so one sphere on
+            # one pair of materials (a sweep in v and t) computes its material terms in floats, once.
             v = np.asarray(v, dtype=float)
-            params = tuple(np.asarray(x, dtype=float) for x in params)
-            plate_edge_distance = np.asarray(plate_edge_distance, dtype=float)
+            params = tuple(_float_or_array(x) for x in params)
+            plate_edge_distance = _float_or_array(plate_edge_distance)
     return _pipeline(v, params, plate_edge_distance, scalar, restitution_model, zener_method, plasticity, plate_waves,
                      effect_tolerance, ode_rtol)
 
@@ -285,15 +285,19 @@ def _pipeline(v, params, edge_distance, scalar, restitution_model, zener_method,
               effect_tolerance, ode_rtol) -> ImpactResult:
     """The model, written once for Python floats (``scalar``) and numpy arrays alike.
 
-    Every step goes through the float-or-array helpers of :mod:`restitution._num`; the only
-    differences are where results are stored (a memoised material step and a direct fill of the
-    result for floats; masked Zener evaluation and owned output arrays for arrays).
+    Every step goes through the float-or-array helpers of :mod:`restitution._num` and the equations'
+    own float-or-array forms; the differences are where results are stored and how many whole-array
+    passes a step takes. Floats: a memoised material step and a direct fill of the result. Arrays:
+    scalar parameters keep the material step in floats, computed once; each equation's array form
+    works in place on its own temporaries; the masks of speed 0, of the auto skip of Zener and of the
+    half-space are built only where one reduction (a minimum) shows a case needs them; owned output arrays.
     """
     sphere_E, sphere_nu, sphere_Sy, sphere_rho, sphere_d, plate_E, plate_nu, plate_Sy, plate_rho, plate_t = params
 
     # --- JGM, Eqs. (1)-(8)
-    material_terms = _material_terms_cached if scalar else _material_terms
-    E_prime, eps_y, m_a, V_c, k, wave_speed, density_factor, modulus_factor, slowness = material_terms(
+    material_terms = (_material_terms_cached if scalar or all(x.__class__ is float for x in params)
+                      else _material_terms)
+    E_prime, eps_y, m_a, V_c, time_factor, lambda_factor, slowness = material_terms(
         sphere_E, sphere_nu, sphere_Sy, sphere_rho, sphere_d, plate_E, plate_nu, plate_Sy, plate_rho)
     V_star = v / V_c
     if plasticity == "off":
@@ -302,27 +306,33 @@ def _pipeline(v, params, edge_distance, scalar, restitution_model, zener_method,
         e_ep = (restitution_e45(V_star, eps_y) if restitution_model == "e45"
                 else restitution_e44(V_star))
         if plasticity == "auto":
-            e_ep = where(1.0 - e_ep < effect_tolerance, 1.0, e_ep)
+            e_ep = (where(1.0 - e_ep < effect_tolerance, 1.0, e_ep) if scalar
+                    else _skip_small_loss(e_ep, effect_tolerance))
 
     # --- Zener, Eqs. (9)-(13a)
-    lam = lambda_from_terms(v, sphere_d, plate_t, wave_speed, density_factor, modulus_factor)  # Eq. (12)
+    v_root = v ** 0.2 if scalar else fifth_root(v)  # v^(1/5), in Eq. (12) and Eq. (9)
+    lam = lambda_from_root(v_root, sphere_d, plate_t, lambda_factor)  # Eq. (12)
+    # Eq. (9), +inf at v = 0; for arrays into v_root's own memory where the shapes allow (one array
+    # fewer alive while Zener's table is read)
+    T = time_scale_from_root(time_factor, v_root, None if scalar or np.shape(time_factor) not in (
+        (), np.shape(v_root)) else v_root)
+    del v_root
     if plate_waves == "auto":
-        needed = ZENER_SLOPE_BOUND * lam >= effect_tolerance
+        needed = ZENER_SLOPE_BOUND * lam >= effect_tolerance if scalar else _waves_needed(lam, effect_tolerance)
         skipped_tau0 = _TAU0_AT_LAMBDA0[zener_method]
     else:
         needed = plate_waves == "on"
         skipped_tau0 = TAU0_HERTZ
     e_ze, d_ze, tau0 = _zener_where_needed(lam, needed, zener_method, ode_rtol, skipped_tau0, scalar)
 
-    moving = v > 0.0
-    T = where(moving, time_scale(m_a, k, where(moving, v, 1.0)), math.inf)
+    moving = v > 0.0 if scalar else _moving(v)
     t_contact = where(moving, contact_duration(T, tau0), 0.0)  # T tau0 = inf where not moving: replaced
 
     # --- Fusion, Eqs. (17)-(20)
     e = apparent_restitution(e_ep, e_ze)
-    m_eff = equivalent_plate_mass(m_a, e_ze, d_ze)
     ratio = mass_ratio(e_ze, d_ze)
-    _, v_plate = velocities_after_impact(v, e_ep, e_ze, d_ze)
+    m_eff = plate_mass_from_ratio(m_a, ratio)
+    v_plate = plate_velocity_after_impact(v, e_ep, d_ze)
 
     # --- Monitors of the assumptions (sections 3 and 4): where Zener was skipped or off, the
     # half-space contact is the reference itself
@@ -337,7 +347,7 @@ def _pipeline(v, params, edge_distance, scalar, restitution_model, zener_method,
     if scalar:  # every value is already a Python float or bool (math-module paths; the tests check it)
         out.__dict__.update(zip(_FIELD_NAMES, values))
         return out
-    shape = np.broadcast_shapes(v.shape, edge_distance.shape, *(x.shape for x in params))
+    shape = np.broadcast_shapes(v.shape, np.shape(edge_distance), *(np.shape(x) for x in params))
     out.__dict__.update((name, _own_array(value, shape, bool if name in _FLAGS else float))
                         for name, value in zip(_FIELD_NAMES, values))
     return out
@@ -364,29 +374,78 @@ def _own_array(x, shape, dtype):
     """
     if x.__class__ is np.ndarray and x.shape == shape and x.dtype == dtype and x.flags.owndata:
         return x
+    if np.ndim(x) == 0:  # a value shared by every case (a material term, a flag): one fill
+        return np.full(shape, x, dtype=dtype)
     return np.broadcast_to(x, shape).astype(dtype)
 
 
 def _material_terms(sphere_E, sphere_nu, sphere_Sy, sphere_rho, sphere_d, plate_E, plate_nu, plate_Sy,
                     plate_rho):
-    """What depends on the materials only: (E' [Pa], eps_y [1], m_a [kg], V_c [m/s], k [N/m^1.5],
-    then the material factors of lambda, :func:`restitution.zener.lambda_material_terms`, and the plate's
-    dilatational slowness 1/c_L [s/m]), Eqs. (1)-(6), the Hertz stiffness of Eq. (9), part of Eq. (12)
-    and the edge monitor's wave speed."""
+    """What depends on the materials and the sphere only: (E' [Pa], eps_y [1], m_a [kg], V_c [m/s],
+    :func:`restitution.zener.time_scale_factor` of the Hertz stiffness, :func:`restitution.zener.lambda_material_factor`
+    and the plate's dilatational slowness 1/c_L [s/m]), Eqs. (1)-(6), the speed-free parts of Eqs. (9)
+    and (12), and the edge monitor's wave speed."""
     E_prime = effective_modulus(sphere_E, sphere_nu, plate_E, plate_nu)
     CSy = critical_pressure(sphere_nu, sphere_Sy, plate_nu, plate_Sy)
     eps_y = yield_strain(E_prime, sphere_nu, sphere_Sy, plate_nu, plate_Sy)
     R = 0.5 * sphere_d
     m_a = sphere_mass(sphere_rho, sphere_d)
     V_c = critical_velocity(critical_interference(CSy, E_prime, R), critical_load(CSy, E_prime, R), m_a)
-    return (E_prime, eps_y, m_a, V_c, hertz_stiffness(E_prime, sphere_d),
-            *lambda_material_terms(sphere_E, sphere_nu, sphere_rho, plate_E, plate_nu, plate_rho),
+    return (E_prime, eps_y, m_a, V_c, time_scale_factor(m_a, hertz_stiffness(E_prime, sphere_d)),
+            lambda_material_factor(sphere_E, sphere_nu, sphere_rho, plate_E, plate_nu, plate_rho),
             dilatational_slowness(plate_E, plate_nu, plate_rho))
 
 
 #: :func:`_material_terms` memoised for Python floats (a pure function): a co-simulation or a
 #: sweep in v pays for it once.
 _material_terms_cached = lru_cache(maxsize=64)(_material_terms)
+
+
+def _float_or_array(x):
+    """A scalar input as a Python float, anything else as a float array."""
+    return float(x) if is_scalar(x) else np.asarray(x, dtype=float)
+
+
+def _skip_small_loss(e_ep, tolerance):
+    """``plasticity="auto"`` on arrays: e_ep = 1 where the plastic loss 1 - e_ep is below ``tolerance``, in
+    place (e_ep is a fresh result of Eq. 7 or 8, no one else's), by one comparison with
+    :func:`_loss_threshold`: the same cases as 1 - e_ep < tolerance, without the array of 1 - e_ep."""
+    if np.ndim(e_ep) == 0:
+        return where(1.0 - e_ep < tolerance, 1.0, e_ep)
+    threshold = _loss_threshold(tolerance)
+    np.copyto(e_ep, 1.0, where=(e_ep > threshold) if threshold is not None else np.subtract(1.0, e_ep) < tolerance)
+    return e_ep
+
+
+@lru_cache(maxsize=8)
+def _loss_threshold(tolerance):
+    """The largest float below or at 1 - ``tolerance`` (exactly, not rounded to nearest), or None for a
+    tolerance above 1/2. For e_ep in [1/2, 1], 1 - e_ep is exact (Sterbenz), so the floating-point
+    1 - e_ep < tolerance holds exactly where e_ep > 1 - tolerance, i.e. where e_ep exceeds this float;
+    below 1/2 neither holds (1 - e_ep > 1/2 >= tolerance, and the threshold is >= 1/2); e_ep never exceeds 1."""
+    if not 0.0 <= tolerance <= 0.5:
+        return None
+    exact = Fraction(1) - Fraction(tolerance)
+    threshold = float(exact)  # rounded to nearest: one step down if that went up
+    return threshold if Fraction(threshold) <= exact else math.nextafter(threshold, -math.inf)
+
+
+def _moving(v):
+    """v > 0 [m/s], an impact at all, of an array: one True when every speed is positive (the masks it
+    selects by then cost nothing), else the mask."""
+    if v.size and v.min() > 0.0:  # min propagates NaN: not > 0, and the mask decides
+        return True
+    return v > 0.0
+
+
+def _waves_needed(lam, tolerance):
+    """Where ``plate_waves="auto"`` computes Zener on arrays: ZENER_SLOPE_BOUND * lambda >= ``tolerance``;
+    one True when the smallest lambda passes (the product is non-decreasing in lambda, so then every case
+    does), else the mask."""
+    lam = np.asarray(lam)
+    if lam.size and ZENER_SLOPE_BOUND * lam.min() >= tolerance:
+        return True
+    return ZENER_SLOPE_BOUND * lam >= tolerance
 
 
 def _zener_where_needed(lam, needed, method, rtol, skipped_tau0, scalar):

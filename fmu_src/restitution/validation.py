@@ -17,6 +17,11 @@ def _check(name, value, unit, ok_scalar, ok_array, allowed):
             raise ValueError(f"{name} = {v!r}{unit} is outside the allowed range: {allowed}")
         return v
     arr = np.asarray(value, dtype=float)
+    if arr.size and ok_scalar(float(arr.min())) and ok_scalar(float(arr.max())):
+        # every range allowed here is an interval, so its two ends decide for the whole array: two
+        # reductions instead of an elementwise mask (NaN propagates through min and max: refused, and
+        # the mask below finds it)
+        return arr
     with np.errstate(invalid="ignore"):
         good = ok_array(arr)
     if not np.all(good):

@@ -23,7 +23,8 @@ from .zener_ode import solve_zener_ode
 
 __all__ = [
     "ZENER_METHODS", "LAMBDA_STUDIED_MAX", "lambda_in_studied_range", "TAU0_HERTZ", "plate_wave_speed", "inelasticity_parameter",
-    "hertz_stiffness", "time_scale", "zener_paper_fit", "zener_paper_fit_deficit", "zener_linear",
+    "lambda_material_factor", "lambda_from_root", "hertz_stiffness", "time_scale", "time_scale_factor",
+    "time_scale_from_root", "zener_paper_fit", "zener_paper_fit_deficit", "zener_linear",
     "zener_linear_deficit", "zener_linear_fit", "zener_ode", "zener_restitution", "zener_solution",
     "contact_duration", "WAVE_DELAY_LIMIT", "wave_delay", "waves_concurrent", "dilatational_wave_speed",
     "dilatational_slowness", "edge_echo_ratio", "edge_clear",
@@ -50,25 +51,28 @@ def inelasticity_parameter(v0, E_a, nu_a, rho_a, d, E_b, nu_b, rho_b, t):
     with v0 the impact speed [m/s], d the sphere diameter [m], t = 2h the plate thickness [m].
     It depends on t/d only, not on t and d separately.
     """
-    return lambda_from_terms(v0, d, t, *lambda_material_terms(E_a, nu_a, rho_a, E_b, nu_b, rho_b))
+    return lambda_from_root(v0 ** 0.2, d, t, lambda_material_factor(E_a, nu_a, rho_a, E_b, nu_b, rho_b))
 
 
-def lambda_material_terms(E_a, nu_a, rho_a, E_b, nu_b, rho_b):
-    """The factors of Eq. (12) that depend on the materials only, in SI: (v' [m/s],
-    (rho_a/rho_b)^(3/5), (E_a'/(E_a' + E_b'))^(2/5)). Split from the speed and geometry so that the
-    model computes them once per pair of materials (:func:`restitution.model._material_terms`)."""
+def lambda_material_factor(E_a, nu_a, rho_a, E_b, nu_b, rho_b):
+    """The factor of Eq. (12) that depends on the materials only, in SI [(s/m)^(1/5)]:
+    pi^(3/5)/sqrt(3) v'^(-1/5) (rho_a/rho_b)^(3/5) (E_a'/(E_a' + E_b'))^(2/5), v' the plate's wave speed
+    (:func:`plate_wave_speed`). Split from the speed and the geometry so that the model computes it once
+    per pair of materials (:func:`restitution.model._material_terms`)."""
     Ea = _reduced_modulus(E_a, nu_a)
     Eb = _reduced_modulus(E_b, nu_b)
-    return _plate_wave_speed(E_b, nu_b, rho_b), (rho_a / rho_b) ** 0.6, (Ea / (Ea + Eb)) ** 0.4
+    return (_LAMBDA_PREFACTOR * (rho_a / rho_b) ** 0.6 * (Ea / (Ea + Eb)) ** 0.4
+            / _plate_wave_speed(E_b, nu_b, rho_b) ** 0.2)
 
 
-def lambda_from_terms(v0, d, t, wave_speed, density_factor, modulus_factor):
-    """lambda [1], Eq. (12), from :func:`lambda_material_terms`'s factors, in SI. The product is taken
-    in the order of the printed equation, so it is the same number to the last bit whichever way the
-    factors were obtained."""
-    r_over_t = 0.5 * d / t
-    return (_LAMBDA_PREFACTOR * r_over_t * r_over_t * (v0 / wave_speed) ** 0.2
-            * density_factor * modulus_factor)
+def lambda_from_root(v0_root, d, t, material_factor):
+    """lambda [1], Eq. (12), in SI from v0^(1/5) (``v0_root``, shared with Zener's time unit, Eq. (9),
+    :func:`time_scale_from_root`), the sphere's diameter d [m], the plate's thickness t [m] and
+    :func:`lambda_material_factor`: (material_factor (d/2)^2) v0^(1/5) / t / t. The bracket holds what
+    does not depend on the speed or the thickness, so one sphere on one pair of materials (a sweep in
+    v and t) computes it once, and an array of cases pays three operations per case, in one array
+    (numpy reuses the temporary of each step; t^2 would be a second one)."""
+    return material_factor * (0.25 * d * d) * v0_root / t / t
 
 
 _LAMBDA_PREFACTOR = math.pi ** 0.6 / math.sqrt(3.0)
@@ -83,7 +87,24 @@ def hertz_stiffness(E_prime, d):
 @with_units(m_a="kg", k="N/m**1.5", v0="m/s")
 def time_scale(m_a, k, v0):
     """Zener's time unit T = (m / (k v0^(1/2)))^(2/5) [s], Eq. (9). Infinite at v0 = 0."""
-    return (m_a / (k * sqrt(v0))) ** 0.4
+    return time_scale_from_root(time_scale_factor(m_a, k), v0 ** 0.2)
+
+
+def time_scale_factor(m_a, k):
+    """(m_a / k)^(2/5) [s^(4/5) m^(1/5)]: the part of Zener's time unit, Eq. (9), that does not depend on
+    the speed (sphere mass m_a [kg], Hertz stiffness k [N/m^1.5])."""
+    return (m_a / k) ** 0.4
+
+
+def time_scale_from_root(factor, v0_root, out=None):
+    """T = (m_a / k)^(2/5) / v0^(1/5) [s], Eq. (9), from :func:`time_scale_factor` and v0^(1/5)
+    (``v0_root``, shared with Eq. (12), :func:`lambda_from_root`). +inf at v0 = 0 (no impact).
+    ``out``: an array of the result's shape to write T into (the model passes v0_root's own, once
+    lambda no longer needs it)."""
+    if is_scalar(v0_root):
+        return factor / v0_root if v0_root > 0.0 else math.inf
+    with np.errstate(divide="ignore"):  # a positive factor over v0 = 0: +inf, the value for no impact
+        return np.divide(factor, v0_root, out=out)
 
 
 def lambda_in_studied_range(lam):
@@ -151,6 +172,13 @@ def edge_echo_ratio(edge_distance, slowness, t_contact):
     :func:`dilatational_slowness`) is the fastest; the flexural waves that carry Zener's energy loss
     come back later. a = 0 or +inf means an unbounded plate (Zener's assumption): +inf, as for no
     contact (t_contact = 0); 0 where the contact never ends (t_contact = +inf)."""
+    if t_contact.__class__ is not float and not is_scalar(t_contact) and is_scalar(edge_distance) and is_scalar(
+            slowness):  # one plate, many contacts
+        if edge_distance == 0.0 or edge_distance == math.inf:
+            return np.full(np.shape(t_contact), math.inf)
+        if slowness > 0.0:  # a positive echo time over t_contact is +inf at 0 and 0 at +inf: no masks
+            with np.errstate(divide="ignore"):
+                return np.divide(2.0 * edge_distance * slowness, t_contact)
     unbounded = (edge_distance == 0.0) | (edge_distance == math.inf)
     no_contact = t_contact == 0.0
     echo = 2.0 * where(unbounded, 0.0, edge_distance) * slowness

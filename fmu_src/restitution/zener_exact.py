@@ -169,24 +169,58 @@ def _scalar_general(lam):
     return _asym(x)
 
 
-def _horner_cubic(piece, first, t):
-    """c[first] + t (c[first+1] + t (c[first+2] + t c[first+3])) of each case's piece (index array
-    ``piece``), the columns gathered one at a time, in place."""
-    out = _COEF_COLS[first + 3].take(piece)
-    out *= t
-    out += _COEF_COLS[first + 2].take(piece)
-    out *= t
-    out += _COEF_COLS[first + 1].take(piece)
-    out *= t
-    out += _COEF_COLS[first].take(piece)
-    return out
+#: Cases per block of :func:`_table_array`: its temporaries (the local coordinate, the cell index, a
+#: gathered column, a partial cubic: 4 x 256 kB) stay in the cache and are reused block after block,
+#: instead of four fresh arrays of the whole size, which numpy takes from the system (and the system
+#: must clear) once they pass ~32 MB.
+_BLOCK = 32768
 
 
 def _table_array(lam):
-    x = lam * _INV_H
-    piece = x.astype(np.intp)
-    t = x - _COEF_COLS[0].take(piece)
-    return _horner_cubic(piece, 1, t), _horner_cubic(piece, 5, t), _horner_cubic(piece, 9, t)
+    """(e_ze, 1 - e_ze, tau0) of an array 0 <= lambda <= LAMBDA_TABLE_MAX: the pieces of
+    :func:`_table_scalar`, with one cell index and one local coordinate t shared by both cubics.
+
+    Each coefficient column is gathered once (9 gathers, not one per coefficient of the three cubics),
+    and the deficit is not a third cubic: its pieces are (1 - a0, -a1, -a2, -a3), so with
+    q = t (a1 + t (a2 + t a3)) the e_ze cubic is a0 + q and the deficit's is (1 - a0) - q, the same
+    floating-point operations as Horner on the deficit's own pieces (negation is exact) and
+    1 - a0 the same number as its column ``c0`` (both are that one subtraction). In place, in blocks
+    of :data:`_BLOCK` cases written into the three results."""
+    results = tuple(np.empty(np.shape(lam)) for _ in range(3))  # their own memory, in lambda's shape
+    flat = tuple(r.reshape(-1) for r in results)  # views, to write them block by block
+    lam = np.ascontiguousarray(lam).reshape(-1)
+    n = min(lam.size, _BLOCK)
+    t, piece, gathered, q = np.empty(n), np.empty(n, dtype=np.intp), np.empty(n), np.empty(n)
+    for start in range(0, lam.size, _BLOCK):
+        stop = min(start + _BLOCK, lam.size)
+        m = stop - start
+        _table_block(lam[start:stop], *(r[start:stop] for r in flat), t[:m], piece[:m], gathered[:m], q[:m])
+    return results
+
+
+def _table_block(lam, e, deficit, tau0, t, piece, gathered, q):
+    """One block of :func:`_table_array`: the three cubics of the cases ``lam`` into ``e``, ``deficit`` and
+    ``tau0``, with the block's buffers ``t``, ``piece``, ``gathered`` and ``q``."""
+    def gather(column, out=gathered):  # mode "clip": indices are in range, and no bounds pass is buffered
+        return _COEF_COLS[column].take(piece, out=out, mode="clip")
+
+    np.multiply(lam, _INV_H, out=t)
+    np.copyto(piece, t, casting="unsafe")  # truncation: the fine cell
+    t -= gather(0)  # now t, in [0, w) of the piece
+    gather(4, q)
+    q *= t
+    q += gather(3)
+    q *= t
+    q += gather(2)
+    q *= t
+    gather(1, e)
+    np.subtract(1.0, e, out=deficit)
+    deficit -= q
+    e += q
+    gather(12, tau0)
+    for column in (11, 10, 9):
+        tau0 *= t
+        tau0 += gather(column)
 
 
 def _array(lam):
