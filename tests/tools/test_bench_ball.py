@@ -5,14 +5,11 @@ asserted (machines are noisy and shared)."""
 import os
 import re
 import shutil
-import subprocess
 import sys
-from pathlib import Path
 
 import pytest
+from bench_script import run_benchmark
 
-ROOT = Path(__file__).resolve().parents[2]
-SCRIPT = ROOT / "build_scripts" / "benchmarks" / "bench_ball.py"
 
 pytestmark = [
     pytest.mark.skipif(not sys.platform.startswith("linux"), reason="Linux-only (linux64 binaries, C host)"),
@@ -22,11 +19,9 @@ pytestmark = [
 
 def _quick(tmp_path, *args, reference=None):
     env = {k: v for k, v in os.environ.items() if k != "RESTITUTION_REFERENCE_FMUS"}
-    env["PYTHONPATH"] = str(ROOT / "fmu_src")
     if reference is not None:
         env["RESTITUTION_REFERENCE_FMUS"] = str(reference)
-    return subprocess.run([sys.executable, str(SCRIPT), "--quick", *args], capture_output=True, text=True,
-                          timeout=600, cwd=tmp_path, env=env)
+    return run_benchmark("bench_ball.py", "--quick", *args, cwd=tmp_path, timeout=600, env=env)
 
 
 @pytest.mark.slow

@@ -1,24 +1,16 @@
 """build_scripts/benchmarks/bench_impact.py --quick runs in a process of its own and prints both sides of the
 measurement and their ratio beside the goal; its numpy expression computes what impact() computes (the
 benchmark stops otherwise). No timing is asserted (machines are noisy): the ratio is the benchmark's to print."""
-import os
 import re
-import subprocess
-import sys
-from pathlib import Path
 
 import numpy as np
+from bench_script import run_benchmark
 
-ROOT = Path(__file__).resolve().parents[2]
-SCRIPT = ROOT / "build_scripts" / "benchmarks" / "bench_impact.py"
 NUMBER = r"[0-9.]+(?:e[+-]?\d+)?"
 
 
 def test_quick_run_prints_both_sides_and_the_ratio(tmp_path):
-    path = [str(ROOT / "fmu_src"), os.environ.get("PYTHONPATH")]
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join(p for p in path if p)}
-    proc = subprocess.run([sys.executable, str(SCRIPT), "--quick"], capture_output=True, text=True, cwd=tmp_path,
-                          env=env, timeout=300)
+    proc = run_benchmark("bench_impact.py", "--quick", cwd=tmp_path, timeout=300)
     assert proc.returncode == 0, proc.stderr[-3000:]
     out = proc.stdout
     assert re.search(r"^bench_impact\.py on \d{4}-\d\d-\d\d .*\d+ cores", out, re.M), out

@@ -3,17 +3,13 @@ binary can crash a process at exit): it builds the product FMU and its plain twi
 the ratio beside its goal. Timing is not asserted (machines are noisy and shared): the printed ratio is
 what the benchmark reports."""
 import math
-import os
 import re
 import shutil
-import subprocess
 import sys
-from pathlib import Path
 
 import pytest
+from bench_script import run_benchmark
 
-ROOT = Path(__file__).resolve().parents[2]
-BENCH = ROOT / "build_scripts" / "benchmarks" / "bench_pythonfmu.py"
 
 pytestmark = [
     pytest.mark.skipif(not sys.platform.startswith("linux"), reason="Linux-only (the guard is the linux64 binary)"),
@@ -23,9 +19,8 @@ pytestmark = [
 
 @pytest.mark.slow
 def test_quick_run_prints_every_row_with_measured_values(tmp_path):
-    done = subprocess.run([sys.executable, str(BENCH), "--quick", "--work", str(tmp_path / "work")],
-                          capture_output=True, text=True, timeout=900,
-                          env={**os.environ, "PYTHONPATH": str(ROOT / "fmu_src")})
+    done = run_benchmark("bench_pythonfmu.py", "--quick", "--work", str(tmp_path / "work"), cwd=tmp_path,
+                         timeout=900)
     assert done.returncode == 0, done.stdout + done.stderr
     out = done.stdout
     for text in ("quick run", "product (guard + pythonfmu + slave + physics)", "plain pythonfmu twin",

@@ -2,22 +2,14 @@
 both sides of each measurement and their ratio beside the goal, and the two sides of the Monte Carlo
 computed the same statistics of e. No timing is asserted (machines are noisy): the ratios are the
 benchmark's to print."""
-import os
 import re
-import subprocess
-import sys
-from pathlib import Path
+from bench_script import run_benchmark
 
-ROOT = Path(__file__).resolve().parents[2]
-SCRIPT = ROOT / "build_scripts" / "benchmarks" / "bench_uncertainty.py"
 NUMBER = r"[0-9.]+(?:e[+-]?\d+)?"
 
 
 def test_quick_run_prints_both_sides_and_the_ratio_of_each_measurement(tmp_path):
-    path = [str(ROOT / "fmu_src"), os.environ.get("PYTHONPATH")]
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join(p for p in path if p)}
-    proc = subprocess.run([sys.executable, str(SCRIPT), "--quick"], capture_output=True, text=True, cwd=tmp_path,
-                          env=env, timeout=120)
+    proc = run_benchmark("bench_uncertainty.py", "--quick", cwd=tmp_path, timeout=120)
     assert proc.returncode == 0, proc.stderr[-3000:]
     out = proc.stdout
     assert re.search(r"^bench_uncertainty\.py on \d{4}-\d\d-\d\d: .*\d+ cores", out, re.M), out
