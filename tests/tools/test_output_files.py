@@ -432,7 +432,8 @@ def damage(parts: Path, other_sweep: Path, marker: Path) -> dict:
     bogus = parts / "chunk-000000000000005-000000000000015.parquet"  # not one of the sweep's chunks
     shutil.copy(f[8], bogus)
     why[bogus] = "not one of this sweep's chunks"
-    pq.write_table(pq.read_table(f[9]), f[9])  # a Parquet file of the same columns: no record of its range and checksum
+    # a Parquet file of the same columns, no record of its range and checksum
+    pq.write_table(pq.read_table(f[9]).replace_schema_metadata(None), f[9])
     why[f[9]] = "no record"
     return why
 

@@ -15,7 +15,7 @@ import os
 import struct
 from pathlib import Path
 
-__all__ = ["read_footer", "join_parquet", "add_key_value", "key_value", "JoinError"]
+__all__ = ["read_footer", "join_parquet", "key_value", "JoinError"]
 
 MAGIC = b"PAR1"
 
@@ -201,30 +201,18 @@ def key_value(footer: list, key: bytes) -> bytes | None:
     return None
 
 
-def add_key_value(footer: bytes, key: bytes, value: bytes) -> bytes:
-    """The encoded FileMetaData ``footer`` with the key-value entry ``key``: ``value`` added."""
-    fields = _Reader(footer).struct()
-    kv = _field(fields, _KEY_VALUE)
-    if kv is None:
-        kv = [_KEY_VALUE, _LIST, (_STRUCT, [])]
-        fields.append(kv)
-        fields.sort(key=lambda f: f[0])
-    kv[2][1].append([[_KV_KEY, _BINARY, key], [2, _BINARY, value]])
-    out = bytearray()
-    _write_struct(out, fields)
-    return bytes(out)
-
-
 def _shift(fields: list, ids, by: int) -> None:
     for f in fields:
         if f[0] in ids and f[1] == _I64:
             f[2] += by
 
 
-def join_parquet(files, out, drop_keys=()) -> int:
+def join_parquet(files, out, drop_keys=(), set_keys=None) -> int:
     """Write the Parquet files ``files`` (one schema; row groups in the order given) as one file
     ``out``, copying their column chunks; the footer is the first file's with every row group and
-    the rows summed, less the key-value entries ``drop_keys``. The rows written."""
+    the rows summed, less the key-value entries ``drop_keys``, with the values of ``set_keys`` (key ->
+    value, bytes) in place of its own. The rows written."""
+    set_keys = dict(set_keys or {})
     head, groups, rows = None, [], 0
     with open(out, "wb", buffering=0) as dst:
         pos = _write_all(dst.fileno(), MAGIC, 0)
@@ -255,7 +243,8 @@ def join_parquet(files, out, drop_keys=()) -> int:
             elif fid == _ROW_GROUPS:
                 value = (_STRUCT, groups)
             elif fid == _KEY_VALUE:
-                value = (_STRUCT, [e for e in value[1] if _field(e, _KV_KEY)[2] not in drop_keys])
+                kept = [e for e in value[1] if _field(e, _KV_KEY)[2] not in (*drop_keys, *set_keys)]
+                value = (_STRUCT, kept + [[[_KV_KEY, _BINARY, k], [2, _BINARY, v]] for k, v in set_keys.items()])
             footer.append([fid, kind, value])
         encoded = bytearray()
         _write_struct(encoded, footer)

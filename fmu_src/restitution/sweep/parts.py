@@ -23,6 +23,7 @@ holds other columns, or whose column chunks do not match their checksum is remov
 computed again (one line on stderr each). The checksum is checked before any column is decoded."""
 from __future__ import annotations
 
+import base64
 import hashlib
 import json
 import os
@@ -48,6 +49,8 @@ __all__ = ["PartStore", "DiskSweepResult", "ResumeError", "PartError", "write_fr
 PART_NAME = re.compile(r"chunk-(\d{15})-(\d{15})\.parquet")
 #: The footer key of a part's record.
 RECORD_KEY = b"restitution.part"
+#: The footer key of the Arrow schema (pyarrow's: the base64 of the schema's IPC message).
+ARROW_SCHEMA = b"ARROW:schema"
 #: Columns a part's counts are made from (:func:`restitution.sweep.table.table_counts`).
 COUNT_COLUMNS = ("case", "ok", *VALIDITY)
 
@@ -229,9 +232,14 @@ class PartStore:
         the part). Not fsynced: --resume verifies every part's checksum and computes a bad one again,
         so a part that a power loss cut short is never used, and a run does not wait for the disk."""
         columns, info = part
-        body, footer = encode_part(chunk_table(self.spec, columns, self.keep))
-        record = {"range": [int(a), int(b)], "sweep": self.sweep, "crc32": f"{zlib.crc32(body):08x}"}
-        footer = _with_key_value(footer, RECORD_KEY, json.dumps({**info, "part": record}, default=str).encode())
+        record = {"range": [int(a), int(b)], "sweep": self.sweep, "crc32": _CRC_PENDING}
+        text = json.dumps({**info, "part": record}, default=str)
+        body, footer = encode_part(chunk_table(self.spec, columns, self.keep), {RECORD_KEY: text.encode()})
+        # the record's checksum, once the column chunks it covers are encoded: same length, in place
+        pending = json.dumps({"crc32": _CRC_PENDING})[1:-1].encode()
+        if footer.count(pending) != 1:
+            raise RuntimeError("the part's record is not in its footer once")
+        footer = footer.replace(pending, json.dumps({"crc32": f"{zlib.crc32(body):08x}"})[1:-1].encode())
 
         def write_to(tmp):
             with open(tmp, "wb") as f:
@@ -246,12 +254,19 @@ class PartStore:
         shutil.rmtree(self.path, ignore_errors=True)
 
 
-def encode_part(table) -> tuple[bytes, bytes]:
-    """(column chunks, footer) of ``table`` written as one Parquet row group (:func:`parquet_options`)."""
+#: A part's checksum until its column chunks are encoded (as long as the CRC-32 in hex).
+_CRC_PENDING = "-" * 8
+
+
+def encode_part(table, key_values: dict) -> tuple[bytes, bytes]:
+    """(column chunks, footer) of ``table`` written as one Parquet row group (:func:`parquet_options`),
+    with ``key_values`` in the footer's key-value metadata (they are in the footer's Arrow schema too:
+    :func:`write_from_parts` writes the table's without them)."""
     import pyarrow as pa
     import pyarrow.parquet as pq
 
     sink = pa.BufferOutputStream()
+    table = table.replace_schema_metadata(key_values)
     pq.write_table(table, sink, row_group_size=max(1, table.num_rows), **parquet_options(table.column_names))
     data = memoryview(sink.getvalue())
     length = struct.unpack("<I", data[-8:-4])[0]
@@ -262,13 +277,6 @@ def _body_crc(data) -> str:
     """CRC-32 (hex) of a Parquet file's column chunks: its bytes between the leading magic and the footer."""
     length = struct.unpack("<I", data[-8:-4])[0]
     return f"{zlib.crc32(memoryview(data)[4:len(data) - 8 - length]):08x}"
-
-
-def _with_key_value(footer: bytes, key: bytes, value: bytes) -> bytes:
-    """The Parquet footer ``footer`` with the key-value entry ``key``: ``value`` added."""
-    from .parquet_join import add_key_value
-
-    return add_key_value(footer, key, value)
 
 
 def part_files(result) -> list[Path]:
@@ -294,8 +302,10 @@ def write_from_parts(result, path: Path, suffix: str) -> None:
             return
         for file in files:  # each is whole, of this sweep: its record says so (parts are checked when resumed)
             _check_record(file, result.info.get("sweep"))
+        schema = chunk_table(result.spec, None, result.info.get("keep")).schema  # the table's, no part's record
         try:
-            join_parquet(files, path, drop_keys=(RECORD_KEY,))
+            join_parquet(files, path, drop_keys=(RECORD_KEY,),
+                         set_keys={ARROW_SCHEMA: base64.b64encode(schema.serialize().to_pybytes())})
         except JoinError as exc:
             raise PartError(path, f"cannot join the parts ({exc})") from None
         return
