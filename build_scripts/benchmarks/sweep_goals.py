@@ -1,8 +1,8 @@
 """The sweep's cost goals, measured in one process (part of bench_sweep.py's run).
 
 * sweep / model: a serial package sweep (cases built as arrays per chunk, evaluated, the whole table
-  gathered) against :func:`restitution.impact` alone on the same cases' arrays, CPU time of this
-  thread, best of ``repeats``;
+  gathered) against :func:`restitution.impact` alone on the arrays the sweep hands it, CPU time of
+  this thread, taken in turn, the least of ``repeats`` each;
 * write / gather: writing the table as Parquet against the gather of a Dask sweep (measured by the
   caller), and beside it the in-process join of the chunks (``restitution.sweep.table.assemble``), the
   table's raw bytes written to a file and CSV, CPU time, best of ``repeats``;
