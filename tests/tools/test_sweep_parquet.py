@@ -163,3 +163,12 @@ def test_stream_benchmark_runs_quick():
     for goal in ("sweep command / `impact` alone, whole processes, CPU", "the same, wall time",
                  "1 material pair(s)", "2 material pair(s)"):
         assert goal in done.stdout, (goal, done.stdout)
+
+
+def test_a_result_in_memory_whose_parts_were_replaced_writes_its_own_columns(tmp_path):
+    """The parts directory reused by another sweep (its parts checked against this sweep's fingerprint
+    before they are joined): the table comes from the columns in memory, never from the other sweep."""
+    parts = tmp_path / "p"
+    result = run_sweep(SPEC, scheduler="serial", chunk_size=25, parts=parts)
+    run_sweep(SweepSpec(grid={"v": "1,2"}), scheduler="serial", parts=parts)
+    _assert_same_table(read_table(result.write(tmp_path / "t.parquet")), run_sweep(SPEC, scheduler="serial").columns)

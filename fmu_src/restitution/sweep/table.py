@@ -199,11 +199,14 @@ class SweepResult:
     def _write_to(self, path: Path, suffix: str) -> None:
         if suffix.lower() == ".parquet":
             if self.parts is not None and self.chunk_counts and self.parts.is_dir():
-                from .parts import write_from_parts  # the parts' column chunks, joined: nothing encoded again
+                from .parts import PartError, write_from_parts
 
-                write_from_parts(self, path, suffix)
-            else:
-                self.to_parquet(path)
+                try:  # the parts' column chunks, joined: nothing encoded again
+                    write_from_parts(self, path, suffix)
+                    return
+                except PartError:  # the parts changed since (removed, another sweep's): the columns are here
+                    pass
+            self.to_parquet(path)
         else:
             self.to_csv(path)
 
