@@ -302,7 +302,8 @@ def chunk_table(spec: SweepSpec, columns: dict | None, keep):
 #: material constants and fixed inputs, which were a third of the cost of turning a chunk into a table
 #: (written out in fresh memory, 26 columns of 37, every chunk). Immutable, so shared freely.
 _CONSTANTS: dict = {}
-_CONSTANTS_KEPT = 128
+#: Bytes the kept arrays may take (a 10^5-row chunk's 26 one-value columns: 21 MB).
+_CONSTANTS_BYTES = 64 * 2**20
 
 
 def _constant_array(value: np.ndarray, rows: int):
@@ -311,9 +312,11 @@ def _constant_array(value: np.ndarray, rows: int):
     key = (value.dtype.str, value.tobytes(), rows)
     array = _CONSTANTS.get(key)
     if array is None:
-        if len(_CONSTANTS) >= _CONSTANTS_KEPT:
+        array = pa.array(np.repeat(value, rows))
+        if sum(a.nbytes for a in _CONSTANTS.values()) + array.nbytes > _CONSTANTS_BYTES:
             _CONSTANTS.clear()
-        array = _CONSTANTS[key] = pa.array(np.repeat(value, rows))
+        if array.nbytes <= _CONSTANTS_BYTES:
+            _CONSTANTS[key] = array
     return array
 
 
