@@ -1,8 +1,8 @@
 """The sweep's cost goals, measured in one process (part of bench_sweep.py's run).
 
 * sweep / model: a serial package sweep (cases built as arrays per chunk, evaluated, the whole table
-  gathered) against :func:`restitution.impact` alone on the same cases' arrays, CPU time of this
-  thread, best of ``repeats``;
+  gathered) against :func:`restitution.impact` alone on the arrays the sweep hands it, CPU time of
+  this thread, taken in turn, the least of ``repeats`` each;
 * write / gather: writing the table as Parquet against the gather of a Dask sweep (measured by the
   caller), and beside it the in-process join of the chunks (``restitution.sweep.table.assemble``), the
   table's raw bytes written to a file and CSV, CPU time, best of ``repeats``;
@@ -31,20 +31,24 @@ def _best_cpu(fn, repeats: int) -> float:
 
 
 def sweep_over_model(spec, repeats: int = 3) -> dict:
-    """CPU seconds of a serial package sweep of ``spec`` and of impact() on its cases' arrays."""
-    import restitution as r
-    from restitution.model import PARAMETERS
-    from restitution.quantities import si_only
+    """CPU seconds of this thread of a serial package sweep of ``spec`` (the whole table gathered in
+    memory) and of impact() alone on the arrays the sweep hands it (the spec's case columns: the
+    constants as one-value views, as :meth:`SweepSpec.cases` gives them), taken in turn ``repeats``
+    times; the least of each."""
+    from restitution.model import impact
     from restitution.sweep import run_sweep
+    from restitution.sweep.backends import impact_groups
 
     result = run_sweep(spec, "package", scheduler="serial")
-    cols = result.columns
-    v = np.asarray(cols["v_approach"], dtype=float)
-    params = {key: np.asarray(cols[key.replace("_", ".", 1)], dtype=float) for key, _unit, _check in PARAMETERS}
-    impact = si_only(r.impact)  # what the sweep calls: SI arrays, checked by the sweep
-    sweep_s = _best_cpu(lambda: run_sweep(spec, "package", scheduler="serial"), repeats)
-    model_s = _best_cpu(lambda: impact(v, **params, validate=False), repeats)
-    return {"cases": len(v), "sweep_s": sweep_s, "model_s": model_s, "ratio": sweep_s / model_s, "result": result}
+    cases = spec.cases()
+    groups = list(impact_groups(cases, np.arange(spec.n_cases)))
+    sweep_s = model_s = float("inf")
+    for _ in range(repeats):  # interleaved: a drift of the machine's speed meets both sides
+        sweep_s = min(sweep_s, _best_cpu(lambda: run_sweep(spec, "package", scheduler="serial"), 1))
+        model_s = min(model_s, _best_cpu(lambda: [impact(**inputs, **options, validate=False)
+                                                  for _sel, inputs, options in groups], 1))
+    return {"cases": spec.n_cases, "sweep_s": sweep_s, "model_s": model_s, "ratio": sweep_s / model_s,
+            "result": result}
 
 
 def _chunks(result, n_chunks: int) -> list[dict]:
@@ -203,7 +207,7 @@ def goal_lines(model: dict, write: dict, cpu_eff: dict, task_cpu_us: float, stre
         lines.append(
             f"- Streamed run on a LocalCluster of 2 workers: {big['cases']:,} cases (the whole 37-column "
             f"table) in {big['wall_s']:.0f} s, **{big['rate']:,.0f} cases/s**, each of its {big['chunks']:,} "
-            f"chunks written to disk (`.npz`) when it finished and nothing gathered ({big['disk_gb']:.0f} GB on disk); "
+            f"chunks written to disk (a Parquet part) when it finished and nothing gathered ({big['disk_gb']:.0f} GB on disk); "
             f"peak memory of this process and the workers together **{big['peak_gb']:.1f} GB**, against "
             f"{small['peak_gb']:.1f} GB for {small['cases']:,} cases in the same run. Interrupted, such a run "
             f"resumes from the chunks on disk (`--resume`).")

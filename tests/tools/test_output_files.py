@@ -4,21 +4,19 @@ is refused before any work, one line on stderr, exit 2, and left as it was; an I
 EIO, EACCES) is one line naming the path and the reason, exit 74, no traceback, nothing half written
 under the final name (the old file intact) and the sweep's finished parts kept; --resume over
 damaged parts (truncated, garbage, swapped, another range, another sweep, a checksum mismatch, a
-pickle) computes them again and gives the uninterrupted table, rows in case order.
+part of the earlier .npz format with a pickle inside) computes them again and gives the uninterrupted table, rows in case order.
 
 I/O errors are simulated in this process by failing a system call of restitution.output_files (the
 open of the temporary file, a write, an fsync) for one file, and, as root, met for real on a small
 tmpfs that fills up."""
 import contextlib
 import errno
-import io
 import os
 import shutil
 import socket
 import stat
 import subprocess
 import sys
-import zipfile
 from pathlib import Path
 
 import numpy as np
@@ -28,6 +26,7 @@ from restitution import output_files
 from restitution.scene.__main__ import main as scene_cli
 from restitution.sweep import SweepSpec, read_table, run_sweep
 from restitution.sweep.__main__ import main as sweep_cli
+from restitution.sweep.parts import RECORD_KEY as RECORD
 
 PYTHON = sys.executable
 ENV = {**os.environ, "PYTHONUNBUFFERED": "1"}
@@ -245,7 +244,7 @@ def test_sweep_table_io_error_keeps_the_old_table_and_every_part(code, tmp_path,
     assert sweep_cli([*SWEEP, "--no-plot", "--out", str(out)]) == output_files.EXIT_IO_ERROR
     one_line(capsys.readouterr().err, f"cannot write {out}: {reason}", "every chunk is kept", "--resume")
     assert out.read_text() == "the old table\n"
-    assert len(list((tmp_path / "s.csv.parts" / "package").glob("chunk-*.npz"))) == N_CHUNKS
+    assert len(list((tmp_path / "s.csv.parts" / "package").glob("chunk-*.parquet"))) == N_CHUNKS
     no_temporaries(tmp_path)
     monkeypatch.undo()
     assert sweep_cli([*SWEEP, "--no-plot", "--out", str(out), "--resume"]) == 0
@@ -258,14 +257,14 @@ def test_sweep_part_io_error_keeps_the_finished_parts_for_resume(code, tmp_path,
     out = tmp_path / "s.csv"
     call, reason = CODES[code]
     call = "replace" if call == "fsync" else call  # parts are not fsynced (--resume checks them): fail the rename
-    part = "chunk-000000000000050-000000000000060.npz"
+    part = "chunk-000000000000050-000000000000060.parquet"
     monkeypatch.setattr(output_files, "os", FailingOs(call, code, temporary_of(part)))
     assert sweep_cli([*SWEEP, "--no-plot", "--out", str(out)]) == output_files.EXIT_IO_ERROR
     one_line(capsys.readouterr().err, f"{part}: {reason}", "the 5 finished chunk(s) are kept", "--resume")
     assert not out.exists()
     parts = tmp_path / "s.csv.parts" / "package"
     assert sorted(p.name for p in parts.iterdir()) == [
-        f"chunk-{a:015d}-{a + 10:015d}.npz" for a in range(0, 50, 10)] + ["manifest.json"]
+        f"chunk-{a:015d}-{a + 10:015d}.parquet" for a in range(0, 50, 10)] + ["manifest.json"]
     monkeypatch.undo()
     assert sweep_cli([*SWEEP, "--no-plot", "--out", str(out), "--resume"]) == 0
     assert capsys.readouterr().err.count("--resume") == 0  # the kept parts were whole: nothing to say
@@ -354,7 +353,7 @@ def test_sweep_on_a_full_file_system(tmp_path, reference):
         assert proc.returncode == 74, proc.stderr
         one_line(proc.stderr, "cannot write s.csv.parts/package/chunk-", "No space left on device (ENOSPC)",
                  "finished chunk(s) are kept in s.csv.parts", "--resume")
-        kept = sorted((disk / "s.csv.parts" / "package").glob("chunk-*.npz"))
+        kept = sorted((disk / "s.csv.parts" / "package").glob("chunk-*.parquet"))
         assert 0 < len(kept) < N_CHUNKS
         assert (disk / "s.csv").read_text() == "the old table\n"
         no_temporaries(disk)
@@ -372,7 +371,7 @@ def test_sweep_on_a_full_file_system(tmp_path, reference):
         assert proc.returncode == 74, proc.stderr
         one_line(proc.stderr, "cannot write s.csv: No space left on device", "every chunk is kept in s.csv.parts")
         assert (disk / "s.csv").read_text() == "the old table\n"
-        assert len(list(parts.glob("chunk-*.npz"))) == N_CHUNKS
+        assert len(list(parts.glob("chunk-*.parquet"))) == N_CHUNKS
         no_temporaries(disk)
 
 
@@ -404,7 +403,7 @@ class Pickled:
 
 def damage(parts: Path, other_sweep: Path, marker: Path) -> dict:
     """Damage most parts in a different way each; the reason each is expected to be named by."""
-    files = sorted(parts.glob("chunk-*.npz"))
+    files = sorted(parts.glob("chunk-*.parquet"))
     f = {k: files[k] for k in range(len(files))}
     why = {}
     swap(f[0], f[1])
@@ -413,27 +412,28 @@ def damage(parts: Path, other_sweep: Path, marker: Path) -> dict:
     why[f[2]] = "not a whole part"
     f[3].write_bytes(os.urandom(4000))  # garbage
     why[f[3]] = "not a whole part"
-    with np.load(f[4], allow_pickle=False) as z:  # a valid .npz whose numbers changed: the checksum
-        arrays = {k: z[k] for k in z.files}
-    arrays["c:e"] = arrays["c:e"] + 1e-9
-    np.savez(f[4], **arrays)
+    import pyarrow.compute as pc
+    import pyarrow.parquet as pq
+
+    record = {RECORD: pq.read_metadata(f[4]).metadata[RECORD]}
+    table = pq.read_table(f[4])  # a valid Parquet part, its record kept, whose numbers changed: the checksum
+    table = table.set_column(table.column_names.index("e"), "e", pc.add(table.column("e"), 1e-9))
+    pq.write_table(table.replace_schema_metadata(record), f[4])
     why[f[4]] = "checksum"
     shutil.copy(next(other_sweep.glob(f"{f[5].name}")), f[5])  # the same range of another sweep
     why[f[5]] = "another sweep"
-    arrays["c:e"] = np.array([Pickled(marker)] * 10, dtype=object)  # an object array: a pickle inside
-    np.savez(f[6], **{k: v for k, v in arrays.items()})
-    why[f[6]] = "Python objects"
+    # a part of the earlier format (.npz) under this one's name, an object array (a pickle) inside
+    with open(f[6], "wb") as out:
+        np.savez(out, **{"c:e": np.array([Pickled(marker)] * 10, dtype=object)})
+    why[f[6]] = "not a whole part"
     f[7].unlink()
     os.mkfifo(f[7])  # a FIFO in a part's place: never opened
     why[f[7]] = "FIFO"
-    bogus = parts / "chunk-000000000000005-000000000000015.npz"  # not one of the sweep's chunks
+    bogus = parts / "chunk-000000000000005-000000000000015.parquet"  # not one of the sweep's chunks
     shutil.copy(f[8], bogus)
     why[bogus] = "not one of this sweep's chunks"
-    buf = io.BytesIO()  # a part of the earlier format: no record of its range and checksum
-    with zipfile.ZipFile(f[9]) as zin, zipfile.ZipFile(buf, "w") as zout:
-        for name in zin.namelist():
-            zout.writestr(name, zin.read(name) if name != "info.npy" else _npy(np.array('{"pid": 1}')))
-    f[9].write_bytes(buf.getvalue())
+    # a Parquet file of the same columns, no record of its range and checksum
+    pq.write_table(pq.read_table(f[9]).replace_schema_metadata(None), f[9])
     why[f[9]] = "no record"
     return why
 
@@ -443,12 +443,6 @@ def swap(a: Path, b: Path) -> None:
     os.replace(a, a.with_name("swap"))
     os.replace(b, a)
     os.replace(a.with_name("swap"), b)
-
-
-def _npy(array) -> bytes:
-    out = io.BytesIO()
-    np.save(out, array)
-    return out.getvalue()
 
 
 def test_resume_recomputes_damaged_parts_and_keeps_case_order(tmp_path, reference, capsys):
@@ -468,8 +462,8 @@ def test_resume_recomputes_damaged_parts_and_keeps_case_order(tmp_path, referenc
     for file, reason in why.items():
         line, = [x for x in lines if f"{file}:" in x]
         assert line.startswith("--resume: ") and reason in line, (reason, line)
-        assert ("computed again" in line) if file.name != "chunk-000000000000005-000000000000015.npz" else "removed" in line
-    assert sorted(p.name for p in parts.glob("chunk-*.npz")) == [f"chunk-{a:015d}-{a + 10:015d}.npz"
+        assert ("computed again" in line) if file.name != "chunk-000000000000005-000000000000015.parquet" else "removed" in line
+    assert sorted(p.name for p in parts.glob("chunk-*.parquet")) == [f"chunk-{a:015d}-{a + 10:015d}.parquet"
                                                                 for a in range(0, N_CASES, 10)]
 
 
@@ -477,7 +471,7 @@ def test_cli_resume_over_swapped_parts_writes_rows_in_case_order(tmp_path, refer
     out = tmp_path / "s.csv"
     parts = tmp_path / "s.csv.parts" / "package"
     run_sweep(SweepSpec(**SPEC), scheduler="serial", chunk_size=10, parts=parts)
-    swap(parts / "chunk-000000000000030-000000000000040.npz", parts / "chunk-000000000000070-000000000000080.npz")
+    swap(parts / "chunk-000000000000030-000000000000040.parquet", parts / "chunk-000000000000070-000000000000080.parquet")
     assert sweep_cli([*SWEEP, "--no-plot", "--out", str(out), "--resume"]) == 0
     lines = capsys.readouterr().err.strip().splitlines()
     assert len([x for x in lines if "parts swapped or renamed" in x]) == 2, lines
@@ -488,7 +482,7 @@ def test_resume_over_a_part_that_cannot_be_removed_is_one_line_error(tmp_path, c
     out = tmp_path / "s.csv"
     parts = tmp_path / "s.csv.parts" / "package"
     run_sweep(SweepSpec(**SPEC), scheduler="serial", chunk_size=10, parts=parts)
-    part = parts / "chunk-000000000000020-000000000000030.npz"
+    part = parts / "chunk-000000000000020-000000000000030.parquet"
     part.unlink()
     part.mkdir()  # a directory in a part's place
     (part / "keep").write_text("not ours")

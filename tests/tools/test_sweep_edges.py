@@ -123,7 +123,7 @@ def _ctrl_c(tmp_path, sweep, when):
             time.sleep(0.01)
     else:
         deadline = time.monotonic() + 60
-        while time.monotonic() < deadline and len(list(parts.glob("chunk-*.npz"))) < when:
+        while time.monotonic() < deadline and len(list(parts.glob("chunk-*.parquet"))) < when:
             time.sleep(0.02)
     assert proc.poll() is None, "the sweep ended before it could be interrupted"
     import psutil
@@ -139,7 +139,7 @@ def _ctrl_c(tmp_path, sweep, when):
     lines = [l for l in err.splitlines() if any(line in l for line in LINES.values())]
     assert len(lines) == 1 and (when == "first" or LINES["start" if when == "start" else "chunks"] in lines[0]), err
     if when not in ("start", "first"):  # the finished chunks are kept, and written
-        kept = len(list(parts.glob("chunk-*.npz")))
+        kept = len(list(parts.glob("chunk-*.parquet")))
         assert kept >= when
         assert read_table(out)["case"].size >= when * int(sweep[sweep.index("--chunk-size") + 1])
     return err

@@ -139,7 +139,7 @@ def test_resumed_sweep_gives_the_statistics_of_a_whole_run(tmp_path, monkeypatch
     monkeypatch.setattr(sweep_run, "_run_chunk", interrupted_at_the_fourth_chunk)
     status, summary, out = sweep(tmp_path, "--scheduler", "serial", "--chunk-size", "500", check=False)
     assert status == EXIT_INTERRUPTED and summary is None  # no summary of a part of the sweep
-    assert len(list(out.with_name("s.csv.parts").glob("*/chunk-*.npz"))) == 3
+    assert len(list(out.with_name("s.csv.parts").glob("*/chunk-*.parquet"))) == 3
     monkeypatch.setattr(sweep_run, "_run_chunk", real)
     out.unlink()  # the partial table: the statistics must not come from a table file
     _status, resumed, _out = sweep(tmp_path, "--scheduler", "serial", "--chunk-size", "500", "--resume")
@@ -154,7 +154,7 @@ def test_resume_statistics_come_from_the_parts_loaded_for_the_check(tmp_path):
     spec = SweepSpec(pairs=["s2_tool_steel/al_6061"], random={"plate.Sy": "uniform_rel:0.15"}, samples=300, seed=3)
     parts = tmp_path / "parts"
     run_sweep(spec, scheduler="serial", chunk_size=100, parts=parts)
-    (parts / "chunk-000000000000100-000000000000200.npz").unlink()
+    (parts / "chunk-000000000000100-000000000000200.parquet").unlink()
     statistics = SweepStatistics(spec)
     res = run_sweep(spec, scheduler="serial", chunk_size=100, parts=parts, resume=True, in_memory=False,
                     on_chunk=statistics)

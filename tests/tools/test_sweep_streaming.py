@@ -213,7 +213,7 @@ def test_serial_interrupt_keeps_finished_chunks_and_resume_completes(tmp_path):
         run_sweep(spec, backend, scheduler="serial", chunk_size=100, parts=tmp_path / "p")
     partial = info.value.result
     assert len(partial) == 300 and info.value.missing == spec.n_cases - 300
-    assert len(list((tmp_path / "p").glob("chunk-*.npz"))) == 3
+    assert len(list((tmp_path / "p").glob("chunk-*.parquet"))) == 3
     assert np.array_equal(partial["case"], np.arange(300))
     counting = InterruptingBackend(0)  # never interrupts; counts the chunks it evaluates
     resumed = run_sweep(spec, counting, scheduler="serial", chunk_size=7, parts=tmp_path / "p", resume=True)
@@ -293,7 +293,7 @@ def _interrupt_after_chunks(args, parts: Path, n_chunks: int, cwd):
                             stderr=subprocess.PIPE, text=True, cwd=cwd, env=ENV, start_new_session=True)
     deadline = time.monotonic() + 120
     while time.monotonic() < deadline and proc.poll() is None:
-        if len(list(parts.glob("chunk-*.npz"))) >= n_chunks:
+        if len(list(parts.glob("chunk-*.parquet"))) >= n_chunks:
             break
         time.sleep(0.05)
     assert proc.poll() is None, "the sweep ended before it could be interrupted"

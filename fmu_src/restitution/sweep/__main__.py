@@ -5,6 +5,7 @@ import argparse
 import contextlib
 import os
 import sys
+import time
 from pathlib import Path
 
 from ..extras import MissingExtra, require
@@ -69,7 +70,7 @@ def _hooks(*hooks):
 
 
 def _kept(parts: Path) -> str:
-    n = sum(1 for _ in parts.glob("*/chunk-*.npz")) if parts.is_dir() else 0
+    n = sum(1 for _ in parts.glob("*/chunk-*.parquet")) if parts.is_dir() else 0
     return f"the {n:,} finished chunk(s) are kept in {parts}" if n else f"no finished chunk is kept in {parts}"
 
 
@@ -380,9 +381,12 @@ def _main(parser, args) -> int:
                     target = stack.enter_context(open_client(scheduler, workers))
                 except OSError as exc:  # an address nothing answers at (Dask waits its connect timeout)
                     parser.error(f"--scheduler {scheduler}: cannot connect: {exc}")
+            # the columns stay in memory only for what reads them here: the COR map, the comparison of
+            # two back ends; the table itself is joined from the parts, and the statistics come chunk by chunk
+            in_memory = not plan.stream and (plot is not None or backend == "both")
             for name in backends:
                 res = run_sweep(spec, name, fmu=fmu, scheduler=target, chunk_size=chunk, progress=progress,
-                                columns=columns, parts=parts / name, resume=args.resume, in_memory=not plan.stream,
+                                columns=columns, parts=parts / name, resume=args.resume, in_memory=in_memory,
                                 on_chunk=_hooks(statistics, sobol) if name == backends[0] else None)
                 if chosen:
                     res.scheduler = f"this process ({chosen})"
@@ -423,7 +427,11 @@ def _main(parser, args) -> int:
                   "(restitution.agreement)")
     result = results[backends[0]]
     try:
+        started = time.perf_counter()
         print(f"table: {result.write(out)}")
+        if out.suffix.lower() != ".parquet":  # what CSV costs, beside the sweep: it is text, case by case
+            print(f"CSV: {time.perf_counter() - started:.3g} s to write {len(result):,} rows (Parquet, "
+                  f"--out {out.with_suffix('.parquet').name}, joins the finished chunks without formatting them)")
     except KeyboardInterrupt:
         print(f"\ninterrupted while writing {out}: nothing written there; every chunk is kept in {parts}: "
               f"run the same command with --resume to write the table", file=sys.stderr)

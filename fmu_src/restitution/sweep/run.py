@@ -12,10 +12,12 @@ from the spec (nothing large travels to the workers) and evaluates them with the
 finished chunk comes back as one buffer (:class:`~restitution.sweep.table.PackedColumns`) and the
 table is joined from the chunks once they are all in.
 
-With ``parts=DIR`` every finished chunk is written to DIR as it completes (one ``.npz`` file a
-chunk, written under a temporary name, fsynced and renamed, holding its case range and the sha256 of
-its columns, :mod:`restitution.sweep.parts`), beside a ``manifest.json`` naming the spec, back end,
-chunk size and columns. An I/O error writing one raises
+With ``parts=DIR`` every finished chunk is written to DIR as it completes (one Parquet file a
+chunk, its one row group encoded once, written under a temporary name and renamed, its footer
+recording its case range and the CRC-32 of its column chunks, :mod:`restitution.sweep.parts`), beside
+a ``manifest.json`` naming the spec, back end, chunk size and columns; the result's
+:meth:`~SweepResult.write` then joins the parts' column chunks into the Parquet table without encoding
+anything again. An I/O error writing one raises
 :class:`~restitution.output_files.OutputWriteError` and keeps the chunks already written. An interrupt (Ctrl-C) then
 raises :class:`SweepInterrupted` carrying the table of the finished chunks, and
 ``resume=True`` on the same DIR checks every part and evaluates only the chunks that are missing
@@ -294,15 +296,16 @@ class _Run:
                               "cases": sum(int(self.done[a][1]["counts"]["cases"]) for a in self.reused)}
         kwargs = dict(spec=self.spec, backend=self.backend.describe(), scheduler=self.where, n_workers=self.workers,
                       elapsed=elapsed, n_chunks=self.n_chunks, info=info)
+        if self.store is not None:  # the table is written from the parts
+            info["keep"], info["sweep"] = self.keep, self.store.sweep
+            kwargs.update(parts=Path(self.store.path), chunk_counts={a: self.done[a][1]["counts"] for a in starts})
         if self.in_memory:
             parts = []
             for a in starts:
                 parts.append(self.done[a][0])
                 self.done[a] = (None, self.done[a][1])
             return SweepResult(columns=assemble(self.spec, parts, self.keep), **kwargs)
-        info["keep"] = self.keep
-        return DiskSweepResult(columns={}, parts=Path(self.store.path),
-                               chunk_counts={a: self.done[a][1]["counts"] for a in starts}, **kwargs)
+        return DiskSweepResult(columns={}, **kwargs)
 
     def interrupted(self) -> "SweepInterrupted":
         result = self.result()

@@ -12,7 +12,7 @@ from ..output_files import atomic_write as write_atomic
 from .spec import INPUT_NAMES, INTEGER_INPUTS, OUTPUT_NAMES, OUTPUTS as _OUTPUT_TYPES, T_OVER_D, SweepSpec
 
 __all__ = ["COLUMNS", "VALIDITY", "SweepResult", "PackedColumns", "read_table", "table_counts", "assemble",
-           "keep_columns", "write_atomic", "write_csv_rows"]
+           "keep_columns", "write_atomic", "write_csv_rows", "chunk_table", "pair_codes"]
 
 #: Column order of a result table.
 COLUMNS = ("case", "pair", *INPUT_NAMES, T_OVER_D, *OUTPUT_NAMES, "ok")
@@ -139,6 +139,8 @@ class SweepResult:
     #: evaluating them), ``fmu_code_files`` (FMU back end: the bundled model.py that ran).
     n_chunks: int
     info: dict = field(default_factory=dict)
+    parts: Path | None = None  #: the directory of the finished chunks (``run_sweep(..., parts=DIR)``)
+    chunk_counts: dict = field(default_factory=dict)  #: with ``parts``: chunk start -> its counts
 
     def __len__(self):
         return int(np.size(self.columns["case"]))
@@ -196,6 +198,14 @@ class SweepResult:
 
     def _write_to(self, path: Path, suffix: str) -> None:
         if suffix.lower() == ".parquet":
+            if self.parts is not None and self.chunk_counts and self.parts.is_dir():
+                from .parts import PartError, write_from_parts
+
+                try:  # the parts' column chunks, joined: nothing encoded again
+                    write_from_parts(self, path, suffix)
+                    return
+                except PartError:  # the parts changed since (removed, another sweep's): the columns are here
+                    pass
             self.to_parquet(path)
         else:
             self.to_csv(path)
@@ -218,9 +228,13 @@ class SweepResult:
         return path
 
     def to_pandas(self):
+        """The table as a pandas DataFrame, ``pair`` categorical."""
         import pandas as pd
 
-        return pd.DataFrame(self.columns)
+        frame = pd.DataFrame(self.columns)
+        if "pair" in frame:
+            frame["pair"] = frame["pair"].astype("category")
+        return frame
 
     def plot(self, path, **kwargs) -> Path:
         """The COR map (see :func:`restitution.sweep.plot.plot_cor_map`)."""
@@ -235,23 +249,101 @@ def _csv_text(x) -> str:
 
 
 def arrow_table(columns: dict):
-    """The table's columns as a pyarrow Table (text columns as strings), every column declared without
-    missing values, as a sweep's columns are (an out-of-range case has NaN outputs, a value): Parquet
-    then stores no definition levels, which took a fifth of the write."""
+    """The table's columns as a pyarrow Table (``pair`` dictionary-encoded), every column declared
+    without missing values, as a sweep's columns are (an out-of-range case has NaN outputs, a value):
+    Parquet then stores no definition levels, which took a fifth of the write."""
     import pyarrow as pa
 
-    arrays = [pa.array(col, type=pa.string()) if col.dtype == object else pa.array(col) for col in columns.values()]
-    schema = pa.schema([pa.field(name, a.type, nullable=False) for name, a in zip(columns, arrays)])
-    return pa.Table.from_arrays(arrays, schema=schema)
+    arrays = [pa.array(col, type=pa.string()).dictionary_encode() if col.dtype == object else pa.array(col)
+              for col in columns.values()]
+    return pa.Table.from_arrays(arrays, schema=_schema(columns, arrays))
 
 
-def parquet_options(columns: dict) -> dict:
-    """How a sweep table is written as Parquet: dictionary encoding for the text columns only (the
-    material pair: a few distinct values). pyarrow's default tries it on every column, which took
-    45 % of a write of the numbers (measured on 10^6 rows: 0.28 s against 0.15 s, for a file 9 %
-    larger); snappy, the most widely read codec, still compresses the per-pair constants."""
-    return {"use_dictionary": [name for name, col in columns.items() if col.dtype == object],
-            "compression": "snappy"}
+def _schema(names, arrays):
+    import pyarrow as pa
+
+    return pa.schema([pa.field(name, a.type, nullable=False) for name, a in zip(names, arrays)])
+
+
+def _pair_labels(spec: SweepSpec):
+    import pyarrow as pa
+
+    return pa.array([*spec.pairs, ""], type=pa.string())  # the last: no pairs (index -1)
+
+
+def chunk_table(spec: SweepSpec, columns: dict | None, keep):
+    """One chunk's columns (as :meth:`SweepSpec.cases` and the back ends give them; None: no rows) as a
+    pyarrow Table of the table's columns at their types, ``pair`` dictionary-encoded with the spec's
+    pair labels as the dictionary (the same in every chunk). Columns that hold one value (views of it,
+    ``numpy.broadcast_to``) are filled from it."""
+    import pyarrow as pa
+
+    names = [c for c in COLUMNS if keep is None or c in keep]
+    n = 0 if columns is None else int(np.size(columns["case"]))
+    arrays = []
+    for name in names:
+        if name == "pair":
+            codes = np.zeros(0, np.int32) if columns is None else np.asarray(columns["pair"], dtype=np.int32)
+            codes = np.where(codes < 0, len(spec.pairs), codes) if n and codes.min() < 0 else codes
+            arrays.append(pa.DictionaryArray.from_arrays(pa.array(codes, type=pa.int32()), _pair_labels(spec)))
+            continue
+        col = np.empty(0, _column_type(name)) if columns is None else np.asarray(columns[name])
+        want = np.dtype(_column_type(name))
+        if col.ndim == 1 and col.size > 1 and col.strides[0] == 0:  # a one-value view: the same array each chunk
+            arrays.append(_constant_array(col[:1].astype(want), col.size))
+            continue
+        if col.dtype != want or not col.flags.c_contiguous:  # an integer input held as float
+            col = np.ascontiguousarray(col, dtype=want)
+        arrays.append(pa.array(col))
+    return pa.Table.from_arrays(arrays, schema=_schema(names, arrays))
+
+
+#: Arrow arrays of one value repeated, by (type, value's bytes, rows): a grid sweep's chunks share their
+#: material constants and fixed inputs, which were a third of the cost of turning a chunk into a table
+#: (written out in fresh memory, 26 columns of 37, every chunk). Immutable, so shared freely.
+_CONSTANTS: dict = {}
+#: Bytes the kept arrays may take (a 10^5-row chunk's 26 one-value columns: 21 MB).
+_CONSTANTS_BYTES = 64 * 2**20
+
+
+def _constant_array(value: np.ndarray, rows: int):
+    import pyarrow as pa
+
+    key = (value.dtype.str, value.tobytes(), rows)
+    array = _CONSTANTS.get(key)
+    if array is None:
+        array = pa.array(np.repeat(value, rows))
+        if sum(a.nbytes for a in _CONSTANTS.values()) + array.nbytes > _CONSTANTS_BYTES:
+            _CONSTANTS.clear()
+        if array.nbytes <= _CONSTANTS_BYTES:
+            _CONSTANTS[key] = array
+    return array
+
+
+def pair_codes(spec: SweepSpec, column) -> np.ndarray:
+    """The spec's pair index (-1: no pairs) of each row of a ``pair`` column read from a Parquet file
+    (dictionary-encoded: its labels matched to the spec's, whatever dictionary the file kept)."""
+    import pyarrow as pa
+
+    column = column.combine_chunks() if isinstance(column, pa.ChunkedArray) else column
+    if not pa.types.is_dictionary(column.type):
+        column = column.dictionary_encode()
+    lookup = {label: i for i, label in enumerate(spec.pairs)}
+    codes = np.array([lookup.get(label, -1) for label in column.dictionary.to_pylist()], dtype=np.int64)
+    indices = column.indices.to_numpy(zero_copy_only=False)
+    return codes[indices] if codes.size else np.full(indices.size, -1, dtype=np.int64)
+
+
+def parquet_options(names) -> dict:
+    """How a sweep table is written as Parquet: dictionary encoding for ``pair`` only (a few distinct
+    values); pyarrow's default tries it on every column, which took 45 % of a write of the numbers
+    (measured on 10^6 rows: 0.28 s against 0.15 s, for a file 9 % larger). Snappy, the most widely
+    read codec, still compresses the per-pair constants. Values are handed to the encoder 65,536 at
+    a time, not 1,024 (a fifth less CPU, measured on 10^5-row chunks of 37 columns). Statistics (min
+    and max) for ``case`` only, so a reader finds a case's row group: on every column they took a
+    quarter of the encoding (4 of 16 ms a 10^5-row chunk)."""
+    return {"use_dictionary": [name for name in names if name == "pair"], "compression": "snappy",
+            "write_batch_size": 65_536, "write_statistics": [name for name in names if name == "case"]}
 
 
 def write_csv_rows(f, columns: dict) -> None:
@@ -281,9 +373,17 @@ def read_table(path) -> dict:
     if path.suffix.lower() == ".parquet":
         import pyarrow.parquet as pq
 
+        import pyarrow as pa
+
         table = pq.read_table(path)
-        return {name: np.asarray(table.column(name).to_pylist() if table.column(name).type == "string"
-                                 else table.column(name).to_numpy()) for name in table.column_names}
+        out = {}
+        for name in table.column_names:
+            col = table.column(name)
+            if pa.types.is_dictionary(col.type):
+                col = col.cast(col.type.value_type)
+            out[name] = (np.array(col.to_pylist(), dtype=object) if pa.types.is_string(col.type)
+                         else col.to_numpy())
+        return out
     import csv
 
     with open(path, encoding="utf-8", newline="") as f:
