@@ -221,3 +221,23 @@ def test_quantities_and_ranges_in_python():
     assert not run_sweep(spec, scheduler="serial")["ok"][0]
     with pytest.raises(QuantityError, match="v_approach = -1 m/s"):
         spec.check_domain()
+
+
+def test_inputs_ok_checks_a_one_value_column_once_and_each_case_of_the_others():
+    """inputs_ok against each variable's declared interval (the interface table, not the code under test):
+    a one-value column (a stride-0 view, as SweepSpec.cases gives constants) out of its range marks every
+    case, an array marks only its own bad cases, an Integer code must be whole."""
+    from restitution.sweep.backends import inputs_ok
+    from restitution.sweep.spec import SETTABLE, START
+
+    n = 5
+    cases = {name: np.broadcast_to(np.float64(value), (n,)) for name, value in START.items()}
+    cases["v_approach"] = np.array([0.5, 1.0, -1.0, 2.0, 3.0])  # one case below the range
+    assert inputs_ok(cases).tolist() == [True, True, False, True, True]
+    var = next(v for v in SETTABLE if v.name == "plate.t")
+    low = var.interval[0]
+    bad_t = dict(cases, **{"plate.t": np.broadcast_to(np.float64(low - 1.0), (n,))})
+    assert not inputs_ok(bad_t).any()
+    code = next(v for v in SETTABLE if v.type == "Integer")
+    half = dict(cases, **{code.name: np.array([1.0, 1.5, 1.0, 1.0, 1.0])})
+    assert inputs_ok(half).tolist() == [True, False, False, True, True]

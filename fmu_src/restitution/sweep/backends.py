@@ -89,16 +89,24 @@ def inputs_ok(cases: dict) -> np.ndarray:
     """Cases whose inputs the FMU accepts (each in its declared range, codes whole numbers): the
     others read NaN."""
     ok = np.ones(np.size(cases["v_approach"]), dtype=bool)
+    every_constant_ok = True  # the one-value columns, checked once each and applied to ok once
     with np.errstate(invalid="ignore"):
         for var in SETTABLE:
             x = np.asarray(cases[var.name], dtype=float)
-            if x.ndim == 1 and x.size > 1 and x.strides[0] == 0:  # one value for every case: checked once
-                x = x[:1]
+            constant = x.ndim == 0 or (x.ndim == 1 and x.size > 1 and x.strides[0] == 0)
+            if constant:  # one value for every case
+                x = x.reshape(-1)[:1]
             low, high, low_open, high_open = var.interval
-            ok &= (x > low) if low_open else (x >= low)
-            ok &= (x < high) if high_open else (x <= high)
+            good = (x > low) if low_open else (x >= low)
+            good &= (x < high) if high_open else (x <= high)
             if var.type == "Integer":
-                ok &= x == np.round(x)
+                good &= x == np.round(x)
+            if constant:
+                every_constant_ok = every_constant_ok and bool(good[0])
+            else:
+                ok &= good
+    if not every_constant_ok:
+        ok[:] = False
     return ok
 
 
