@@ -133,7 +133,8 @@ def restitution_e45(v_star, eps_y):
     if not v_star > 1.0:  # V* <= 1 (or NaN): no plastic loss
         return 1.0
     log_loss = _LOG_E45_COEFFICIENT - 0.114 * log(eps_y) + log(log(v_star)) + 9.5 * eps_y * log(v_star - 1.0)
-    return maximum(1.0 - exp(minimum(log_loss, _EXP_ARG_CAP)), 0.0)
+    e = 1.0 - exp(log_loss if log_loss <= _EXP_ARG_CAP else _EXP_ARG_CAP)  # the comparisons of _num's minimum
+    return e if e >= 0.0 else 0.0  # and maximum (a NaN loss: the cap, e = 0), without their calls
 
 
 def _restitution_e45_array(v_star, eps_y):

@@ -360,12 +360,11 @@ def impact_record_at(v, terms: ImpactTerms, validate: bool = True) -> tuple:
         if not isinstance(terms, ImpactTerms):
             raise TypeError(f"terms must be an ImpactTerms (made by impact_terms), got {type(terms).__name__}")
         v = check_nonnegative("v_approach", v, "m/s")
-    values = _pipeline(v, terms)
-    return values + (_both(values[_LAMBDA_OK_AT], values[_VSTAR_OK_AT]),)
+    return _pipeline(v, terms)
 
 
 def _result(values) -> ImpactResult:
-    """The :class:`ImpactResult` of :func:`_pipeline`'s values."""
+    """The :class:`ImpactResult` of :func:`_pipeline`'s record (its fields: all but ``valid``, a property)."""
     out = object.__new__(ImpactResult)  # frozen dataclass: its __dict__ set directly, ~5x faster
     object.__setattr__(out, "__dict__", dict(zip(_FIELD_NAMES, values)))
     return out
@@ -407,8 +406,8 @@ def _terms(params, edge_distance, restitution_model, zener_method, plasticity, p
 
 
 def _pipeline(v, terms) -> tuple:
-    """The values of :class:`ImpactResult`'s fields, in order, at the speed ``v``, from the parameter-only
-    ``terms``; written once for Python floats
+    """The record (:data:`RECORD`: :class:`ImpactResult`'s fields in order, then ``valid``) at the speed ``v``,
+    from the parameter-only ``terms``; written once for Python floats
     (``v`` a float and ``terms.floats``, the scalar mode) and numpy arrays alike.
 
     Every step goes through the float-or-array helpers of :mod:`restitution._num` and the equations'
@@ -455,8 +454,9 @@ def _pipeline(v, terms) -> tuple:
     else:
         e_ze, d_ze, tau0 = _zener_where_needed(lam, needed, zener_method, ode_rtol, skipped_tau0)
 
-    moving = v > 0.0 if scalar else _moving(v)
-    t_contact = where(moving, contact_duration(T, tau0), 0.0)  # T tau0 = inf where not moving: replaced
+    # T tau0 = inf where not moving (v = 0): replaced by 0
+    t_contact = ((contact_duration(T, tau0) if v > 0.0 else 0.0) if scalar
+                 else where(_moving(v), contact_duration(T, tau0), 0.0))
 
     # --- Fusion, Eqs. (17)-(20)
     e = apparent_restitution(e_ep, e_ze)
@@ -464,18 +464,21 @@ def _pipeline(v, terms) -> tuple:
 
     # --- The monitors of the assumptions (sections 3 and 4): where Zener was skipped or off, the half-space
     # contact is its own reference
-    delay = where(needed, wave_delay(tau0, tau0_half_space), 1.0)
+    delay = ((wave_delay(tau0, tau0_half_space) if needed else 1.0) if scalar
+             else where(needed, wave_delay(tau0, tau0_half_space), 1.0))
     echo = edge_echo_ratio_from_time(echo_time, t_contact)
 
+    lambda_ok, vstar_ok = lambda_in_studied_range(lam), vstar_in_fit_range(V_star)
     values = (e, e * v, e_ep, V_c, V_star, eps_y, e_ze, lam, tau0, T, t_contact, m_a,
               plate_mass_from_ratio(m_a, ratio), ratio, plate_velocity_after_impact(v, e_ep, d_ze), delay, echo,
-              e_ep < 1.0, needed, lambda_in_studied_range(lam), vstar_in_fit_range(V_star), e < 0.0,
-              tau0 < math.inf, waves_concurrent(delay), edge_clear(echo))
+              e_ep < 1.0, needed, lambda_ok, vstar_ok, e < 0.0, tau0 < math.inf, waves_concurrent(delay),
+              edge_clear(echo))
     if scalar:  # every value is already a Python float or bool (math-module paths; the tests check it)
-        return values
+        return values + (lambda_ok and vstar_ok,)
     shape = np.broadcast_shapes(v.shape, shape)
-    return tuple(_own_array(value, shape, bool if name in _FLAGS else float)
-                 for name, value in zip(_FIELD_NAMES, values))
+    values = tuple(_own_array(value, shape, bool if name in _FLAGS else float)
+                   for name, value in zip(_FIELD_NAMES, values))
+    return values + (_both(values[_LAMBDA_OK_AT], values[_VSTAR_OK_AT]),)
 
 
 #: tau0 [1] of each Zener method at lambda = 0: what ``plate_waves="auto"`` reports where it skips

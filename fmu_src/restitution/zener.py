@@ -23,8 +23,8 @@ from .zener_ode import solve_zener_ode
 
 __all__ = [
     "ZENER_METHODS", "LAMBDA_STUDIED_MAX", "lambda_in_studied_range", "TAU0_HERTZ", "plate_wave_speed", "inelasticity_parameter",
-    "lambda_material_factor", "lambda_speed_factor", "lambda_from_root", "hertz_stiffness", "time_scale", "time_scale_factor",
-    "time_scale_from_root", "zener_paper_fit", "zener_paper_fit_deficit", "zener_linear",
+    "lambda_material_factor", "lambda_speed_factor", "lambda_from_root", "hertz_stiffness", "time_scale",
+    "time_scale_factor", "time_scale_from_root", "zener_paper_fit", "zener_paper_fit_deficit", "zener_linear",
     "zener_linear_deficit", "zener_linear_fit", "zener_ode", "zener_restitution", "zener_solution",
     "contact_duration", "WAVE_DELAY_LIMIT", "wave_delay", "waves_concurrent", "dilatational_wave_speed",
     "dilatational_slowness", "edge_echo_time", "edge_echo_ratio", "edge_echo_ratio_from_time", "edge_clear",
@@ -51,7 +51,8 @@ def inelasticity_parameter(v0, E_a, nu_a, rho_a, d, E_b, nu_b, rho_b, t):
     with v0 the impact speed [m/s], d the sphere diameter [m], t = 2h the plate thickness [m].
     It depends on t/d only, not on t and d separately.
     """
-    return lambda_from_root(v0 ** 0.2, lambda_speed_factor(lambda_material_factor(E_a, nu_a, rho_a, E_b, nu_b, rho_b), d, t))
+    material_factor = lambda_material_factor(E_a, nu_a, rho_a, E_b, nu_b, rho_b)
+    return lambda_from_root(v0 ** 0.2, lambda_speed_factor(material_factor, d, t))
 
 
 def lambda_material_factor(E_a, nu_a, rho_a, E_b, nu_b, rho_b):
