@@ -12,8 +12,8 @@ Builds, in a scratch directory (``--work``, default a temporary one):
   value references) in plain pythonfmu style (attributes read and written by pythonfmu's default
   getters and setters) and does no physics: ``do_step`` returns True, every output is a constant;
 * for the breakdown, the product *without its physics*: a copy of the product whose slave script calls
-  :func:`restitution.impact` once and returns that result at every later evaluation (the guard, pythonfmu
-  and the slave's per-step work, all but the physics).
+  :func:`restitution.model.impact_record_at` once and returns that record at every later evaluation (the
+  guard, pythonfmu and the slave's per-step work, all but the physics).
 
 Then, in this process (a Python host, fmpy's ctypes bindings called raw: prepared argument arrays, no
 fmpy wrappers), it times one round trip of each FMU, interleaved batch by batch: ``fmi2SetReal`` of
@@ -110,8 +110,8 @@ def _unzip(fmu: Path, directory: Path) -> Path:
 
 
 #: The line of the slave script that binds the physics, and what the copy without physics has instead.
-PHYSICS_LINE = "_impact_si = si_only(impact)\n"
-MEMO_PHYSICS = '''_impact_once = si_only(impact)
+PHYSICS_LINE = "_impact_si = si_only(impact_record_at)\n"
+MEMO_PHYSICS = '''_impact_once = si_only(impact_record_at)
 _first_result = []
 
 

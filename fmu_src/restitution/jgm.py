@@ -126,13 +126,15 @@ def restitution_e45(v_star, eps_y):
     ~ 1e-307, an underflow) or overflow (brittle pairs, eps_y ~ 10); in log space the loss is
     0 exactly below exp's range (no underflow flag) and capped above it.
     """
-    if not (v_star.__class__ is float and eps_y.__class__ is float) and (np.ndim(v_star) or np.ndim(eps_y)):
-        return _restitution_e45_array(np.asarray(v_star, dtype=float), eps_y)
-    above, vm1 = _above_one(v_star)
-    log_v = log(where(above, v_star, 2.0))  # ln V* > 0 wherever it is used
-    log_loss = _LOG_E45_COEFFICIENT - 0.114 * log(eps_y) + log(log_v) + 9.5 * eps_y * log(vm1)
-    e = 1.0 - exp(minimum(log_loss, _EXP_ARG_CAP))
-    return where(above, maximum(e, 0.0), 1.0)
+    if not (v_star.__class__ is float and eps_y.__class__ is float):
+        if np.ndim(v_star) or np.ndim(eps_y):
+            return _restitution_e45_array(np.asarray(v_star, dtype=float), eps_y)
+        v_star, eps_y = float(v_star), float(eps_y)  # other scalars: numpy's, ints
+    if not v_star > 1.0:  # V* <= 1 (or NaN): no plastic loss
+        return 1.0
+    log_loss = _LOG_E45_COEFFICIENT - 0.114 * log(eps_y) + log(log(v_star)) + 9.5 * eps_y * log(v_star - 1.0)
+    e = 1.0 - exp(log_loss if log_loss <= _EXP_ARG_CAP else _EXP_ARG_CAP)  # the comparisons of _num's minimum
+    return e if e >= 0.0 else 0.0  # and maximum (a NaN loss: the cap, e = 0), without their calls
 
 
 def _restitution_e45_array(v_star, eps_y):

@@ -2,7 +2,9 @@
 I. Green, Nonlinear Dyn (2022), JGM (Eqs. 1-8) and Zener (Eqs. 9-13a) fused by Eq. (20).
 
 :func:`impact` takes Python floats (one impact) or numpy arrays (broadcast together, one
-result per element); one pipeline, :func:`_pipeline`, serves both.
+result per element); one pipeline, :func:`_pipeline`, serves both, after :func:`_terms` has computed what
+depends on the parameters only. Both steps are public too: :func:`impact_terms` once per parameter set,
+:func:`impact_at` per speed (a co-simulation's steps).
 """
 from __future__ import annotations
 
@@ -10,6 +12,7 @@ import math
 from dataclasses import dataclass, fields
 from fractions import Fraction
 from functools import lru_cache
+from typing import NamedTuple
 
 import numpy as np
 
@@ -20,19 +23,20 @@ from .jgm import restitution_e44, restitution_e45, vstar_in_fit_range
 from .quantities import si_only, with_units
 from .validation import (check_choice, check_nonnegative, check_nonnegative_or_infinite, check_poisson,
                          check_positive)
-from .zener import (TAU0_HERTZ, ZENER_METHODS, edge_clear, lambda_from_root, lambda_in_studied_range,
-                    lambda_material_factor, time_scale_factor, time_scale_from_root, wave_delay, waves_concurrent,
-                    zener_linear, zener_paper_fit, zener_solution)
+from .zener import (TAU0_HERTZ, ZENER_METHODS, edge_clear, edge_echo_ratio_from_time, lambda_from_root,
+                    lambda_in_studied_range, lambda_material_factor, lambda_speed_factor, time_scale_factor,
+                    time_scale_from_root, wave_delay, waves_concurrent, zener_linear, zener_paper_fit, zener_solution)
 
 # The pipeline passes SI numbers it has checked: it calls the equations without their unit layer
 # (restitution.quantities), which would cost more than the equations on the scalar path.
 (critical_interference, critical_load, critical_pressure, critical_velocity, effective_modulus, sphere_mass,
  yield_strain) = map(si_only, (jgm.critical_interference, jgm.critical_load, jgm.critical_pressure,
                                jgm.critical_velocity, jgm.effective_modulus, jgm.sphere_mass, jgm.yield_strain))
-(contact_duration, hertz_stiffness, dilatational_slowness, edge_echo_ratio) = map(
-    si_only, (zener.contact_duration, zener.hertz_stiffness, zener.dilatational_slowness, zener.edge_echo_ratio))
+(contact_duration, hertz_stiffness, dilatational_slowness, edge_echo_time) = map(
+    si_only, (zener.contact_duration, zener.hertz_stiffness, zener.dilatational_slowness, zener.edge_echo_time))
 
-__all__ = ["ImpactResult", "impact", "published", "RESTITUTION_MODELS", "EFFECT_MODES", "ZENER_SLOPE_BOUND",
+__all__ = ["ImpactResult", "impact", "ImpactTerms", "impact_terms", "impact_at", "impact_record_at", "RECORD",
+           "published", "RESTITUTION_MODELS", "EFFECT_MODES", "ZENER_SLOPE_BOUND",
            "PARAMETERS", "DOMAIN", "validate_parameters", "RECORD_REALS", "RECORD_FLAGS", "EDGE_ECHO_PUBLISHED_MAX",
            "check_edge_distance"]
 
@@ -78,6 +82,7 @@ def check_edge_distance(value):
     return check_nonnegative_or_infinite("plate.edge_distance", value, "m", ">= 0 (0 or inf: an unbounded plate)")
 
 
+_PARAMETER_NAMES = tuple(name for name, _unit, _kind in PARAMETERS)
 _PARAMETER_CHECKS = tuple((name, name.replace("_", ".", 1), unit, kind) for name, unit, kind in PARAMETERS)
 
 
@@ -132,9 +137,7 @@ class ImpactResult:
     @property
     def valid(self):
         """Inside both models' validated ranges."""
-        if is_scalar(self.lam):
-            return self.lambda_in_range and self.vstar_in_range
-        return np.logical_and(self.lambda_in_range, self.vstar_in_range)
+        return _both(self.lambda_in_range, self.vstar_in_range)
 
     def as_dict(self) -> dict:
         d = dict(self.__dict__)  # the fields, in order: a frozen dataclass has no other instance attributes
@@ -173,6 +176,21 @@ class ImpactResult:
 #: field is one edit here (docs/adding_an_output.md).
 RECORD_REALS = tuple(f.name for f in fields(ImpactResult) if f.type == "Real")
 RECORD_FLAGS = tuple(f.name for f in fields(ImpactResult) if f.type == "Flag") + ("valid",)
+#: The names of :func:`impact_record_at`'s values, in order: :data:`RECORD_REALS`, then :data:`RECORD_FLAGS`,
+#: which is :class:`ImpactResult`'s fields in order (its reals come first), then ``valid``.
+RECORD = RECORD_REALS + RECORD_FLAGS
+if RECORD != tuple(f.name for f in fields(ImpactResult)) + ("valid",):  # a field out of place: fail at import
+    raise RuntimeError("ImpactResult's Real fields must all come before its Flag fields (the record's order)")
+_RECORD_AT = {name: i for i, name in enumerate(RECORD)}  # name -> position in a record
+_BY_NAME = {name: name for name in RECORD}  # name -> key in a dict of the fields
+_LAMBDA_OK_AT, _VSTAR_OK_AT = _RECORD_AT["lambda_in_range"], _RECORD_AT["vstar_in_range"]
+
+
+def _both(lambda_in_range, vstar_in_range):
+    """``valid``: inside both models' validated ranges (a bool of two bools, else an array)."""
+    if lambda_in_range.__class__ is bool and vstar_in_range.__class__ is bool:
+        return lambda_in_range and vstar_in_range
+    return np.logical_and(lambda_in_range, vstar_in_range)
 
 
 #: The flags shown by ``repr`` beside ``valid`` and its two parts.
@@ -186,24 +204,35 @@ _REPR_MONITORS = (("wave_delay", "concurrent"), ("edge_echo", "edge_clear"))
 ENDLESS = ("tau0", "t_contact", "wave_delay")
 
 
-def published(values: dict) -> dict:
-    """``values`` (:meth:`ImpactResult.as_dict`) as the FMUs and the sweep tables publish them: every
-    value finite. Result writers (OMSimulator's, for one) drop a whole time point for one inf, so where
-    the contact never ends tau0 and t_contact read 0 beside ``contact_ends`` = False, and the
-    equivalent plate mass is published as ``mass_ratio`` (0 for a half-space) instead of m_eff = +inf;
-    ``edge_echo`` is capped at :data:`EDGE_ECHO_PUBLISHED_MAX` (+inf for an unbounded plate) and
-    ``wave_delay`` reads 0 with tau0 where the contact never ends.
-    Nothing else changes; the package's own results keep the infinities."""
-    ends, echo = values["contact_ends"], values["edge_echo"]
-    if ends is True and echo.__class__ is float and echo <= EDGE_ECHO_PUBLISHED_MAX:  # one impact, a bounded plate
-        return values
-    out = dict(values)
-    out["edge_echo"] = minimum(echo, EDGE_ECHO_PUBLISHED_MAX)
+def published(values):
+    """``values`` (:meth:`ImpactResult.as_dict`, or a record of :func:`impact_record_at`) as the FMUs and the
+    sweep tables publish them: every value finite. Result writers (OMSimulator's, for one) drop a whole time
+    point for one inf, so where the contact never ends tau0 and t_contact read 0 beside ``contact_ends`` =
+    False, and the equivalent plate mass is published as ``mass_ratio`` (0 for a half-space) instead of
+    m_eff = +inf; ``edge_echo`` is capped at :data:`EDGE_ECHO_PUBLISHED_MAX` (+inf for an unbounded plate)
+    and ``wave_delay`` reads 0 with tau0 where the contact never ends.
+    Nothing else changes; the package's own results keep the infinities. A dict gives a dict; a record
+    gives a record (itself where nothing changes, else a list in the same order)."""
+    at = _BY_NAME if values.__class__ is dict else _RECORD_AT  # where each value sits
+    ends, echo = values[at["contact_ends"]], values[at["edge_echo"]]
+    if ends is True and echo.__class__ is float:  # one impact whose contact ends
+        if echo <= EDGE_ECHO_PUBLISHED_MAX:  # a bounded plate
+            return values
+        out = _copy(values)  # an unbounded plate (+inf), the FMUs' default
+        out[at["edge_echo"]] = EDGE_ECHO_PUBLISHED_MAX
+        return out
+    out = _copy(values)
+    out[at["edge_echo"]] = minimum(echo, EDGE_ECHO_PUBLISHED_MAX)
     if ends is True:
         return out
-    for key in ENDLESS:
-        out[key] = where(ends, values[key], 0.0)
+    for name in ENDLESS:
+        out[at[name]] = where(ends, values[at[name]], 0.0)
     return out
+
+
+def _copy(values):
+    """A dict or a record, as one that :func:`published` may change."""
+    return dict(values) if values.__class__ is dict else list(values)
 
 
 def _mode(name, value):
@@ -216,7 +245,12 @@ def _mode(name, value):
     return check_choice(name, value, EFFECT_MODES)
 
 
-@with_units(v="m/s", sphere_E="Pa", sphere_nu="dimensionless", sphere_Sy="Pa", sphere_rho="kg/m**3", sphere_d="m", plate_E="Pa", plate_nu="dimensionless", plate_Sy="Pa", plate_rho="kg/m**3", plate_t="m", plate_edge_distance="m")
+_UNITS = dict(sphere_E="Pa", sphere_nu="dimensionless", sphere_Sy="Pa", sphere_rho="kg/m**3", sphere_d="m",
+              plate_E="Pa", plate_nu="dimensionless", plate_Sy="Pa", plate_rho="kg/m**3", plate_t="m",
+              plate_edge_distance="m")
+
+
+@with_units(v="m/s", **_UNITS)
 def impact(v, sphere_E, sphere_nu, sphere_Sy, sphere_rho, sphere_d,
            plate_E, plate_nu, plate_Sy, plate_rho, plate_t, *, plate_edge_distance=math.inf,
            restitution_model: str = "e45", zener_method: str = "exact",
@@ -243,14 +277,14 @@ def impact(v, sphere_E, sphere_nu, sphere_Sy, sphere_rho, sphere_d,
     (<= 1000), ``e_negative``, and the monitors of the assumptions: ``wave_delay`` with ``concurrent``
     (<= 1.8136), ``edge_echo`` with ``edge_clear`` (>= 1); docs/assumptions.md. Bad input raises
     ValueError naming the parameter.
+
+    ``impact(v, *p, **o)`` is ``impact_at(v, impact_terms(*p, **o))``: many speeds for one parameter set
+    (a co-simulation's steps) make the terms once (:func:`impact_terms`, :func:`impact_at`).
     """
     plasticity = _mode("plasticity", plasticity)
     plate_waves = _mode("plate_waves", plate_waves)
     if validate:
-        check_choice("restitution_model", restitution_model, RESTITUTION_MODELS)
-        check_choice("zener_method", zener_method, ZENER_METHODS)
-        check_nonnegative("effect_tolerance", effect_tolerance)
-        check_positive("ode_rtol", ode_rtol)
+        _check_options(restitution_model, zener_method, effect_tolerance, ode_rtol)
         v = check_nonnegative("v_approach", v, "m/s")
         (sphere_E, sphere_nu, sphere_Sy, sphere_rho, sphere_d, plate_E, plate_nu, plate_Sy, plate_rho,
          plate_t) = validate_parameters(
@@ -258,47 +292,141 @@ def impact(v, sphere_E, sphere_nu, sphere_Sy, sphere_rho, sphere_d,
             sphere_d=sphere_d, plate_E=plate_E, plate_nu=plate_nu, plate_Sy=plate_Sy,
             plate_rho=plate_rho, plate_t=plate_t).values()
         plate_edge_distance = check_edge_distance(plate_edge_distance)
+    terms = _terms((sphere_E, sphere_nu, sphere_Sy, sphere_rho, sphere_d, plate_E, plate_nu, plate_Sy, plate_rho,
+                    plate_t), plate_edge_distance, restitution_model, zener_method, plasticity, plate_waves,
+                   effect_tolerance, ode_rtol)
+    return _result(_pipeline(v, terms))
+
+
+class ImpactTerms(NamedTuple):
+    """What :func:`impact` computes before it needs the speed: the terms of every equation that depend on the
+    parameters only (Python floats, or arrays where a parameter is one) and the options, as words. Made by
+    :func:`impact_terms`, used by :func:`impact_at`. Units in brackets."""
+
+    floats: bool  #: every parameter is a Python float (one impact per float speed)
+    shape: tuple  #: the parameters' broadcast shape (() for floats)
+    V_c: object  #: critical velocity, Eq. (6) [m/s]
+    eps_y: object  #: yield strain, Eq. (3) [1]
+    m_a: object  #: sphere mass [kg]
+    time_factor: object  #: Zener's time unit without the speed, Eq. (9) [s^(4/5) m^(1/5)]
+    lambda_factor: object  #: lambda / v^(1/5), Eq. (12) [(s/m)^(1/5)]
+    echo_time: object  #: the edge echo's travel time 2a/c_L [s] (+inf: an unbounded plate)
+    restitution_model: str
+    zener_method: str
+    plasticity: str  #: "off", "on" or "auto"
+    plate_waves: str  #: "off", "on" or "auto"
+    effect_tolerance: float
+    ode_rtol: float
+    skipped_tau0: float  #: tau0 [1] where Zener is not computed (off, or skipped by "auto")
+    tau0_half_space: float  #: the method's tau0 at lambda = 0 [1], the reference of ``wave_delay``
+
+
+@with_units(**_UNITS)
+def impact_terms(sphere_E, sphere_nu, sphere_Sy, sphere_rho, sphere_d, plate_E, plate_nu, plate_Sy, plate_rho,
+                 plate_t, *, plate_edge_distance=math.inf, restitution_model: str = "e45",
+                 zener_method: str = "exact", plasticity="auto", plate_waves="auto", effect_tolerance: float = 1e-6,
+                 ode_rtol: float = 1e-10, validate: bool = True) -> ImpactTerms:
+    """Everything :func:`impact` computes from its arguments but the speed, for :func:`impact_at`: the same
+    arguments as :func:`impact` without ``v``, checked the same way (``validate=False`` skips the checks)."""
+    plasticity = _mode("plasticity", plasticity)
+    plate_waves = _mode("plate_waves", plate_waves)
     params = (sphere_E, sphere_nu, sphere_Sy, sphere_rho, sphere_d, plate_E, plate_nu, plate_Sy, plate_rho, plate_t)
-    if (v.__class__ is float and sphere_E.__class__ is float and sphere_nu.__class__ is float
-            and sphere_Sy.__class__ is float and sphere_rho.__class__ is float and sphere_d.__class__ is float
-            and plate_E.__class__ is float and plate_nu.__class__ is float and plate_Sy.__class__ is float
-            and plate_rho.__class__ is float and plate_t.__class__ is float
-            and plate_edge_distance.__class__ is float):
-        # one impact in Python floats (the FMU's case; spelt out: a generator costs 10 % of the call)
-        scalar = True
-    else:
-        scalar = is_scalar(v) and is_scalar(plate_edge_distance) and all(is_scalar(x) for x in params)
-        if scalar:
-            v, params, plate_edge_distance = float(v), tuple(map(float, params)), float(plate_edge_distance)
+    if validate:
+        _check_options(restitution_model, zener_method, effect_tolerance, ode_rtol)
+        params = tuple(validate_parameters(**dict(zip(_PARAMETER_NAMES, params))).values())
+        plate_edge_distance = check_edge_distance(plate_edge_distance)
+    return _terms(params, plate_edge_distance, restitution_model, zener_method, plasticity, plate_waves,
+                  effect_tolerance, ode_rtol)
+
+
+@with_units(v="m/s")
+def impact_at(v, terms: ImpactTerms, validate: bool = True) -> ImpactResult:
+    """:func:`impact` at the approach speed ``v`` [m/s] (a float or an array), the rest of its arguments made
+    into ``terms`` by :func:`impact_terms`: what a co-simulation evaluates per step. ``validate=False``
+    skips the check of ``v`` (>= 0, finite)."""
+    if validate:
+        if not isinstance(terms, ImpactTerms):
+            raise TypeError(f"terms must be an ImpactTerms (made by impact_terms), got {type(terms).__name__}")
+        v = check_nonnegative("v_approach", v, "m/s")
+    return _result(_pipeline(v, terms))
+
+
+@with_units(v="m/s")
+def impact_record_at(v, terms: ImpactTerms, validate: bool = True) -> tuple:
+    """The values of :func:`impact_at`'s result in the order of :data:`RECORD` (its fields, then ``valid``),
+    without the :class:`ImpactResult` around them: a co-simulation's step at the least cost. ``validate=False``
+    skips the check of ``v``."""
+    if validate:
+        if not isinstance(terms, ImpactTerms):
+            raise TypeError(f"terms must be an ImpactTerms (made by impact_terms), got {type(terms).__name__}")
+        v = check_nonnegative("v_approach", v, "m/s")
+    return _pipeline(v, terms)
+
+
+def _result(values) -> ImpactResult:
+    """The :class:`ImpactResult` of :func:`_pipeline`'s record (its fields: all but ``valid``, a property)."""
+    out = object.__new__(ImpactResult)  # frozen dataclass: its __dict__ set directly, ~5x faster
+    object.__setattr__(out, "__dict__", dict(zip(_FIELD_NAMES, values)))
+    return out
+
+
+def _check_options(restitution_model, zener_method, effect_tolerance, ode_rtol):
+    check_choice("restitution_model", restitution_model, RESTITUTION_MODELS)
+    check_choice("zener_method", zener_method, ZENER_METHODS)
+    check_nonnegative("effect_tolerance", effect_tolerance)
+    check_positive("ode_rtol", ode_rtol)
+
+
+def _terms(params, edge_distance, restitution_model, zener_method, plasticity, plate_waves, effect_tolerance,
+           ode_rtol) -> ImpactTerms:
+    """:class:`ImpactTerms` of checked parameters (any real scalars or arrays): JGM's Eqs. (1)-(6), the
+    speed-free parts of Eqs. (9) and (12), the edge echo's travel time.
+
+    Scalars become Python floats. No up-front broadcast: what depends on the parameters only is computed
+    once per distinct parameter value, and a scalar parameter stays a Python float, so one sphere on one
+    pair of materials (a sweep in v and t) computes its material terms in floats, once (memoised)."""
+    floats = edge_distance.__class__ is float and all(x.__class__ is float for x in params)
+    if not floats:
+        if is_scalar(edge_distance) and all(is_scalar(x) for x in params):
+            params, edge_distance, floats = tuple(map(float, params)), float(edge_distance), True
         else:
-            # No up-front broadcast: what depends on the parameters only is computed once per
-            # distinct parameter value, and a scalar parameter stays a Python float, so one sphere on
-            # one pair of materials (a sweep in v and t) computes its material terms in floats, once.
-            v = np.asarray(v, dtype=float)
             params = tuple(_float_or_array(x) for x in params)
-            plate_edge_distance = _float_or_array(plate_edge_distance)
-    return _pipeline(v, params, plate_edge_distance, scalar, restitution_model, zener_method, plasticity, plate_waves,
-                     effect_tolerance, ode_rtol)
+            edge_distance = _float_or_array(edge_distance)
+    sphere_E, sphere_nu, sphere_Sy, sphere_rho, sphere_d, plate_E, plate_nu, plate_Sy, plate_rho, plate_t = params
+    material_terms = (_material_terms_cached if floats or all(x.__class__ is float for x in params)
+                      else _material_terms)
+    E_prime, eps_y, m_a, V_c, time_factor, lambda_material, slowness = material_terms(
+        sphere_E, sphere_nu, sphere_Sy, sphere_rho, sphere_d, plate_E, plate_nu, plate_Sy, plate_rho)
+    tau0_half_space = _TAU0_AT_LAMBDA0[zener_method]
+    return ImpactTerms(
+        floats, () if floats else np.broadcast_shapes(np.shape(edge_distance), *(np.shape(x) for x in params)),
+        V_c, eps_y, m_a, time_factor, lambda_speed_factor(lambda_material, sphere_d, plate_t),
+        edge_echo_time(edge_distance, slowness), restitution_model, zener_method, plasticity, plate_waves,
+        effect_tolerance, ode_rtol, tau0_half_space if plate_waves == "auto" else TAU0_HERTZ, tau0_half_space)
 
 
-def _pipeline(v, params, edge_distance, scalar, restitution_model, zener_method, plasticity, plate_waves,
-              effect_tolerance, ode_rtol) -> ImpactResult:
-    """The model, written once for Python floats (``scalar``) and numpy arrays alike.
+def _pipeline(v, terms) -> tuple:
+    """The record (:data:`RECORD`: :class:`ImpactResult`'s fields in order, then ``valid``) at the speed ``v``,
+    from the parameter-only ``terms``; written once for Python floats
+    (``v`` a float and ``terms.floats``, the scalar mode) and numpy arrays alike.
 
     Every step goes through the float-or-array helpers of :mod:`restitution._num` and the equations'
     own float-or-array forms; the differences are where results are stored and how many whole-array
-    passes a step takes. Floats: a memoised material step and a direct fill of the result. Arrays:
-    scalar parameters keep the material step in floats, computed once; each equation's array form
-    works in place on its own temporaries; the masks of speed 0, of the auto skip of Zener and of the
-    half-space are built only where one reduction (a minimum) shows a case needs them; owned output arrays.
+    passes a step takes. Floats: a direct fill of the result. Arrays: scalar parameters keep their terms
+    in floats; each equation's array form works in place on its own temporaries; the masks of speed 0, of
+    the auto skip of Zener and of the half-space are built only where one reduction (a minimum) shows a
+    case needs them; owned output arrays.
     """
-    sphere_E, sphere_nu, sphere_Sy, sphere_rho, sphere_d, plate_E, plate_nu, plate_Sy, plate_rho, plate_t = params
+    (floats, shape, V_c, eps_y, m_a, time_factor, lambda_factor, echo_time, restitution_model, zener_method,
+     plasticity, plate_waves, effect_tolerance, ode_rtol, skipped_tau0, tau0_half_space) = terms
+    if v.__class__ is float and floats:
+        scalar = True
+    elif floats and is_scalar(v):
+        v, scalar = float(v), True
+    else:
+        v, scalar = np.asarray(v, dtype=float), False
 
     # --- JGM, Eqs. (1)-(8)
-    material_terms = (_material_terms_cached if scalar or all(x.__class__ is float for x in params)
-                      else _material_terms)
-    E_prime, eps_y, m_a, V_c, time_factor, lambda_factor, slowness = material_terms(
-        sphere_E, sphere_nu, sphere_Sy, sphere_rho, sphere_d, plate_E, plate_nu, plate_Sy, plate_rho)
     V_star = v / V_c
     if plasticity == "off":
         e_ep = 1.0
@@ -306,12 +434,12 @@ def _pipeline(v, params, edge_distance, scalar, restitution_model, zener_method,
         e_ep = (restitution_e45(V_star, eps_y) if restitution_model == "e45"
                 else restitution_e44(V_star))
         if plasticity == "auto":
-            e_ep = (where(1.0 - e_ep < effect_tolerance, 1.0, e_ep) if scalar
+            e_ep = ((1.0 if 1.0 - e_ep < effect_tolerance else e_ep) if scalar
                     else _skip_small_loss(e_ep, effect_tolerance))
 
     # --- Zener, Eqs. (9)-(13a)
     v_root = v ** 0.2 if scalar else fifth_root(v)  # v^(1/5), in Eq. (12) and Eq. (9)
-    lam = lambda_from_root(v_root, sphere_d, plate_t, lambda_factor)  # Eq. (12)
+    lam = lambda_from_root(v_root, lambda_factor)  # Eq. (12)
     # Eq. (9), +inf at v = 0; for arrays into v_root's own memory where the shapes allow (one array
     # fewer alive while Zener's table is read)
     T = time_scale_from_root(time_factor, v_root, None if scalar or np.shape(time_factor) not in (
@@ -319,38 +447,38 @@ def _pipeline(v, params, edge_distance, scalar, restitution_model, zener_method,
     del v_root
     if plate_waves == "auto":
         needed = ZENER_SLOPE_BOUND * lam >= effect_tolerance if scalar else _waves_needed(lam, effect_tolerance)
-        skipped_tau0 = _TAU0_AT_LAMBDA0[zener_method]
     else:
         needed = plate_waves == "on"
-        skipped_tau0 = TAU0_HERTZ
-    e_ze, d_ze, tau0 = _zener_where_needed(lam, needed, zener_method, ode_rtol, skipped_tau0, scalar)
+    if scalar:
+        e_ze, d_ze, tau0 = zener_solution(lam, zener_method, ode_rtol) if needed else (1.0, 0.0, skipped_tau0)
+    else:
+        e_ze, d_ze, tau0 = _zener_where_needed(lam, needed, zener_method, ode_rtol, skipped_tau0)
 
-    moving = v > 0.0 if scalar else _moving(v)
-    t_contact = where(moving, contact_duration(T, tau0), 0.0)  # T tau0 = inf where not moving: replaced
+    # T tau0 = inf where not moving (v = 0): replaced by 0
+    t_contact = ((contact_duration(T, tau0) if v > 0.0 else 0.0) if scalar
+                 else where(_moving(v), contact_duration(T, tau0), 0.0))
 
     # --- Fusion, Eqs. (17)-(20)
     e = apparent_restitution(e_ep, e_ze)
     ratio = mass_ratio(e_ze, d_ze)
-    m_eff = plate_mass_from_ratio(m_a, ratio)
-    v_plate = plate_velocity_after_impact(v, e_ep, d_ze)
 
-    # --- Monitors of the assumptions (sections 3 and 4): where Zener was skipped or off, the
-    # half-space contact is the reference itself
-    delay = where(needed, wave_delay(tau0, _TAU0_AT_LAMBDA0[zener_method]), 1.0)
-    echo = edge_echo_ratio(edge_distance, slowness, t_contact)
+    # --- The monitors of the assumptions (sections 3 and 4): where Zener was skipped or off, the half-space
+    # contact is its own reference
+    delay = ((wave_delay(tau0, tau0_half_space) if needed else 1.0) if scalar
+             else where(needed, wave_delay(tau0, tau0_half_space), 1.0))
+    echo = edge_echo_ratio_from_time(echo_time, t_contact)
 
-    values = (e, e * v, e_ep, V_c, V_star, eps_y, e_ze, lam, tau0, T, t_contact, m_a, m_eff, ratio, v_plate,
-              delay, echo,
-              e_ep < 1.0, needed, lambda_in_studied_range(lam), vstar_in_fit_range(V_star), e < 0.0,
-              tau0 < math.inf, waves_concurrent(delay), edge_clear(echo))
-    out = object.__new__(ImpactResult)  # frozen dataclass: fill __dict__ directly, ~5x faster
+    lambda_ok, vstar_ok = lambda_in_studied_range(lam), vstar_in_fit_range(V_star)
+    values = (e, e * v, e_ep, V_c, V_star, eps_y, e_ze, lam, tau0, T, t_contact, m_a,
+              plate_mass_from_ratio(m_a, ratio), ratio, plate_velocity_after_impact(v, e_ep, d_ze), delay, echo,
+              e_ep < 1.0, needed, lambda_ok, vstar_ok, e < 0.0, tau0 < math.inf, waves_concurrent(delay),
+              edge_clear(echo))
     if scalar:  # every value is already a Python float or bool (math-module paths; the tests check it)
-        out.__dict__.update(zip(_FIELD_NAMES, values))
-        return out
-    shape = np.broadcast_shapes(v.shape, np.shape(edge_distance), *(np.shape(x) for x in params))
-    out.__dict__.update((name, _own_array(value, shape, bool if name in _FLAGS else float))
-                        for name, value in zip(_FIELD_NAMES, values))
-    return out
+        return values + (lambda_ok and vstar_ok,)
+    shape = np.broadcast_shapes(v.shape, shape)
+    values = tuple(_own_array(value, shape, bool if name in _FLAGS else float)
+                   for name, value in zip(_FIELD_NAMES, values))
+    return values + (_both(values[_LAMBDA_OK_AT], values[_VSTAR_OK_AT]),)
 
 
 #: tau0 [1] of each Zener method at lambda = 0: what ``plate_waves="auto"`` reports where it skips
@@ -448,11 +576,9 @@ def _waves_needed(lam, tolerance):
     return ZENER_SLOPE_BOUND * lam >= tolerance
 
 
-def _zener_where_needed(lam, needed, method, rtol, skipped_tau0, scalar):
-    """(e_ze, 1 - e_ze, tau0), computed only where the plate-wave effect is needed;
+def _zener_where_needed(lam, needed, method, rtol, skipped_tau0):
+    """(e_ze, 1 - e_ze, tau0) of arrays, computed only where the plate-wave effect is needed;
     (1, 0, ``skipped_tau0``) elsewhere."""
-    if scalar:
-        return zener_solution(lam, method, rtol) if needed else (1.0, 0.0, skipped_tau0)
     lam = np.asarray(lam)  # float already: Eq. (12) of float arrays
     needed = np.broadcast_to(needed, lam.shape)
     if needed.all():  # elementwise methods: same values as the masked evaluation, no gather/scatter

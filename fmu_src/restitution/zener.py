@@ -23,11 +23,11 @@ from .zener_ode import solve_zener_ode
 
 __all__ = [
     "ZENER_METHODS", "LAMBDA_STUDIED_MAX", "lambda_in_studied_range", "TAU0_HERTZ", "plate_wave_speed", "inelasticity_parameter",
-    "lambda_material_factor", "lambda_from_root", "hertz_stiffness", "time_scale", "time_scale_factor",
-    "time_scale_from_root", "zener_paper_fit", "zener_paper_fit_deficit", "zener_linear",
+    "lambda_material_factor", "lambda_speed_factor", "lambda_from_root", "hertz_stiffness", "time_scale",
+    "time_scale_factor", "time_scale_from_root", "zener_paper_fit", "zener_paper_fit_deficit", "zener_linear",
     "zener_linear_deficit", "zener_linear_fit", "zener_ode", "zener_restitution", "zener_solution",
     "contact_duration", "WAVE_DELAY_LIMIT", "wave_delay", "waves_concurrent", "dilatational_wave_speed",
-    "dilatational_slowness", "edge_echo_ratio", "edge_clear",
+    "dilatational_slowness", "edge_echo_time", "edge_echo_ratio", "edge_echo_ratio_from_time", "edge_clear",
 ]
 
 ZENER_METHODS = ("exact", "paper_fit", "linear", "ode")
@@ -51,7 +51,8 @@ def inelasticity_parameter(v0, E_a, nu_a, rho_a, d, E_b, nu_b, rho_b, t):
     with v0 the impact speed [m/s], d the sphere diameter [m], t = 2h the plate thickness [m].
     It depends on t/d only, not on t and d separately.
     """
-    return lambda_from_root(v0 ** 0.2, d, t, lambda_material_factor(E_a, nu_a, rho_a, E_b, nu_b, rho_b))
+    material_factor = lambda_material_factor(E_a, nu_a, rho_a, E_b, nu_b, rho_b)
+    return lambda_from_root(v0 ** 0.2, lambda_speed_factor(material_factor, d, t))
 
 
 def lambda_material_factor(E_a, nu_a, rho_a, E_b, nu_b, rho_b):
@@ -65,14 +66,20 @@ def lambda_material_factor(E_a, nu_a, rho_a, E_b, nu_b, rho_b):
             / _plate_wave_speed(E_b, nu_b, rho_b) ** 0.2)
 
 
-def lambda_from_root(v0_root, d, t, material_factor):
-    """lambda [1], Eq. (12), in SI from v0^(1/5) (``v0_root``, shared with Zener's time unit, Eq. (9),
-    :func:`time_scale_from_root`), the sphere's diameter d [m], the plate's thickness t [m] and
-    :func:`lambda_material_factor`: (material_factor (d/2)^2) v0^(1/5) / t / t. The bracket holds what
-    does not depend on the speed or the thickness, so one sphere on one pair of materials (a sweep in
-    v and t) computes it once, and an array of cases pays three operations per case, in one array
-    (numpy reuses the temporary of each step; t^2 would be a second one)."""
-    return material_factor * (0.25 * d * d) * v0_root / t / t
+def lambda_speed_factor(material_factor, d, t):
+    """lambda / v0^(1/5) [(s/m)^(1/5)], Eq. (12) without the speed: :func:`lambda_material_factor` times
+    ((d/2)/t)^2, d the sphere's diameter [m], t the plate's thickness [m], as
+    (material_factor (d/2)^2) / t / t. Everything in lambda but the speed: the model computes it once per
+    parameter set (:func:`restitution.model.impact_terms`); the bracket holds what does not depend on the
+    thickness, so one sphere on one pair of materials (a sweep in t) pays two divisions per case, in one
+    array (numpy reuses the temporary of the first; t^2 would be a second one)."""
+    return material_factor * (0.25 * d * d) / t / t
+
+
+def lambda_from_root(v0_root, speed_factor):
+    """lambda [1], Eq. (12), from v0^(1/5) (``v0_root``, shared with Zener's time unit, Eq. (9),
+    :func:`time_scale_from_root`) and :func:`lambda_speed_factor`: one product per impact."""
+    return speed_factor * v0_root
 
 
 _LAMBDA_PREFACTOR = math.pi ** 0.6 / math.sqrt(3.0)
@@ -101,7 +108,7 @@ def time_scale_from_root(factor, v0_root, out=None):
     (``v0_root``, shared with Eq. (12), :func:`lambda_from_root`). +inf at v0 = 0 (no impact).
     ``out``: an array of the result's shape to write T into (the model passes v0_root's own, once
     lambda no longer needs it)."""
-    if is_scalar(v0_root):
+    if v0_root.__class__ is float or is_scalar(v0_root):
         return factor / v0_root if v0_root > 0.0 else math.inf
     with np.errstate(divide="ignore"):  # a positive factor over v0 = 0: +inf, the value for no impact
         return np.divide(factor, v0_root, out=out)
@@ -161,6 +168,18 @@ def dilatational_slowness(E_b, nu_b, rho_b):
     return sqrt(rho_b * (1.0 + nu_b) * (1.0 - 2.0 * nu_b) / (E_b * (1.0 - nu_b)))
 
 
+@with_units(edge_distance="m", slowness="s/m")
+def edge_echo_time(edge_distance, slowness):
+    """2 a / c_L [s]: the time the first dilatational wave reflected from the plate's nearest edge, at distance
+    a [m] from the impact point, takes to come back (``slowness`` = 1/c_L [s/m], :func:`dilatational_slowness`);
+    +inf where a = 0 or +inf, an unbounded plate (Zener's assumption): no echo ever returns. Depends on the
+    plate only: the model computes it once per parameter set (:func:`edge_echo_ratio_from_time`)."""
+    if edge_distance.__class__ is float and slowness.__class__ is float:
+        return math.inf if edge_distance == 0.0 or edge_distance == math.inf else 2.0 * edge_distance * slowness
+    unbounded = (edge_distance == 0.0) | (edge_distance == math.inf)
+    return where(unbounded, math.inf, 2.0 * where(unbounded, 0.0, edge_distance) * slowness)
+
+
 @with_units(edge_distance="m", slowness="s/m", t_contact="s")
 def edge_echo_ratio(edge_distance, slowness, t_contact):
     """(2 a / c_L) / t_contact [1]: the time the first dilatational wave reflected from the plate's nearest
@@ -171,18 +190,25 @@ def edge_echo_ratio(edge_distance, slowness, t_contact):
     (:func:`edge_clear`). Conservative: the bulk dilatational wave (``slowness`` = 1/c_L,
     :func:`dilatational_slowness`) is the fastest; the flexural waves that carry Zener's energy loss
     come back later. a = 0 or +inf means an unbounded plate (Zener's assumption): +inf, as for no
-    contact (t_contact = 0); 0 where the contact never ends (t_contact = +inf)."""
-    if t_contact.__class__ is not float and not is_scalar(t_contact) and is_scalar(edge_distance) and is_scalar(
-            slowness):  # one plate, many contacts
-        if edge_distance == 0.0 or edge_distance == math.inf:
+    contact (t_contact = 0); 0 where the contact never ends (t_contact = +inf).
+    :func:`edge_echo_time` and :func:`edge_echo_ratio_from_time`, the parameter-only part and the rest."""
+    return edge_echo_ratio_from_time(_edge_echo_time(edge_distance, slowness), t_contact)
+
+
+def edge_echo_ratio_from_time(echo_time, t_contact):
+    """:func:`edge_echo_ratio` [1] from :func:`edge_echo_time` [s] and the contact time [s]: echo_time /
+    t_contact, +inf where the plate is unbounded (echo_time = +inf) or there is no contact (t_contact = 0),
+    0 where a bounded plate's contact never ends (t_contact = +inf)."""
+    if t_contact.__class__ is float and echo_time.__class__ is float:
+        return math.inf if echo_time == math.inf or t_contact == 0.0 else echo_time / t_contact
+    if is_scalar(echo_time) and not is_scalar(t_contact):  # one plate, many contacts
+        if echo_time == math.inf:
             return np.full(np.shape(t_contact), math.inf)
-        if slowness > 0.0:  # a positive echo time over t_contact is +inf at 0 and 0 at +inf: no masks
+        if echo_time > 0.0:  # a positive echo time over t_contact is +inf at 0 and 0 at +inf: no masks
             with np.errstate(divide="ignore"):
-                return np.divide(2.0 * edge_distance * slowness, t_contact)
-    unbounded = (edge_distance == 0.0) | (edge_distance == math.inf)
-    no_contact = t_contact == 0.0
-    echo = 2.0 * where(unbounded, 0.0, edge_distance) * slowness
-    return where(unbounded | no_contact, math.inf, echo / where(no_contact, 1.0, t_contact))
+                return np.divide(echo_time, t_contact)
+    silent = (echo_time == math.inf) | (t_contact == 0.0)  # no echo, or no contact
+    return where(silent, math.inf, where(silent, 0.0, echo_time) / where(silent, 1.0, t_contact))
 
 
 def edge_clear(ratio):
@@ -299,3 +325,4 @@ def zener_restitution(lam, method: str = "exact", rtol: float = 1e-10):
 _reduced_modulus = si_only(reduced_modulus)
 _plate_wave_speed = si_only(plate_wave_speed)
 _dilatational_slowness = si_only(dilatational_slowness)
+_edge_echo_time = si_only(edge_echo_time)

@@ -184,14 +184,13 @@ def test_a_non_finite_output_is_an_evaluation_failure(impact_fmu, monkeypatch):
     """A NaN or an infinity in any output makes the outputs NaN and valid false, is logged with the
     inputs, and fmi2DoStep returns fmi2Discard. Where the physics is infinite the FMU publishes a finite
     encoding instead: mass_ratio = 0 for a half-space, tau0 = t_contact = 0 beside contact_ends = false."""
-    import dataclasses
-
     import sphere_plate_impact_slave as slave_module  # the module the FMU imported in this process
+    from restitution.model import RECORD
 
-    real_impact = slave_module._impact_si
+    real_impact = slave_module._impact_si  # one impact's record (restitution.model.impact_record_at)
     broken = {}
-    monkeypatch.setattr(slave_module, "_impact_si",
-                        lambda *a, **k: dataclasses.replace(real_impact(*a, **k), **broken))
+    monkeypatch.setattr(slave_module, "_impact_si", lambda *a, **k: tuple(
+        broken.get(name, value) for name, value in zip(RECORD, real_impact(*a, **k))))
     for field, value, name in (("tau0", math.nan, "zener.tau0"), ("v_plate", math.inf, "plate.v_after")):
         broken.clear()
         broken[field] = value

@@ -61,7 +61,8 @@ _variables = _support.submodule(_restitution, "fmu.models.sphere_plate_impact.va
 MATERIAL_SELECTORS, TABLE = _variables.MATERIAL_SELECTORS, _variables.TABLE
 resolve_materials = _variables.resolve_materials
 _model = _support.submodule(_restitution, "model")
-PARAMETERS, impact, published = _model.PARAMETERS, _model.impact, _model.published
+PARAMETERS, RECORD, published = _model.PARAMETERS, _model.RECORD, _model.published
+impact_terms, impact_record_at = _model.impact_terms, _model.impact_record_at
 si_only = _support.submodule(_restitution, "quantities").si_only
 departures = _support.submodule(_restitution, "assumptions").departures
 
@@ -69,14 +70,14 @@ departures = _support.submodule(_restitution, "assumptions").departures
 _OUTPUTS = {vtype: tuple(v for v in TABLE.outputs if v.type == vtype) for vtype in ("Real", "Boolean")}
 #: What the outputs of each type read while they are invalid (the last evaluation failed).
 _INVALID = {"Real": (math.nan,) * len(_OUTPUTS["Real"]), "Boolean": (False,) * len(_OUTPUTS["Boolean"])}
-# published values -> the Real outputs in order, one C call
-_real_values = operator.itemgetter(*(v.key for v in _OUTPUTS["Real"]))
-# "valid" is a property of the result, not one of its fields: where it sits among the Boolean outputs,
-# and the getter of the others
-_VALID_AT = [v.key for v in _OUTPUTS["Boolean"]].index("valid")
-_flag_values = operator.itemgetter(*(v.key for v in _OUTPUTS["Boolean"] if v.key != "valid"))
-#: impact() without its unit layer: the FMU's values are SI floats
-_impact_si = si_only(impact)
+# a published record (restitution.model.RECORD) -> the Real outputs in order, the Boolean outputs in order:
+# one C call each
+_real_values = operator.itemgetter(*(RECORD.index(v.key) for v in _OUTPUTS["Real"]))
+_flag_values = operator.itemgetter(*(RECORD.index(v.key) for v in _OUTPUTS["Boolean"]))
+_VALID, _EDGE_CLEAR, _E_NEGATIVE = (RECORD.index(key) for key in ("valid", "edge_clear", "e_negative"))
+#: impact_terms() and impact_record_at() without their unit layer: the FMU's values are SI floats
+_terms_si = si_only(impact_terms)
+_impact_si = si_only(impact_record_at)
 
 #: impact()'s keyword arguments that are Integer choices, and the words their codes stand for
 _CHOICES = {v.name: v for v in TABLE.settable if v.choices is not None and v.name not in MATERIAL_SELECTORS}
@@ -118,7 +119,7 @@ class SpherePlateImpact(Fmi2Slave):
         super().__init__(**kwargs)
         self._values = {}  # name -> current value of every input and parameter
         self._stale = True  # an input or parameter changed since the last evaluation
-        self._call = None  # impact()'s arguments but v, built when a parameter changed
+        self._terms = None  # impact_terms() of the parameters, made when a parameter changed
         self._used = None  # the parameters with each body's material preset applied, when a parameter changed
         self._failure = None  # message of the last evaluation that raised
         self._warned = set()  # the conditions of restitution.assumptions logged (pythonfmu's reset makes a new slave)
@@ -174,7 +175,7 @@ class SpherePlateImpact(Fmi2Slave):
     def _changed(self, name):
         self._stale = True
         if name != "v_approach":
-            self._call = None
+            self._terms = None
             self._used = None
 
     def _output_getter(self, vtype, position):
@@ -237,19 +238,16 @@ class SpherePlateImpact(Fmi2Slave):
         self._stale = False
         v = self._values
         try:
-            if self._call is None:
+            if self._terms is None:
                 used = self._used_values()
-                self._call = (
-                    tuple(float(used[name]) for name in _PHYSICAL),
-                    dict({TABLE.key_of(name): var.word(int(v[name])) for name, var in _CHOICES.items()},
-                         effect_tolerance=float(v["effect_tolerance"]), ode_rtol=float(v["zener.ode_tolerance"]),
-                         plate_edge_distance=float(v["plate.edge_distance"]), validate=False))
-            args, kwargs = self._call
-            result = _impact_si(float(v["v_approach"]), *args, **kwargs)
-            outputs = published(vars(result))  # the result's fields, not copied: neither changes them
+                self._terms = _terms_si(
+                    *(float(used[name]) for name in _PHYSICAL),
+                    **{TABLE.key_of(name): var.word(int(v[name])) for name, var in _CHOICES.items()},
+                    effect_tolerance=float(v["effect_tolerance"]), ode_rtol=float(v["zener.ode_tolerance"]),
+                    plate_edge_distance=float(v["plate.edge_distance"]), validate=False)
+            outputs = published(_impact_si(float(v["v_approach"]), self._terms, False))
             reals = _real_values(outputs)
             flags = _flag_values(outputs)
-            valid = result.valid
         except Exception as exc:  # a numerical failure must not become fmi2Fatal
             self._fail(f"{type(exc).__name__}: {exc}")
             return
@@ -259,9 +257,9 @@ class SpherePlateImpact(Fmi2Slave):
                 self._fail("non-finite output " + ", ".join(bad))
                 return
         self._failure = None
-        self._current = {"Real": reals, "Boolean": flags[:_VALID_AT] + (valid,) + flags[_VALID_AT:]}
-        if not (valid and outputs["edge_clear"] and not outputs["e_negative"]):  # rare: say it once
-            self._log_departures(dict(outputs, valid=valid))
+        self._current = {"Real": reals, "Boolean": flags}
+        if not (outputs[_VALID] and outputs[_EDGE_CLEAR] and not outputs[_E_NEGATIVE]):  # rare: say it once
+            self._log_departures(dict(zip(RECORD, outputs)))
 
     def _log_departures(self, outputs):
         for name, message in departures(outputs):
@@ -295,7 +293,7 @@ class SpherePlateImpact(Fmi2Slave):
         for var in TABLE.settable:
             self._values[var.name] = var.start
         self._stale = True
-        self._call = None
+        self._terms = None
         self._used = None
         self._failure = None
         self._current = dict(_INVALID)
