@@ -98,7 +98,7 @@ static double restitution_e44(double v_star)
 /* lambda / v0^(1/5) [(s/m)^(1/5)], Eq. (12) without its speed factor:
  * pi^(3/5)/sqrt(3) ((d/2)/t)^2 v'^(-1/5) (rho_a/rho_b)^(3/5) (E_a'/(E_a'+E_b'))^(2/5), from the reduced
  * moduli E_a', E_b' [Pa], the densities [kg/m3], d and t [m]; v' = sqrt(E_b'/rho_b) [m/s] (Eq. 11).
- * lambda = lambda_per_speed v0^(1/5) (restitution.zener.lambda_from_terms). */
+ * lambda = lambda_per_speed v0^(1/5) (restitution.zener.lambda_speed_factor and lambda_from_root). */
 static double lambda_per_speed(double Ea, double Eb, double rho_a, double rho_b, double d, double t)
 {
     double r_over_t = 0.5 * d / t;
@@ -262,7 +262,7 @@ static int check_codes(const rst_impact_inputs *in)
     return in->zener_method == RST_ZENER_ODE ? RST_PHYSICS_UNSUPPORTED : RST_PHYSICS_OK;
 }
 
-/* restitution.model._material_terms and the other parameter-only parts of restitution.model._pipeline:
+/* restitution.model._terms (the parameter-only parts of an impact, _material_terms among them):
  * JGM Eqs. (1)-(6), the Hertz stiffness and time unit of Eq. (9) without the speed, Eq. (12) without
  * the speed, the edge echo's travel time. Each C(nu) once (two exp), each reduced modulus once. */
 void rst_impact_terms_of(const rst_impact_inputs *in, rst_impact_terms *terms)

@@ -1,7 +1,7 @@
 /* The SpherePlateImpact model in C99 (libm only): I. Green, Nonlinear Dyn (2022), JGM Eqs. (1)-(8),
  * Zener Eqs. (9)-(13a) and (22), fusion Eqs. (17)-(20).
  *
- * A transcription of the Python package `restitution` (model.py `_pipeline`, jgm.py, zener.py,
+ * A transcription of the Python package `restitution` (model.py `_terms` and `_pipeline`, jgm.py, zener.py,
  * zener_exact.py, fusion.py), which is authoritative: where the two disagree, the C is wrong.
  * The same well-conditioned forms are used (e45 in log space, expm1 deficits 1 - e_ze, the fused
  * COR as a difference of two non-negative terms), so the two agree within each output's
