@@ -15,8 +15,8 @@ A pythonfmu FMU runs in the host's interpreter and imports its bundled ``restitu
 package by name. A worker that already imported ``restitution`` (to run this module) would
 hand the FMU that copy instead. The instance is therefore created with the host's
 ``restitution`` modules set aside, so the FMU imports and keeps its own bundled code; the
-back end checks that the FMU's ``impact`` comes from the extracted FMU and reports the
-bundled code's fingerprint with the results.
+back end checks that the physics the FMU evaluates (``impact_record_at``) comes from the
+extracted FMU and reports the bundled code's fingerprint with the results.
 """
 from __future__ import annotations
 
@@ -154,6 +154,17 @@ class PackageBackend(Backend):
         return (_empty_outputs(n) if out is None else out), {"code": _own_fingerprint(), "pid": os.getpid()}
 
 
+def _impact_input(column, sel) -> np.ndarray | float:
+    """One input of impact() for the cases ``sel`` (None: all) of a case column: a float where the column
+    is a view of one value (SweepSpec.cases gives a sweep's fixed inputs so), which lets impact() compute
+    the terms that depend only on the parameters once for the chunk instead of once per case; else the
+    column's values as float64."""
+    column = np.asarray(column, dtype=float)
+    if column.ndim == 1 and column.size > 1 and column.strides[0] == 0:
+        return float(column[0])
+    return column if sel is None else column[sel]
+
+
 def impact_groups(cases: dict, rows):
     """(rows, impact() input arrays, impact() option keywords) for the ``rows`` of ``cases``,
     grouped by their integer-coded options (one vectorized call per group)."""
@@ -172,7 +183,7 @@ def impact_groups(cases: dict, rows):
     for g, opt in enumerate(groups):
         sel = rows if inverse is None else rows[inverse.ravel() == g]
         whole = inverse is None and every_case
-        inputs = {kw: np.asarray(cases[name], dtype=float) if whole else np.asarray(cases[name], dtype=float)[sel]
+        inputs = {kw: _impact_input(cases[name], None if whole else sel)
                   for name, kw, _t, _s in INPUTS if name not in _OPTION_NAMES}
         yield sel, inputs, {TABLE.key_of(name): (TABLE[name].word(int(x)) if name in CODES else float(x))
                             for name, x in zip(_OPTION_NAMES, opt)}
@@ -316,7 +327,7 @@ def _instantiate_with_bundled_code(slave, unzip_dir: str) -> str:
         try:
             quiet_instantiate(slave)
             fmu_module = sys.modules.get(slave_module) if slave_module else None
-            impact_fn = getattr(fmu_module, "impact", None)
+            impact_fn = getattr(fmu_module, "impact_record_at", None)  # what the slave evaluates at each step
             impact_fn = inspect.unwrap(impact_fn) if impact_fn is not None else None  # past the unit layer
             code_file = getattr(getattr(impact_fn, "__code__", None), "co_filename", None)
         finally:
@@ -326,7 +337,7 @@ def _instantiate_with_bundled_code(slave, unzip_dir: str) -> str:
             sys.path[:] = path_before  # pythonfmu prepends resources/; the FMU's modules are loaded
     if code_file is None or not os.path.realpath(code_file).startswith(os.path.realpath(resources) + os.sep):
         raise RuntimeError(f"the FMU in {unzip_dir} does not run its bundled restitution package "
-                           f"(impact() comes from {code_file})")
+                           f"(impact_record_at() comes from {code_file})")
     return code_file
 
 
