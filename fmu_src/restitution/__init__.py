@@ -12,7 +12,7 @@ from .jgm import (critical_velocity, effective_modulus, poisson_coefficient, res
 from .materials import (BRITTLE_SY, MATERIALS, TABLE1_CASES, TABLE4_CASES, Material, Plate, Sphere,
                         table4_case)
 from .quantities import with_units
-from .model import EFFECT_MODES, RESTITUTION_MODELS, ImpactResult, impact
+from .model import EFFECT_MODES, RESTITUTION_MODELS, ImpactResult, ImpactTerms, impact, impact_at, impact_terms
 from .zener import (TAU0_HERTZ, ZENER_METHODS, inelasticity_parameter, zener_linear, zener_paper_fit,
                     zener_restitution)
 
@@ -24,7 +24,7 @@ def impact_between(sphere: Sphere, plate: Plate, v, **options) -> ImpactResult:
 
 
 __all__ = [
-    "impact", "impact_between", "ImpactResult", "Material", "Sphere", "Plate", "MATERIALS",
+    "impact", "impact_between", "impact_terms", "impact_at", "ImpactResult", "ImpactTerms", "Material", "Sphere", "Plate", "MATERIALS",
     "TABLE1_CASES", "TABLE4_CASES", "table4_case", "BRITTLE_SY", "RESTITUTION_MODELS",
     "ZENER_METHODS", "EFFECT_MODES", "TAU0_HERTZ", "apparent_restitution", "equivalent_plate_mass",
     "velocities_after_impact", "critical_velocity", "effective_modulus", "poisson_coefficient",

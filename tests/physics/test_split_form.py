@@ -130,3 +130,20 @@ def test_the_split_form_checks_its_inputs_as_impact_does():
     with pytest.raises(TypeError, match="ImpactTerms"):
         impact_at(1.0, tuple(terms)[2:])
     assert isinstance(impact_at(1.0, terms, validate=False), ImpactResult)
+
+
+def test_the_package_exports_the_split_for_bodies_and_quantities_with_units():
+    """restitution.impact_terms / impact_at as docs/api shows them: the bodies' parameters, speeds in any
+    unit (pint), one terms object for many speeds, each result within conditioning of impact_between."""
+    pint = pytest.importorskip("pint")
+    Q_ = pint.get_application_registry().Quantity
+
+    sphere = r.Sphere(r.MATERIALS["s2_tool_steel"], d=6.35e-3)
+    plate = r.Plate(r.MATERIALS["al_6061"], t=3e-3)
+    terms = r.impact_terms(**sphere.params(), **plate.params())
+    assert isinstance(terms, r.ImpactTerms)
+    params = {**sphere.params(), **plate.params()}
+    for v in (0.0, 0.3, 2.0, 7.5):
+        assert_agree(r.impact_between(sphere, plate, v), r.impact_at(v, terms), v, params, f"v = {v}")
+        in_kmh = r.impact_at(Q_(v * 3.6, "km/h"), terms)
+        assert_agree(r.impact_between(sphere, plate, v), in_kmh, v, params, f"v = {v * 3.6} km/h")
