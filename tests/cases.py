@@ -69,6 +69,15 @@ def random_cases(rng, n):
     return v, params
 
 
+def random_preset_bodies(rng):
+    """(sphere material, plate material, d [m], t [m]) drawn from ``rng``: two presets, a sphere from 0.3 mm
+    to 30 mm, a plate from 1/30 to 10 sphere diameters (thin plates reach lambda > 1.5 and lambda >= 2)."""
+    mats = list(r.MATERIALS.values())
+    a, b = mats[rng.integers(len(mats))], mats[rng.integers(len(mats))]
+    d = 10 ** rng.uniform(-3.5, -1.5)
+    t = d * 10 ** rng.uniform(-1.5, 1.0)
+    return a, b, d, t
+
 def log_uniform(low, high):
     """Floats spread evenly in log10 between low > 0 and high, with both ends as likely examples."""
     return st.one_of(st.sampled_from([low, high]),

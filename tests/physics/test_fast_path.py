@@ -6,10 +6,10 @@ import math
 import numpy as np
 import pytest
 
-import restitution as r
 from restitution.model import ImpactResult, impact
 
 from agree import assert_agree, stack
+from cases import random_preset_bodies
 
 FLAGS = {"plasticity_used", "plate_waves_used", "lambda_in_range", "vstar_in_range", "e_negative", "valid",
          "contact_ends", "concurrent", "edge_clear"}
@@ -17,11 +17,8 @@ FLAGS = {"plasticity_used", "plate_waves_used", "lambda_in_range", "vstar_in_ran
 
 def _cases(n, seed=5):
     rng = np.random.default_rng(seed)
-    mats = list(r.MATERIALS.values())
     for k in range(n):
-        a, b = mats[rng.integers(len(mats))], mats[rng.integers(len(mats))]
-        d = 10 ** rng.uniform(-3.5, -1.5)
-        t = d * 10 ** rng.uniform(-1.5, 1.0)
+        a, b, d, t = random_preset_bodies(rng)
         v = 0.0 if k % 17 == 0 else 10 ** rng.uniform(-4, 2.5)
         args = (float(v), a.E, a.nu, a.Sy, a.rho, float(d), b.E, b.nu, b.Sy, b.rho, float(t))  # rho: int
         options = dict(restitution_model=("e45", "e44")[rng.integers(2)],

@@ -14,6 +14,7 @@ from restitution.model import (RECORD, RECORD_FLAGS, RECORD_REALS, ImpactResult,
                                impact_record_at, impact_terms, published)
 
 from agree import assert_agree, stack
+from cases import random_preset_bodies
 
 NAMES = ("sphere_E", "sphere_nu", "sphere_Sy", "sphere_rho", "sphere_d",
          "plate_E", "plate_nu", "plate_Sy", "plate_rho", "plate_t")
@@ -30,11 +31,8 @@ def _parameter_sets(n, seed):
     """Random material pairs (the presets), spheres from 0.3 mm to 30 mm, plates from 1/30 to 10 sphere
     diameters (thin plates reach lambda > 1.5, and lambda >= 2), edges: unbounded (0 or inf) or bounded."""
     rng = np.random.default_rng(seed)
-    mats = list(r.MATERIALS.values())
     for k in range(n):
-        a, b = mats[rng.integers(len(mats))], mats[rng.integers(len(mats))]
-        d = 10 ** rng.uniform(-3.5, -1.5)
-        t = d * 10 ** rng.uniform(-1.5, 1.0)
+        a, b, d, t = random_preset_bodies(rng)
         params = dict(zip(NAMES, map(float, (a.E, a.nu, a.Sy, a.rho, d, b.E, b.nu, b.Sy, b.rho, t))))
         edge = (0.0, math.inf, float(d * 10 ** rng.uniform(-1, 3)))[k % 3]
         yield params, edge

@@ -35,7 +35,7 @@ import numpy as np
 from ..cosim.fmu import FmiStatusError, quiet_instantiate
 from ..fmu.models.sphere_plate_impact.variables import TABLE
 from ..model import PARAMETERS
-from .spec import CODES, INPUTS, INTEGER_INPUTS, OUTPUTS, SETTABLE
+from .spec import CODES, INPUTS, INTEGER_INPUTS, OUTPUTS, SETTABLE, is_one_value_view
 
 __all__ = ["Backend", "PackageBackend", "FmuBackend", "get_backend", "code_fingerprint", "release_fmus"]
 
@@ -93,7 +93,7 @@ def inputs_ok(cases: dict) -> np.ndarray:
     with np.errstate(invalid="ignore"):
         for var in SETTABLE:
             x = np.asarray(cases[var.name], dtype=float)
-            constant = x.ndim == 0 or (x.ndim == 1 and x.size > 1 and x.strides[0] == 0)
+            constant = x.ndim == 0 or is_one_value_view(x)
             if constant:  # one value for every case
                 x = x.reshape(-1)[:1]
             low, high, low_open, high_open = var.interval
@@ -160,7 +160,7 @@ def _impact_input(column, sel) -> np.ndarray | float:
     the terms that depend only on the parameters once for the chunk instead of once per case; else the
     column's values as float64."""
     column = np.asarray(column, dtype=float)
-    if column.ndim == 1 and column.size > 1 and column.strides[0] == 0:
+    if is_one_value_view(column):
         return float(column[0])
     return column if sel is None else column[sel]
 

@@ -126,6 +126,13 @@ def _section(section: str):
         raise
 
 
+def is_one_value_view(column: np.ndarray) -> bool:
+    """Whether ``column`` (1-d, more than one case) is a view of one value (stride 0), as
+    :meth:`SweepSpec.cases` gives a column that holds one value over its range: what can be checked,
+    sent and evaluated once for the whole range."""
+    return column.ndim == 1 and column.size > 1 and column.strides[0] == 0
+
+
 @dataclass
 class SweepSpec:
     """A grid and/or random sample over FMU inputs/parameters (see the module docstring).

@@ -9,7 +9,8 @@ from pathlib import Path
 import numpy as np
 
 from ..output_files import atomic_write as write_atomic
-from .spec import INPUT_NAMES, INTEGER_INPUTS, OUTPUT_NAMES, OUTPUTS as _OUTPUT_TYPES, T_OVER_D, SweepSpec
+from .spec import (INPUT_NAMES, INTEGER_INPUTS, OUTPUT_NAMES, OUTPUTS as _OUTPUT_TYPES, T_OVER_D, SweepSpec,
+                   is_one_value_view)
 
 __all__ = ["COLUMNS", "VALIDITY", "SweepResult", "PackedColumns", "read_table", "table_counts", "assemble",
            "keep_columns", "write_atomic", "write_csv_rows", "chunk_table", "pair_codes"]
@@ -58,7 +59,7 @@ class PackedColumns:
         arrays, offset = [], 0
         for name, col in columns.items():
             col = np.asarray(col).reshape(-1)
-            if col.size > 1 and col.strides[0] == 0:  # a view of one value (SweepSpec.cases): sent as it
+            if is_one_value_view(col):  # sent as its value
                 col, constant = col[:1].copy(), True
             else:
                 col = np.ascontiguousarray(col)
@@ -289,7 +290,7 @@ def chunk_table(spec: SweepSpec, columns: dict | None, keep):
             continue
         col = np.empty(0, _column_type(name)) if columns is None else np.asarray(columns[name])
         want = np.dtype(_column_type(name))
-        if col.ndim == 1 and col.size > 1 and col.strides[0] == 0:  # a one-value view: the same array each chunk
+        if is_one_value_view(col):  # the same array each chunk
             arrays.append(_constant_array(col[:1].astype(want), col.size))
             continue
         if col.dtype != want or not col.flags.c_contiguous:  # an integer input held as float
