@@ -227,6 +227,33 @@ def test_serial_interrupt_keeps_finished_chunks_and_resume_completes(tmp_path):
         run_sweep(other, scheduler="serial", parts=tmp_path / "p", resume=True)
 
 
+@pytest.mark.parametrize("backend", ["package", "fmu"])
+def test_ctrl_c_just_after_a_part_is_written_keeps_that_chunk_in_the_table(tmp_path, monkeypatch, backend,
+                                                                            impact_fmu):
+    """A real SIGINT sent the moment the third part file is on disk, before the run records the chunk as
+    done (the window where a CI run's interrupted table had 11 chunks and its parts directory 12): the
+    interrupted table has every chunk whose part exists, and the statistics saw the same chunks."""
+    from restitution.sweep.parts import PartStore
+
+    write = PartStore.write
+
+    def write_then_ctrl_c(self, a, b, part):
+        write(self, a, b, part)
+        if a == 200:
+            os.kill(os.getpid(), signal.SIGINT)
+
+    monkeypatch.setattr(PartStore, "write", write_then_ctrl_c)
+    spec = SweepSpec(pairs=["s2_tool_steel/al_6061"], grid={"v": "geomspace:0.1:10:10", "t/d": "0.2,1,5"},
+                     random={"sphere.E": {"normal_rel": 0.05}}, samples=20, seed=4)
+    seen = []
+    with pytest.raises(SweepInterrupted) as info:
+        run_sweep(spec, backend, fmu=impact_fmu if backend == "fmu" else None, scheduler="serial",
+                  chunk_size=100, parts=tmp_path / "p", on_chunk=lambda a, b, columns: seen.append(a))
+    on_disk = sorted(int(f.name.split("-")[1]) for f in (tmp_path / "p").glob("chunk-*.parquet"))
+    assert on_disk == [0, 100, 200] and seen == on_disk
+    assert np.array_equal(info.value.result["case"], np.arange(300))
+
+
 def test_cli_resume_on_another_sweeps_chunks_is_one_line_error(tmp_path):
     run_sweep(SweepSpec(grid={"v": "1,2,3"}), scheduler="serial", parts=tmp_path / "s.csv.parts" / "package")
     proc = _cli("--grid", "v=1,2,4", "--resume", "--scheduler", "serial", "--no-plot", "--out", str(tmp_path / "s.csv"))

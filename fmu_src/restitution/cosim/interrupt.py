@@ -11,16 +11,22 @@ class DeferredInterrupt:
     """SIGINT held back while the FMU runs: the handler only notes it, and the master raises
     KeyboardInterrupt between FMU calls (:meth:`check`). A KeyboardInterrupt raised inside a
     pythonfmu FMU's callback would end as fmi2Fatal and lose the drop in progress and the instance;
-    a second Ctrl-C interrupts at once. Only in the main thread (elsewhere signals are not ours)."""
+    a second Ctrl-C interrupts at once. Only in the main thread (elsewhere signals are not ours).
 
-    def __init__(self):
+    By default it takes Ctrl-C over only from Python's own handler; ``over_any_handler=True`` takes it
+    over from any Python handler (another DeferredInterrupt's included) for a step that must not be
+    cut in two, such as writing a finished chunk and recording it as done."""
+
+    def __init__(self, over_any_handler: bool = False):
         self.pending = False
         self.previous = None
+        self.over_any_handler = over_any_handler
 
     def __enter__(self):
-        if threading.current_thread() is threading.main_thread() and \
-                signal.getsignal(signal.SIGINT) is signal.default_int_handler:
-            self.previous = signal.signal(signal.SIGINT, self._note)
+        if threading.current_thread() is threading.main_thread():
+            current = signal.getsignal(signal.SIGINT)
+            if current is signal.default_int_handler or (self.over_any_handler and callable(current)):
+                self.previous = signal.signal(signal.SIGINT, self._note)
         return self
 
     def _note(self, signum, frame):

@@ -278,13 +278,19 @@ class _Run:
         self.t0 = time.perf_counter()
 
     def finished(self, a, b, part):
+        """Chunk ``a`` ... ``b - 1`` written, shown to ``on_chunk`` and recorded as done, with Ctrl-C
+        held until all three are: cut in between, the interrupted table left out a chunk whose part
+        was on disk (or the statistics a chunk that the table has)."""
         columns, info = part
         plain = columns.columns() if isinstance(columns, PackedColumns) else columns  # views: no copy
-        if self.store is not None:
-            self.store.write(a, b, (plain, info))
-        if self.on_chunk is not None:
-            self.on_chunk(a, b, plain)
-        self.done[a] = (columns if self.in_memory else None, info)
+        held = DeferredInterrupt(over_any_handler=True)
+        with held:
+            if self.store is not None:
+                self.store.write(a, b, (plain, info))
+            if self.on_chunk is not None:
+                self.on_chunk(a, b, plain)
+            self.done[a] = (columns if self.in_memory else None, info)
+        held.check()
 
     def result(self) -> SweepResult:
         """The table of the finished chunks (their columns are consumed: call once)."""
