@@ -89,3 +89,42 @@ def test_assemble_keeps_the_asked_columns_with_their_types():
     assert np.array_equal(table["zener_method"], cols["zener_method"].astype(np.int64))
     empty = assemble(SPEC, [], keep)
     assert set(empty) == set(keep) and all(len(c) == 0 for c in empty.values())
+
+
+ONE_PAIR = SweepSpec(pairs=["s2_tool_steel/al_6061"], grid={"v_approach": {"geomspace": [0.05, 20.0, 30]},
+                                                            "t_over_d": {"geomspace": [0.05, 10.0, 20]}})
+
+
+def _evaluated(spec, a, b):
+    cols = spec.cases(a, b)
+    cols.update(PackageBackend().evaluate(cols)[0])
+    return cols
+
+
+@pytest.mark.parametrize("chunks", [1, 3])
+@pytest.mark.parametrize("packed", [False, True])
+def test_assemble_keeps_fixed_inputs_as_views_and_owns_every_other_column(chunks, packed):
+    """Inputs that hold one value over the whole sweep (here one pair's materials and the fixed options,
+    found from the values themselves) are read-only one-value views; outputs and varying inputs are
+    writable arrays, none sharing memory with another column; the values are the chunks' own, bit for bit."""
+    n, bounds = ONE_PAIR.n_cases, np.linspace(0, ONE_PAIR.n_cases, chunks + 1).astype(int)
+    own = [_evaluated(ONE_PAIR, a, b) for a, b in zip(bounds[:-1], bounds[1:])]
+    expected = {name: np.concatenate([np.array(c[name]) for c in own]) for name in own[0]}
+    table = assemble(ONE_PAIR, [PackedColumns(c) if packed else c for c in own], None)
+    outputs = set(COLUMNS[COLUMNS.index("t_over_d") + 1:])
+    owned = []
+    for name in COLUMNS:
+        col = table[name]
+        if name == "pair":
+            assert list(col) == ["s2_tool_steel/al_6061"] * n
+        else:
+            assert _same_bits(col, expected[name].astype(col.dtype)), name
+        constant = name not in outputs and np.all(col == col[0])
+        assert (col.strides == (0,)) == constant, name  # a view exactly where the input is fixed
+        assert col.flags.writeable != constant, name
+        if not constant:
+            owned.append(name)
+    assert {"v_approach", "t_over_d", "e", "jgm.V_c"} <= set(owned) and "sphere.E" not in owned
+    for i, a in enumerate(owned):
+        for b in owned[i + 1:]:
+            assert not np.shares_memory(table[a], table[b]), (a, b)

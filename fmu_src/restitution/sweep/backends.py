@@ -116,6 +116,8 @@ class Backend:
     name = "backend"
     #: Cases per Dask task when the caller does not choose (about a second of work).
     default_chunk = 10_000
+    #: Cases per chunk of a serial sweep whose table stays in memory only (no parts on disk).
+    in_memory_chunk = 10_000
 
     def payload(self):
         """What each task needs besides the cases (sent to the workers once)."""
@@ -135,6 +137,9 @@ class PackageBackend(Backend):
 
     name = "package"
     default_chunk = 100_000
+    #: a serial sweep kept in memory only: up to 10^6 cases are one chunk, whose arrays become the table
+    #: without a copy (assemble); impact()'s temporaries for them peak near the table's own size
+    in_memory_chunk = 1_000_000
 
     def evaluate(self, cases: dict, payload=None, outputs=None):
         from ..model import impact, published

@@ -303,7 +303,7 @@ class SweepSpec:
         -1 without pairs), every FMU input/parameter by name, and ``t_over_d``.
 
         A column that holds one value for every case of the range (a start value, a fixed parameter,
-        a material constant where the range has one pair) is a read-only view of that value
+        a material constant and ``pair`` where the range has one pair) is a read-only view of that value
         (``numpy.broadcast_to``): no memory is written for it, and the table is filled from the value."""
         n = self.n_cases
         stop = n if stop is None else min(int(stop), n)
@@ -331,6 +331,8 @@ class SweepSpec:
             for k in values[0]:
                 by_pair = np.array([v[k] for v in values], dtype=float)
                 cols[k] = float(by_pair[pair[0]]) if one_pair else by_pair[pair]
+            if one_pair:  # like the pair's constants: a view of its one value
+                pair = np.broadcast_to(pair[:1], index.shape)
         t_over_d = None
         for k, v in coords.items():
             if k == T_OVER_D:

@@ -95,25 +95,72 @@ def _column_type(name: str):
 def assemble(spec: SweepSpec, parts: list, keep) -> dict:
     """The table from consecutive chunks (each a dict of columns or a :class:`PackedColumns`).
 
-    ``parts`` is consumed: each chunk is dropped once copied into the table, whose columns are
-    allocated at their final types and filled chunk by chunk, so the memory in use stays near one
-    table (the chunks not yet copied plus the rows filled)."""
+    An input that holds one value over the whole sweep (a fixed parameter, a single pair's materials,
+    ``pair`` itself then) stays a read-only view of that value (:func:`~restitution.sweep.spec.is_one_value_view`):
+    no memory, as in the chunks. A single chunk's own arrays become the table's columns (no copy). Otherwise
+    ``parts`` is consumed: each chunk is dropped once copied into the table, whose columns are allocated at
+    their final types and filled chunk by chunk, so the memory in use stays near one table (the chunks not
+    yet copied plus the rows filled)."""
     names = [c for c in COLUMNS if keep is None or c in keep]
     n = sum(part.rows if isinstance(part, PackedColumns) else int(np.size(part["case"])) for part in parts)
-    columns = {name: np.empty(n, dtype=_column_type(name)) for name in names}
-    parts.reverse()
-    row = 0
-    while parts:
-        part = parts.pop()
-        chunk = part.columns() if isinstance(part, PackedColumns) else part
-        end = row + int(np.size(chunk["case"]))
+    chunks = [part.columns() if isinstance(part, PackedColumns) else part for part in parts]
+    columns = {name: _one_value_column(name, chunks, n) for name in names}
+    if len(parts) == 1:
         for name in names:
-            columns[name][row:end] = chunk[name]
-        row = end
-        del part, chunk
+            if columns[name] is None:
+                columns[name] = _own_column(chunks[0][name], _column_type(name), isinstance(parts[0], PackedColumns))
+        parts.clear()
+    else:
+        copied = [name for name in names if columns[name] is None]
+        columns.update((name, np.empty(n, dtype=_column_type(name))) for name in copied)
+        del chunks
+        parts.reverse()
+        row = 0
+        while parts:
+            part = parts.pop()
+            chunk = part.columns() if isinstance(part, PackedColumns) else part
+            end = row + int(np.size(chunk["case"]))
+            for name in copied:
+                columns[name][row:end] = chunk[name]
+            row = end
+            del part, chunk
     labels = np.array(list(spec.pairs) + [""], dtype=object)  # pair -1 (no pairs) reads ""
-    columns["pair"] = labels[columns["pair"]]
+    pair = columns["pair"]
+    columns["pair"] = (np.broadcast_to(labels[pair[:1]], (n,)) if is_one_value_view(pair) else labels[pair])
     return columns
+
+
+#: The columns that may stay one-value views in a table: the inputs (what the spec fixes), never an output.
+_VIEW_COLUMNS = frozenset(("pair", *INPUT_NAMES, T_OVER_D))
+
+
+def _one_value_column(name, chunks, n):
+    """``name``'s column as a read-only view of one value when it is an input that every chunk holds as a
+    view of the same value (bit for bit); else None."""
+    if name not in _VIEW_COLUMNS or n < 2:
+        return None
+    dtype, value = _column_type(name), None
+    for chunk in chunks:
+        col = chunk[name]
+        if not is_one_value_view(col):
+            return None
+        first = np.asarray(col[:1], dtype=dtype)
+        if value is None:
+            value = first
+        elif value.tobytes() != first.tobytes():
+            return None
+    return np.broadcast_to(value, (n,))
+
+
+def _own_column(col, dtype, packed: bool):
+    """A chunk's column as a table column without a copy where it can be one: a writable, contiguous
+    array of the table's type that no other column shares (an array the chunk owns, or a column of a
+    packed chunk's buffer, where each column has its own bytes); else a copy."""
+    col = np.asarray(col)
+    if (col.dtype == dtype and col.flags.c_contiguous and col.flags.writeable
+            and (col.flags.owndata or packed) and col.strides[0] != 0):
+        return col
+    return np.array(col, dtype=dtype)
 
 
 def keep_columns(columns):
@@ -127,7 +174,11 @@ def keep_columns(columns):
 
 @dataclass
 class SweepResult:
-    """The table of a sweep (``columns``: name -> array, in :data:`COLUMNS` order) and how it ran."""
+    """The table of a sweep (``columns``: name -> array, in :data:`COLUMNS` order) and how it ran.
+
+    An input that holds one value over the whole sweep (a fixed parameter; with one pair, its materials
+    and ``pair``) is a read-only view of that value, which takes no memory (``numpy.array(col)`` gives a
+    writable copy); every other column is an array of its own."""
 
     columns: dict
     spec: SweepSpec
