@@ -32,6 +32,7 @@
 
 #include "fmi2FunctionTypes.h"
 #include "fmi3FunctionTypes.h"
+#include "load_symbol.h"
 
 #define MAX_FMUS 4
 #define MAX_SETTINGS 8
@@ -121,13 +122,6 @@ static void *symbol(const fmu *f, const char *name)
         fail(f, name);
     return p;
 }
-
-/* a function pointer from dlsym without the object-to-function pointer cast ISO C forbids */
-#define LOAD(target, name)                 \
-    do {                                   \
-        void *p_ = symbol(f, name);        \
-        memcpy(&(target), &p_, sizeof p_); \
-    } while (0)
 
 static void load(fmu *f)
 {

@@ -9,6 +9,7 @@
 #include "fmi2FunctionTypes.h"
 #include "fmi3FunctionTypes.h"
 #include "precomputed_floor.h"
+#include "load_symbol.h"
 
 #define MAX_FMUS 8
 #define MAX_VRS 64
@@ -81,13 +82,6 @@ static void *symbol(fmu *f, const char *name)
     }
     return p;
 }
-
-/* a function pointer from dlsym without the object-to-function pointer cast ISO C forbids */
-#define LOAD(target, name)                  \
-    do {                                    \
-        void *p_ = symbol(f, name);         \
-        memcpy(&(target), &p_, sizeof p_);  \
-    } while (0)
 
 static fmi2ValueReference vr_v, vr_reals[MAX_VRS], vr_bools[MAX_VRS];
 static size_t n_reals, n_bools;
