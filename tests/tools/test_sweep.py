@@ -334,3 +334,18 @@ def test_a_dask_sweep_keeps_few_chunks_in_flight(cluster, monkeypatch):
     assert len(seen) == 40 and max(seen) <= sweep_run.IN_FLIGHT_PER_WORKER * 2
     expected = run_sweep(spec, "package", scheduler="serial")
     assert np.array_equal(result.columns["e"], expected.columns["e"])
+
+
+def test_serial_in_memory_chunks_are_the_back_ends_own_unless_it_names_bigger_ones(tmp_path):
+    """A serial sweep kept in memory takes the back end's ``in_memory_chunk`` cases at a time (the package's:
+    10^6, so a small sweep is one chunk); a back end without one keeps its ``default_chunk``, as does any
+    sweep that writes its chunks to disk."""
+    from restitution.sweep.backends import PackageBackend
+
+    class SmallChunks(PackageBackend):
+        default_chunk, in_memory_chunk = 7, None
+
+    spec = SweepSpec(pairs=["s2_tool_steel/al_6061"], grid={"v_approach": [0.5, 1, 2, 3, 4], "t_over_d": [0.5, 1, 2, 4]})
+    assert run_sweep(spec, "package", scheduler="serial").n_chunks == 1
+    assert run_sweep(spec, SmallChunks(), scheduler="serial").n_chunks == 3  # 20 cases, 7 at a time
+    assert run_sweep(spec, SmallChunks(), scheduler="serial", parts=tmp_path / "p").n_chunks == 3

@@ -116,8 +116,9 @@ class Backend:
     name = "backend"
     #: Cases per Dask task when the caller does not choose (about a second of work).
     default_chunk = 10_000
-    #: Cases per chunk of a serial sweep whose table stays in memory only (no parts on disk).
-    in_memory_chunk = 10_000
+    #: Cases per chunk of a serial sweep whose table stays in memory only (no parts on disk); None:
+    #: :attr:`default_chunk`.
+    in_memory_chunk = None
 
     def payload(self):
         """What each task needs besides the cases (sent to the workers once)."""

@@ -92,8 +92,8 @@ def run_sweep(spec: SweepSpec | dict, backend: str | Backend = "package", *, fmu
     "serial" (no Dask: one loop in this process, for reference and debugging).
     ``chunk_size``: cases per task (default: the back end's, at most a quarter of each worker's
     share so the work spreads and progress moves; a serial package sweep kept in memory only takes up
-    to 10^6 cases at a time, and a table of one chunk is that chunk's arrays, not a copy). ``progress``: a progress line on stderr
-    (redrawn in a terminal; elsewhere only the final state). ``columns``: keep only these
+    to 10^6 cases at a time, and a table of one chunk is that chunk's arrays, not a copy).
+    ``progress``: a progress line on stderr (redrawn in a terminal; elsewhere only the final state). ``columns``: keep only these
     columns (besides ``case``, ``pair``, ``ok`` and the validity flags, which every table has), for
     sweeps whose full table would be too big to gather. ``release=False`` keeps the FMU instances
     loaded in the workers for the next sweep (free them with ``client.run(release_fmus)``).
@@ -125,8 +125,8 @@ def run_sweep(spec: SweepSpec | dict, backend: str | Backend = "package", *, fmu
 
     if scheduler == "serial":
         default = backend.default_chunk
-        if store is None and in_memory:  # nothing goes to disk: chunks only pace the progress and bound memory
-            default = max(default, backend.in_memory_chunk)
+        if store is None and in_memory and backend.in_memory_chunk:  # nothing on disk: chunks only pace the
+            default = backend.in_memory_chunk                            # progress and bound the memory
         chunk_size = _chunk_size(store, resume, chunk_size or default)
         chunks = _chunks(n, chunk_size)
         run.open(chunk_size, resume, len(chunks), "this process (serial)", 1)

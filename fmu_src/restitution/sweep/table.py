@@ -103,27 +103,24 @@ def assemble(spec: SweepSpec, parts: list, keep) -> dict:
     yet copied plus the rows filled)."""
     names = [c for c in COLUMNS if keep is None or c in keep]
     n = sum(part.rows if isinstance(part, PackedColumns) else int(np.size(part["case"])) for part in parts)
+    packed = len(parts) == 1 and isinstance(parts[0], PackedColumns)
     chunks = [part.columns() if isinstance(part, PackedColumns) else part for part in parts]
+    parts.clear()  # each chunk's columns (views of a packed buffer) now hold what it holds
     columns = {name: _one_value_column(name, chunks, n) for name in names}
-    if len(parts) == 1:
-        for name in names:
-            if columns[name] is None:
-                columns[name] = _own_column(chunks[0][name], _column_type(name), isinstance(parts[0], PackedColumns))
-        parts.clear()
+    copied = [name for name in names if columns[name] is None]
+    if len(chunks) == 1:
+        columns.update((name, _own_column(chunks[0][name], _column_type(name), packed)) for name in copied)
     else:
-        copied = [name for name in names if columns[name] is None]
         columns.update((name, np.empty(n, dtype=_column_type(name))) for name in copied)
-        del chunks
-        parts.reverse()
+        chunks.reverse()
         row = 0
-        while parts:
-            part = parts.pop()
-            chunk = part.columns() if isinstance(part, PackedColumns) else part
+        while chunks:
+            chunk = chunks.pop()
             end = row + int(np.size(chunk["case"]))
             for name in copied:
                 columns[name][row:end] = chunk[name]
             row = end
-            del part, chunk
+            del chunk
     labels = np.array(list(spec.pairs) + [""], dtype=object)  # pair -1 (no pairs) reads ""
     pair = columns["pair"]
     columns["pair"] = (np.broadcast_to(labels[pair[:1]], (n,)) if is_one_value_view(pair) else labels[pair])
