@@ -73,6 +73,31 @@ def test_cases_do_not_depend_on_chunking_and_are_reproducible():
     assert np.allclose(whole["t_over_d"], whole["plate.t"] / 6.35e-3)
 
 
+def test_draws_are_each_blocks_own_generator_in_the_specs_order():
+    """What the docs promise about the draws, computed here with numpy's distributions directly: case
+    block b (RANDOM_BLOCK cases) draws from default_rng([seed, b]), each random input in the spec's
+    order drawing a whole block, with rng.uniform, rng.standard_normal and rng.integers. Compared to
+    a few ulps (the sweep applies the parameters to a whole range at once; the same operations)."""
+    random = {"plate.Sy": "uniform_rel:0.15", "plate.t": "uniform:1mm:5mm", "v_approach": "normal:2:0.2",
+              "sphere.E": "normal_rel:0.03", "sphere.d": "loguniform:1mm:1cm", "zener_method": "choice:1,3"}
+    spec = SweepSpec(pairs=["brass_260/al_6061"], random=random, samples=2 * RANDOM_BLOCK + 100, seed=11)
+    brass = r.MATERIALS["brass_260"]
+    start, stop = RANDOM_BLOCK - 50, 2 * RANDOM_BLOCK + 60  # a range across two block boundaries
+    got = spec.cases(start, stop)
+    want = {k: [] for k in random}
+    for b in range(3):
+        rng = np.random.default_rng([11, b])
+        want["plate.Sy"].append(rng.uniform(0.85, 1.15, RANDOM_BLOCK) * r.MATERIALS["al_6061"].Sy)
+        want["plate.t"].append(rng.uniform(1e-3, 5e-3, RANDOM_BLOCK))
+        want["v_approach"].append(2 + 0.2 * rng.standard_normal(RANDOM_BLOCK))
+        want["sphere.E"].append((1 + 0.03 * rng.standard_normal(RANDOM_BLOCK)) * brass.E)
+        want["sphere.d"].append(np.exp(rng.uniform(np.log(1e-3), np.log(1e-2), RANDOM_BLOCK)))
+        want["zener_method"].append(np.array([1.0, 3.0])[rng.integers(0, 2, RANDOM_BLOCK)])
+    for k, blocks in want.items():
+        expected = np.concatenate(blocks)[start:stop]
+        np.testing.assert_allclose(np.asarray(got[k], dtype=float), expected, rtol=4 * np.finfo(float).eps, err_msg=k)
+
+
 def test_one_value_columns_are_read_only_views_and_pairs_split_inside_a_range():
     spec = SweepSpec(pairs=["brass_260/al_6061", "s2_tool_steel/borosilicate_glass"], grid={"v_approach": [0.5, 1, 2]},
                      fixed={"zener_method": "paper_fit"})

@@ -180,7 +180,7 @@ def impact_groups(cases: dict, rows):
     every_case = rows.size == np.size(cases["v_approach"])  # rows is then 0..n-1: no copies needed
     columns = [np.asarray(cases[k], dtype=float) if every_case else np.asarray(cases[k], dtype=float)[rows]
                for k in _OPTION_NAMES]
-    if all((col == col[0]).all() for col in columns):
+    if all(is_one_value_view(col) or (col == col[0]).all() for col in columns):
         # the usual chunk: one choice of options, found without stacking the columns (np.unique sorts
         # the cases: 60 % of a sweep)
         groups, inverse = np.array([[col[0] for col in columns]]), None

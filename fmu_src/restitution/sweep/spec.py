@@ -28,7 +28,7 @@ import numpy as np
 
 from ..fmu.models.sphere_plate_impact.variables import MATERIAL_SELECTORS, TABLE, fmu_values
 from ..materials import MATERIALS, TABLE4_CASES, table4_case
-from .values import (MAX_AXIS_VALUES, ROWS, QuantityError, axis_form, axis_size, draw,  # noqa: F401 (axis_size)
+from .values import (MAX_AXIS_VALUES, ROWS, QuantityError, axis_form, axis_size, draw_standard, from_standard,  # noqa: F401 (axis_size)
                      outside, parse_distribution, parse_values, range_ends, range_size, range_values)
 
 __all__ = ["SweepSpec", "INPUTS", "OUTPUTS", "CODES", "RANDOM_BLOCK", "canonical_name", "load_spec",
@@ -311,7 +311,6 @@ class SweepSpec:
         if not 0 <= start <= stop:
             raise ValueError(f"case range [{start}, {stop}) outside [0, {n})")
         index = np.arange(start, stop, dtype=np.int64)
-        grid_index = index // self.samples
         cols = {name: float(START[name]) for name in INPUT_NAMES}  # a float: one value for the whole range
         for k, v in self._fixed.items():
             if k != T_OVER_D:
@@ -319,7 +318,7 @@ class SweepSpec:
         # Grid coordinates, C order (last axis fastest).
         axes = self.axes
         coords = {}
-        rem = grid_index.copy()
+        rem = (index // self.samples if self.samples > 1 else index.copy()) if axes else None
         for name, values in reversed(list(axes.items())):
             coords[name] = values[rem % values.size]
             rem //= values.size
@@ -362,15 +361,25 @@ class SweepSpec:
         return out
 
     def _random_draws(self, start: int, stop: int) -> dict:
+        """Each random input's draws for cases start ... stop - 1: block b of RANDOM_BLOCK cases comes
+        from its own generator seeded with (seed, b), whatever the chunking; the blocks' standard draws
+        are gathered first and their parameters applied to the whole range at once."""
         first, last = start // RANDOM_BLOCK, (max(stop, start + 1) - 1) // RANDOM_BLOCK
-        parts = {k: [] for k in self._dists}
+        base = {k: np.empty(stop - start, dtype=np.intp if kind == "choice" else float)
+                for k, (kind, _args) in self._dists.items()}
+        block = {k: np.empty(RANDOM_BLOCK, dtype=v.dtype) for k, v in base.items()}
         for b in range(first, last + 1):
             rng = np.random.default_rng([self.seed, b])
             lo = max(start - b * RANDOM_BLOCK, 0)
             hi = min(stop - b * RANDOM_BLOCK, RANDOM_BLOCK)
+            at = b * RANDOM_BLOCK + lo - start
             for k, (kind, args) in self._dists.items():
-                parts[k].append(draw(rng, kind, args, RANDOM_BLOCK)[lo:hi])
-        return {k: np.concatenate(v) if v else np.empty(0) for k, v in parts.items()}
+                whole = hi - lo == RANDOM_BLOCK  # a whole block is drawn into place, a part through a buffer
+                out = base[k][at:at + RANDOM_BLOCK] if whole else block[k]
+                draw_standard(rng, kind, len(args), out)
+                if not whole:
+                    base[k][at:at + hi - lo] = out[lo:hi]
+        return {k: from_standard(kind, args, base[k]) for k, (kind, args) in self._dists.items()}
 
     def describe(self) -> str:
         bits = []

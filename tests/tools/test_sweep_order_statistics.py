@@ -1,0 +1,90 @@
+"""restitution.sweep.order_statistics: the k-th smallest values, exactly as np.partition picks them.
+
+The reference is numpy's own selection (np.partition, a different algorithm: introselect), so every
+comparison is exact equality: selection copies values, it computes none, and the order statistics of
+a given array are unique numbers whatever the method. The data are made to stress what the counting
+into bins relies on: smooth, heavy-tailed, discrete, constant, sorted and reversed values, far
+outliers, a span that overflows a double, ranks at both ends, and a wanted bin crowded enough for a
+nested level.
+"""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from restitution.sweep import order_statistics as osx
+from restitution.sweep.order_statistics import Scratch, order_statistics
+
+N = 200_000  # above the direct-partition size, so that the bins are used
+
+
+def _datasets():
+    rng = np.random.default_rng(20261126)
+    u = rng.random(N)
+    return {
+        "uniform": u,
+        "normal": rng.normal(3.0, 0.2, N),
+        "lognormal sigma 5": rng.lognormal(0.0, 5.0, N),
+        "cauchy": rng.standard_cauchy(N),
+        "one far outlier": np.r_[u, 1e300],
+        "both far ends": np.r_[u * 1e-12 + 1.0, -1e308, 1e308],  # their span overflows to inf
+        "two values": np.r_[np.zeros(N // 2), np.ones(N // 2)],
+        "three codes": rng.integers(0, 3, N).astype(float),
+        "constant": np.full(N, 2.5),
+        "mostly constant": np.r_[np.full(N - 10, 7.0), rng.random(10)],
+        "sorted": np.sort(u),
+        "reversed": np.sort(u)[::-1].copy(),
+        "negative and tiny": -rng.random(N) * 1e-300,
+        "periodic with the sample's stride": np.tile(np.arange(N // osx.SAMPLE, dtype=float), osx.SAMPLE + 1)[:N],
+        "a crowded middle": np.r_[rng.random(N // 2), 0.5 + rng.random(N // 2) * 1e-9],
+    }
+
+
+@pytest.mark.parametrize("name", list(_datasets()))
+def test_the_percentiles_ranks_are_np_partitions(name):
+    values = _datasets()[name]
+    n = values.size
+    before = values.copy()
+    ranks = []
+    for p in (2.5, 50.0, 97.5):
+        below = int(np.floor((n - 1) * p / 100))
+        ranks += [below, min(below + 1, n - 1)]
+    got = order_statistics(values, ranks)
+    assert np.array_equal(got, np.partition(values, ranks)[ranks])
+    assert np.array_equal(values, before)  # left unchanged
+
+
+@pytest.mark.parametrize("name", ["uniform", "cauchy", "one far outlier", "sorted", "three codes"])
+def test_any_ranks_in_any_order_and_the_extremes(name):
+    values = _datasets()[name]
+    n = values.size
+    ranks = [n - 1, 0, 1, n // 3, n // 3, n - 2, n // 2]
+    got = order_statistics(values, ranks, Scratch())
+    assert np.array_equal(got, np.partition(values, ranks)[ranks])
+
+
+def test_one_scratch_serves_arrays_of_every_size_in_turn():
+    rng = np.random.default_rng(7)
+    scratch = Scratch()
+    for n in (300_000, 50_000, 1_000, 120_000):
+        values = rng.gamma(2.0, size=n)
+        ranks = [n // 40, n // 2, n - n // 40]
+        assert np.array_equal(order_statistics(values, ranks, scratch), np.partition(values, ranks)[ranks])
+
+
+def test_a_nested_level_is_exact(monkeypatch):
+    """Fewer bins make each wanted bin hold more than the direct size, so that bin is counted again."""
+    monkeypatch.setattr(osx, "BINS", 8)
+    monkeypatch.setattr(osx, "CROWDED", 1)  # never give up on crowded bins here
+    values = np.random.default_rng(3).random(N)
+    ranks = [5_000, 100_000, 100_001, 195_000]
+    assert np.array_equal(order_statistics(values, ranks), np.partition(values, ranks)[ranks])
+
+
+def test_small_inputs_and_bad_ranks():
+    assert np.array_equal(order_statistics([3.0, 1.0, 2.0], [0, 2]), [1.0, 3.0])
+    assert order_statistics(np.arange(5.0), []).size == 0
+    with pytest.raises(IndexError, match="within 0 .. 4"):
+        order_statistics(np.arange(5.0), [5])
+    with pytest.raises(IndexError):
+        order_statistics(np.arange(5.0), [-1])
