@@ -6,12 +6,14 @@ Plain numpy/scipy functions; nothing here knows about FMI. Start with :func:`imp
 inputs are SI numbers or pint Quantities of any compatible unit (:mod:`restitution.quantities`).
 """
 from .about import VERSION as __version__
+from .domain import DOMAIN, DomainWarning, check_in_domain
 from .fusion import apparent_restitution, equivalent_plate_mass, velocities_after_impact
 from .jgm import (critical_velocity, effective_modulus, poisson_coefficient, restitution_e44,
                   restitution_e45, yield_strain)
 from .materials import (BRITTLE_SY, MATERIALS, TABLE1_CASES, TABLE4_CASES, Material, Plate, Sphere,
                         table4_case)
 from .quantities import with_units
+from .validation import check_nonnegative
 from .model import EFFECT_MODES, RESTITUTION_MODELS, ImpactResult, ImpactTerms, impact, impact_at, impact_terms
 from .zener import (TAU0_HERTZ, ZENER_METHODS, inelasticity_parameter, zener_linear, zener_paper_fit,
                     zener_restitution)
@@ -19,12 +21,15 @@ from .zener import (TAU0_HERTZ, ZENER_METHODS, inelasticity_parameter, zener_lin
 
 @with_units(v="m/s")
 def impact_between(sphere: Sphere, plate: Plate, v, **options) -> ImpactResult:
-    """:func:`impact` for a :class:`Sphere` and a :class:`Plate` at approach speed ``v`` [m/s]."""
+    """:func:`impact` for a :class:`Sphere` and a :class:`Plate` at approach speed ``v`` [m/s] (a number,
+    an array or a pint Quantity), which must lie in the model's domain, 0 to 10 km/s, as the
+    sphere's and the plate's properties do (a ValueError names a value outside it)."""
+    v = check_in_domain("v_approach", "v", check_nonnegative("v_approach", v, "m/s"), "m/s")
     return impact(v, **sphere.params(), **plate.params(), **options)
 
 
 __all__ = [
-    "impact", "impact_between", "impact_terms", "impact_at", "ImpactResult", "ImpactTerms", "Material", "Sphere", "Plate", "MATERIALS",
+    "impact", "impact_between", "DOMAIN", "DomainWarning", "impact_terms", "impact_at", "ImpactResult", "ImpactTerms", "Material", "Sphere", "Plate", "MATERIALS",
     "TABLE1_CASES", "TABLE4_CASES", "table4_case", "BRITTLE_SY", "RESTITUTION_MODELS",
     "ZENER_METHODS", "EFFECT_MODES", "TAU0_HERTZ", "apparent_restitution", "equivalent_plate_mass",
     "velocities_after_impact", "critical_velocity", "effective_modulus", "poisson_coefficient",

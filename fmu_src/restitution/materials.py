@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 
+from .domain import check_in_domain
 from .quantities import to_si
 from .validation import check_poisson, check_positive
 
@@ -35,10 +36,10 @@ class Material:
     def __post_init__(self):
         for field, unit in (("E", "Pa"), ("nu", "dimensionless"), ("Sy", "Pa"), ("rho", "kg/m**3")):
             object.__setattr__(self, field, to_si(f"{self.name}.{field}", getattr(self, field), unit))
-        check_positive(f"{self.name}.E", self.E, "Pa")
+        for field, unit in (("E", "Pa"), ("Sy", "Pa"), ("rho", "kg/m3")):  # a sphere's and a plate's domain alike
+            label = f"{self.name}.{field}"
+            check_in_domain(label, f"sphere_{field}", check_positive(label, getattr(self, field), unit), unit)
         check_poisson(f"{self.name}.nu", self.nu)
-        check_positive(f"{self.name}.Sy", self.Sy, "Pa")
-        check_positive(f"{self.name}.rho", self.rho, "kg/m3")
 
     def params(self, role: str) -> dict:
         """The material's keyword arguments for :func:`restitution.impact` as the ``role``
@@ -56,12 +57,13 @@ class Material:
 class Sphere:
     """Impacting sphere: material and diameter d [m]."""
 
-    material: Material  #: what the sphere is made of
+    material: Material  #: what the sphere is made of (or a preset's name: "chrome_steel")
     d: float  #: diameter [m]
 
     def __post_init__(self):
+        object.__setattr__(self, "material", _material(self.material, "sphere"))
         object.__setattr__(self, "d", to_si("sphere.d", self.d, "m"))
-        check_positive("sphere.d", self.d, "m")
+        check_in_domain("sphere.d", "sphere_d", check_positive("sphere.d", self.d, "m"), "m")
 
     def params(self) -> dict:
         """Keyword arguments for :func:`restitution.impact` (``sphere_*``)."""
@@ -72,12 +74,13 @@ class Sphere:
 class Plate:
     """Target plate: material and thickness t [m]."""
 
-    material: Material  #: what the plate is made of
+    material: Material  #: what the plate is made of (or a preset's name: "al_6061")
     t: float  #: thickness [m]
 
     def __post_init__(self):
+        object.__setattr__(self, "material", _material(self.material, "plate"))
         object.__setattr__(self, "t", to_si("plate.t", self.t, "m"))
-        check_positive("plate.t", self.t, "m")
+        check_in_domain("plate.t", "plate_t", check_positive("plate.t", self.t, "m"), "m")
 
     def params(self) -> dict:
         """Keyword arguments for :func:`restitution.impact` (``plate_*``)."""
@@ -85,6 +88,17 @@ class Plate:
 
     def with_thickness(self, t: float) -> "Plate":
         return replace(self, t=t)
+
+
+def _material(material, role: str) -> Material:
+    """A :class:`Material`, or the preset of that name (a KeyError naming the close ones if there
+    is none); a TypeError, at once, for anything else."""
+    if isinstance(material, Material):
+        return material
+    if isinstance(material, str):
+        return MATERIALS[material]
+    raise TypeError(f"{role}.material = {material!r}: a restitution.Material or a preset's name "
+                    f"(restitution.MATERIALS, e.g. 'chrome_steel')")
 
 
 _T1 = "Green (2022) Table 1"

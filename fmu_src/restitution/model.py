@@ -20,6 +20,7 @@ from . import fusion, jgm, zener
 from ._num import fifth_root, is_scalar, minimum, where
 from .fusion import apparent_restitution, mass_ratio, plate_mass_from_ratio, plate_velocity_after_impact
 from .jgm import restitution_e44, restitution_e45, vstar_in_fit_range
+from .domain import DOMAIN, warn_outside_domain
 from .quantities import si_only, with_units
 from .validation import (check_choice, check_nonnegative, check_nonnegative_or_infinite, check_poisson,
                          check_positive)
@@ -56,19 +57,6 @@ PARAMETERS = (
 )
 
 
-#: The domain the FMUs declare (min/max in modelDescription.xml) and the property tests cover, per
-#: argument of :func:`impact`: (low, high) [SI units of :data:`PARAMETERS`], both included; nu has
-#: its own [0, 0.5). Inside it every output is finite except the documented infinities (m_eff for
-#: e_ze = 1, T at v = 0, the linear method's tau0 and t_contact for lambda >= 2): wide enough for
-#: any solid (foams to osmium, rubber to diamond; BRITTLE_SY = 1e12 Pa included), spheres from
-#: 1 um to 10 m, plates from 0.1 um to 100 m, speeds up to 10 km/s. :func:`impact` itself accepts
-#: any positive value, where intermediate results may leave double range (over- or underflow).
-DOMAIN = {
-    "v": (0.0, 1e4),
-    "sphere_E": (1e5, 1e13), "sphere_Sy": (1e3, 1e13), "sphere_rho": (1.0, 1e5), "sphere_d": (1e-6, 10.0),
-    "plate_E": (1e5, 1e13), "plate_Sy": (1e3, 1e13), "plate_rho": (1.0, 1e5), "plate_t": (1e-7, 100.0),
-}
-
 #: The largest ``edge_echo`` the FMUs and the sweep tables publish [1] (:func:`published`): an unbounded
 #: plate (or no contact) has an infinite echo ratio, and every published output must be finite.
 #: 1e9 contact times is far beyond any echo that matters (the monitor's threshold is 1).
@@ -87,14 +75,27 @@ _PARAMETER_CHECKS = tuple((name, name.replace("_", ".", 1), unit, kind) for name
 
 
 def validate_parameters(**params) -> dict:
-    """Check each parameter named in :data:`PARAMETERS`; ValueError naming the first bad one."""
+    """Check each parameter named in :data:`PARAMETERS`: ValueError naming the first that is not finite
+    and positive (nu: in [0, 0.5]); a :class:`~restitution.domain.DomainWarning` for one outside the
+    model's :data:`~restitution.domain.DOMAIN`, with the unit it was likely meant in."""
     checked = {}
     for name, label, unit, kind in _PARAMETER_CHECKS:
         if kind == "poisson":
             checked[name] = check_poisson(label, params[name])
         else:
-            checked[name] = check_positive(label, params[name], unit)
+            checked[name] = warn_outside_domain(label, name, check_positive(label, params[name], unit), unit,
+                                                stacklevel=_CALLER)
     return checked
+
+
+#: warnings.warn's stacklevel from validate_parameters / check_speed to the code that called impact(),
+#: impact_terms() or impact_at() (through the units wrapper where there is one): the line a warning names
+_CALLER = 4
+
+
+def check_speed(v):
+    """The approach speed [m/s]: ValueError unless finite and >= 0; a DomainWarning above 10 km/s."""
+    return warn_outside_domain("v_approach", "v", check_nonnegative("v_approach", v, "m/s"), "m/s", stacklevel=_CALLER)
 
 
 #: The annotations of :class:`ImpactResult`'s fields: a real (a float, or an array of floats) or a flag
@@ -273,7 +274,11 @@ def impact(v, sphere_E, sphere_nu, sphere_Sy, sphere_rho, sphere_d,
     linear), so tau0 and t_contact stay continuous at the skip threshold. ``ode_rtol`` is the tolerance of ``zener_method="ode"``.
     ``validate=False`` skips the input checks (for callers that already checked).
 
-    Validity is reported, never clipped: ``lambda_in_range`` (<= 1.5), ``vstar_in_range``
+    The equations are computed for any finite positive input. One outside the model's domain (the
+    ranges the FMUs declare and :class:`Material`, :class:`Sphere`, :class:`Plate` and
+    :func:`impact_between` refuse: :data:`restitution.domain.DOMAIN`) gives a
+    :class:`~restitution.domain.DomainWarning` naming the unit it was likely meant in (``sphere_E =
+    114``: did you mean 114 GPa?). Validity is reported, never clipped: ``lambda_in_range`` (<= 1.5), ``vstar_in_range``
     (<= 1000), ``e_negative``, and the monitors of the assumptions: ``wave_delay`` with ``concurrent``
     (<= 1.8136), ``edge_echo`` with ``edge_clear`` (>= 1); docs/assumptions.md. Bad input raises
     ValueError naming the parameter.
@@ -285,7 +290,7 @@ def impact(v, sphere_E, sphere_nu, sphere_Sy, sphere_rho, sphere_d,
     plate_waves = _mode("plate_waves", plate_waves)
     if validate:
         _check_options(restitution_model, zener_method, effect_tolerance, ode_rtol)
-        v = check_nonnegative("v_approach", v, "m/s")
+        v = check_speed(v)
         (sphere_E, sphere_nu, sphere_Sy, sphere_rho, sphere_d, plate_E, plate_nu, plate_Sy, plate_rho,
          plate_t) = validate_parameters(
             sphere_E=sphere_E, sphere_nu=sphere_nu, sphere_Sy=sphere_Sy, sphere_rho=sphere_rho,
@@ -347,7 +352,7 @@ def impact_at(v, terms: ImpactTerms, validate: bool = True) -> ImpactResult:
     if validate:
         if not isinstance(terms, ImpactTerms):
             raise TypeError(f"terms must be an ImpactTerms (made by impact_terms), got {type(terms).__name__}")
-        v = check_nonnegative("v_approach", v, "m/s")
+        v = check_speed(v)
     return _result(_pipeline(v, terms))
 
 
@@ -359,7 +364,7 @@ def impact_record_at(v, terms: ImpactTerms, validate: bool = True) -> tuple:
     if validate:
         if not isinstance(terms, ImpactTerms):
             raise TypeError(f"terms must be an ImpactTerms (made by impact_terms), got {type(terms).__name__}")
-        v = check_nonnegative("v_approach", v, "m/s")
+        v = check_speed(v)
     return _pipeline(v, terms)
 
 

@@ -45,7 +45,7 @@ _NU_DOMAIN = (0.0, 0.5)
 
 
 def domain(name: str) -> tuple[float, float]:
-    """The physical range (low, high) [SI] of the parameter ``name`` (FMU name): :data:`restitution.model.DOMAIN`,
+    """The physical range (low, high) [SI] of the parameter ``name`` (FMU name): :data:`restitution.domain.DOMAIN`,
     and [0, 0.5] for Poisson's ratios."""
     key = KEYS[name]
     return _NU_DOMAIN if key.endswith("_nu") else DOMAIN[key]

@@ -16,7 +16,7 @@ deviance D = -2 log L (noise profiled out analytically, i.e. maximised over).
 
 The fitted quantities are :class:`Coordinate` s: x = ln(value/ref) for the positive quantities (they span
 decades), x = value - ref for Poisson's ratios, bounded by the physical domain
-(:func:`restitution.fit.forward.domain`, :data:`restitution.model.DOMAIN`). :class:`Problem` puts a
+(:func:`restitution.fit.forward.domain`, :data:`restitution.domain.DOMAIN`). :class:`Problem` puts a
 likelihood, the fixed parameters and the fitted coordinates together: x -> residuals, deviance.
 
 A noise-free data set would make S = 0 and D = -inf: S is floored at relative residuals of 1e-12

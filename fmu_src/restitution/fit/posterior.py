@@ -1,7 +1,7 @@
 """The posterior of the model parameters by Markov-chain Monte Carlo (emcee's affine-invariant ensemble
 sampler), on the likelihood of :func:`restitution.fit.estimate.fit_parameters`: :func:`sample_posterior`.
 
-Priors: flat in the fit coordinates over each parameter's physical domain (:data:`restitution.model.DOMAIN`):
+Priors: flat in the fit coordinates over each parameter's physical domain (:data:`restitution.domain.DOMAIN`):
 flat in ln theta for the positive parameters (and for a drop's v_1), flat in nu for Poisson's ratios.
 The likelihood is the one the fit maximises, its noise level profiled out (the maximum over s or sigma_t);
 for a level s with the scale-invariant prior 1/s, marginalising gives the same function of theta up to a

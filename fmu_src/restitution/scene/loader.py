@@ -209,7 +209,7 @@ def _check_keys(ctx: _Ctx, table: dict, where: str, allowed, required=()):
 
 
 def _quantity(ctx, table, where, key, kind, *, positive=True, default=None, domain=None):
-    """``domain``: (low, high) [SI] the FMU accepts (:data:`restitution.model.DOMAIN`), checked here
+    """``domain``: (low, high) [SI] the FMU accepts (:data:`restitution.domain.DOMAIN`), checked here
     so that a value the FMU would reject is a loader error naming the key."""
     full = _join(where, key)
     if key not in table:

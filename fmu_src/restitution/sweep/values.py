@@ -8,7 +8,7 @@ kind is refused naming the input, the unit given and the kind expected. Dimensio
 (``sphere.nu``, tolerances, ``t_over_d``) and relative spreads take plain numbers.
 
 An explicit value outside the input's declared range (the interface table's interval, the FMUs'
-``min``/``max``, :data:`restitution.model.DOMAIN`) is refused by :func:`outside`, with a hint where a
+``min``/``max``, :data:`restitution.domain.DOMAIN`) is refused by :func:`outside`, with a hint where a
 slipped SI prefix explains it (``plate.E = 114 Pa ... did you mean 114 GPa?``).
 """
 from __future__ import annotations
@@ -17,6 +17,7 @@ import math
 
 import numpy as np
 
+from ..domain import number_text, slipped_prefix
 from ..fmu.models.sphere_plate_impact.variables import TABLE
 from ..scene.units import EXAMPLES, QUANTITIES, UnitError, convert_quantity, split_quantity
 
@@ -28,13 +29,6 @@ __all__ = ["QuantityError", "quantity", "quantities", "unit_of", "outside", "par
 ROWS = {v.name: v for v in TABLE.settable}
 #: SI unit (as the interface table writes it) -> the kind of quantity the scene's parser converts to.
 KINDS = {si: kind for kind, si in QUANTITIES.items()}
-#: The prefixed units a slip of an SI prefix suggests: SI unit -> {factor to SI: unit}. A value
-#: outside the range that lands in it times a factor (1e3, 1e6, 1e9 or 1e-3) was likely meant in
-#: that unit (``plate.E = 114`` -> 114 GPa; ``plate.t = 3000`` -> 3000 mm).
-PREFIXED = {"m": {1e-3: "mm"}, "Pa": {1e3: "kPa", 1e6: "MPa", 1e9: "GPa"},
-            "m/s": {1e-3: "mm/s", 1e3: "km/s"}, "kg/m3": {1e3: "g/cm3"}}
-
-
 class QuantityError(ValueError):
     """A value the sweep refuses: not a number, a unit it cannot take, or outside the input's declared
     range. ``name`` is the input, ``section`` where the value was given ("grid", "random", "fixed";
@@ -95,24 +89,11 @@ def quantities(name: str, values, text=None) -> list[float]:
     return [si for si, _ in read]
 
 
-def _format(value: float) -> str:
-    return f"{value:.15g}"
-
-
 def _hint(name: str, value: float) -> str | None:
-    """``"114 GPa"`` where ``value`` (SI, outside the range) lands in it with a slipped SI prefix: of the
-    prefixed units of :data:`PREFIXED` that bring it in, the one nearest (in decades) the input's
-    start value; None where none does."""
-    row, unit = ROWS[name], unit_of(name)
-    start = float(row.start)
-    best = None
-    for factor, prefixed in PREFIXED.get(unit, {}).items():
-        meant = value * factor
-        if meant > 0 < start and row.accepts(meant):
-            distance = abs(math.log10(meant / start))
-            if best is None or distance < best[0]:
-                best = (distance, prefixed)
-    return None if best is None else f"{_format(value)} {best[1]}"
+    """``"114 GPa"`` where ``value`` (SI, outside the range) lands in it with a slipped SI prefix
+    (:func:`restitution.domain.slipped_prefix`, nearest the input's start value); None where none does."""
+    row = ROWS[name]
+    return slipped_prefix(value, unit_of(name), row.accepts, float(row.start))
 
 
 def outside(name: str, value: float) -> str | None:
@@ -130,7 +111,7 @@ def outside(name: str, value: float) -> str | None:
         pass
     unit = unit_of(name)
     suffix = f" {unit}" if unit else ""
-    message = f"{name} = {_format(value)}{suffix} is outside {row.allowed_text()}{suffix}"
+    message = f"{name} = {number_text(value)}{suffix} is outside {row.allowed_text()}{suffix}"
     hint = _hint(name, value) if unit and math.isfinite(value) else None
     return f"{message}: did you mean {hint}?" if hint else message
 

@@ -2,7 +2,7 @@
 
 Inputs and parameters carry :func:`restitution.impact`'s keyword, outputs the field of
 :meth:`restitution.ImpactResult.as_dict` as :func:`restitution.model.published` gives it (every
-output finite). Ranges are the package's declared domain (:data:`restitution.model.DOMAIN`), inside
+output finite). Ranges are the package's declared domain (:data:`restitution.domain.DOMAIN`), inside
 which every output is finite; the defaults are the paper's Table 3 pair (S2 tool-steel ball on Al 6061).
 """
 from __future__ import annotations
@@ -10,7 +10,8 @@ from __future__ import annotations
 import math
 
 from ....materials import ALIASES, MATERIALS
-from ....model import DOMAIN, EFFECT_MODES, RESTITUTION_MODELS, ZENER_METHODS
+from ....domain import DOMAIN
+from ....model import EFFECT_MODES, RESTITUTION_MODELS, ZENER_METHODS
 from ...table import Table, calculated_parameter, input_, output, parameter
 
 _BALL, _PLATE = MATERIALS["s2_tool_steel"], MATERIALS["al_6061"]

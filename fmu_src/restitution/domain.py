@@ -1,0 +1,105 @@
+"""The model's domain: the values of each physical input that every front end accepts (the package's
+objects and :func:`restitution.impact`, the FMUs, scenes, sweeps, ``restitution cor`` and ``fit``),
+and the one-line refusal of a value outside it, with the unit the value was likely meant in:
+
+    plate.E = 114 Pa is outside 1e+05 <= value <= 1e+13 Pa: did you mean 114 GPa?
+
+A bare number is SI everywhere, so the usual slip is a number meant in a prefixed unit (GPa, MPa, mm).
+The domain is wide (foams to osmium, rubber to diamond, spheres of 1 um to 10 m, plates of 0.1 um to
+100 m, speeds to 10 km/s): a value outside it is a slip, never a material.
+"""
+from __future__ import annotations
+
+import math
+import warnings
+
+import numpy as np
+
+from ._num import is_scalar
+
+__all__ = ["DOMAIN", "PREFIXED", "TYPICAL", "DomainWarning", "slipped_prefix", "outside_domain", "check_in_domain",
+           "warn_outside_domain", "number_text"]
+
+#: The domain the FMUs declare (min/max in modelDescription.xml) and the property tests cover, per
+#: argument of :func:`restitution.impact`: (low, high) [SI], both included; nu has its own [0, 0.5].
+#: Inside it every output is finite except the documented infinities (m_eff for e_ze = 1, T at v = 0,
+#: the linear method's tau0 and t_contact for lambda >= 2): wide enough for any solid (BRITTLE_SY =
+#: 1e12 Pa included), spheres from 1 um to 10 m, plates from 0.1 um to 100 m, speeds up to 10 km/s.
+DOMAIN = {
+    "v": (0.0, 1e4),
+    "sphere_E": (1e5, 1e13), "sphere_Sy": (1e3, 1e13), "sphere_rho": (1.0, 1e5), "sphere_d": (1e-6, 10.0),
+    "plate_E": (1e5, 1e13), "plate_Sy": (1e3, 1e13), "plate_rho": (1.0, 1e5), "plate_t": (1e-7, 100.0),
+}
+
+#: A typical value of each quantity of :data:`DOMAIN` (by the part after ``sphere_`` / ``plate_``) [SI]:
+#: of the prefixed units that would bring a refused value into the domain, the hint names the one
+#: that brings it nearest (in decades) to this.
+TYPICAL = {"v": 2.0, "E": 1e11, "Sy": 5e8, "rho": 5e3, "d": 1e-2, "t": 5e-3}
+
+#: The prefixed units a slip of an SI prefix suggests: SI unit -> {factor to SI: unit}. A value
+#: outside the range that lands in it times a factor (1e3, 1e6, 1e9 or 1e-3) was likely meant in
+#: that unit (``plate.E = 114`` -> 114 GPa; ``plate.t = 3000`` -> 3000 mm).
+PREFIXED = {"m": {1e-3: "mm"}, "Pa": {1e3: "kPa", 1e6: "MPa", 1e9: "GPa"},
+            "m/s": {1e-3: "mm/s", 1e3: "km/s"}, "kg/m3": {1e3: "g/cm3"}}
+
+
+def number_text(value: float) -> str:
+    return f"{value:.15g}"
+
+
+def slipped_prefix(value: float, unit: str, accepts, typical: float) -> str | None:
+    """``"114 GPa"`` where ``value`` (SI, refused) is accepted (``accepts(SI value) -> bool``) once read
+    in a prefixed unit of :data:`PREFIXED` ``[unit]``: of those that bring it in, the one nearest (in
+    decades) to ``typical``; None where none does."""
+    best = None
+    for factor, prefixed in PREFIXED.get(unit, {}).items():
+        meant = value * factor
+        if meant > 0 < typical and accepts(meant):
+            distance = abs(math.log10(meant / typical))
+            if best is None or distance < best[0]:
+                best = (distance, prefixed)
+    return None if best is None else f"{number_text(value)} {best[1]}"
+
+
+class DomainWarning(UserWarning):
+    """A value outside the model's domain given to :func:`restitution.impact`, which computes it anyway."""
+
+
+def outside_domain(label: str, key: str, value, unit: str) -> str | None:
+    """The one-line refusal of ``value`` (a number or an array, SI, already checked finite) for
+    :data:`DOMAIN` ``[key]``, naming ``label``, the first value outside and the prefixed unit it was
+    likely meant in; None where every value lies inside."""
+    low, high = DOMAIN[key]
+    if value.__class__ is float and low <= value <= high:  # the usual call: one comparison
+        return None
+    if is_scalar(value):
+        bad = float(value)
+        if low <= bad <= high:
+            return None
+    else:
+        arr = np.asarray(value, dtype=float)
+        if arr.size == 0 or (low <= arr.min() and arr.max() <= high):
+            return None
+        bad = float(arr[(arr < low) | (arr > high)].flat[0])
+    message = f"{label} = {number_text(bad)} {unit} is outside {low:g} <= value <= {high:g} {unit}"
+    hint = slipped_prefix(bad, unit, lambda x: low <= x <= high, TYPICAL[key.split("_", 1)[-1]])
+    return f"{message}: did you mean {hint}?" if hint else message
+
+
+def check_in_domain(label: str, key: str, value, unit: str):
+    """``value`` if it lies in :data:`DOMAIN` ``[key]``, else ValueError (:func:`outside_domain`'s line)."""
+    message = outside_domain(label, key, value, unit)
+    if message:
+        raise ValueError(message)
+    return value
+
+
+def warn_outside_domain(label: str, key: str, value, unit: str, stacklevel: int = 2):
+    """``value``, after a :class:`DomainWarning` (:func:`outside_domain`'s line) if it leaves
+    :data:`DOMAIN` ``[key]``: for :func:`restitution.impact`, the equations, which are defined beyond
+    the domain and computed there (the model's limits, its tests, a study of the asymptotes)."""
+    message = outside_domain(label, key, value, unit)
+    if message:
+        warnings.warn(f"{message} (outside the domain the FMUs, the objects and the command lines accept; "
+                      f"impact() computes it anyway)", DomainWarning, stacklevel=stacklevel + 1)
+    return value
