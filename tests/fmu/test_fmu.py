@@ -165,6 +165,16 @@ def test_the_fmi_version_and_variable_kinds_are_read_from_the_model_description(
         assert fmu.get("plate.material", "sphere.material", "plate.used.E") == [1, 0, 103e9]  # Table 3: brass
 
 
+def test_an_unknown_variable_is_a_key_error_naming_the_model_and_the_close_names(any_version_impact_fmu):
+    with pytest.raises(KeyError, match=r"SpherePlateImpact has no variable 'plate\.thickness' \(did you mean 'plate\.t'"):
+        FmuInstance(any_version_impact_fmu, parameters={"plate.thickness": 3e-3})
+    with FmuInstance(any_version_impact_fmu) as fmu:
+        with pytest.raises(KeyError, match="no variable 'v_aproach' .*'v_approach'"):
+            fmu.set(v_aproach=2.0)
+        with pytest.raises(KeyError, match="no variable 'rebound'"):
+            fmu.get("rebound")
+
+
 def test_state_round_trip(any_version_impact_fmu):
     with FmuInstance(any_version_impact_fmu) as fmu:
         fmu.set(v_approach=1.7, **{"plate.t": 3e-3})

@@ -222,6 +222,25 @@ def quiet_instantiate(slave):
     (_Fmi3 if isinstance(slave, FMU3Slave) else _Fmi2).instantiate(slave, False, None)
 
 
+class _Variables(dict):
+    """The model's variables by name; an unknown name is a KeyError naming the model and the closest
+    names (a parameter misspelled in ``FmuInstance(parameters=...)`` or ``set()``)."""
+
+    def __init__(self, model: str, variables: dict):
+        super().__init__(variables)
+        self.model = model
+
+    def __missing__(self, name):
+        import difflib
+
+        close = difflib.get_close_matches(str(name), list(self), n=3)
+        if not close:  # a word of the name in a variable's name: "plate.thickness" -> plate.t, plate.E, ...
+            words = [w for w in str(name).replace("_", ".").split(".") if len(w) >= 3]
+            close = [v for v in self if any(w.lower() in v.lower() for w in words)][:3]
+        hint = f" (did you mean {' or '.join(repr(c) for c in close)}?)" if close else ""
+        raise KeyError(f"{self.model} has no variable {name!r}{hint}")
+
+
 class FmuInstance:
     """One co-simulation instance of an FMI 2.0 or FMI 3.0 FMU, addressed by variable name.
 
@@ -254,7 +273,8 @@ class FmuInstance:
         self._fmi = self._interface()
         self._own_dir = unzip_dir is None
         self.unzip_dir = extract(str(self.path)) if unzip_dir is None else str(unzip_dir)
-        self.variables = {v.name: v for v in self.model_description.modelVariables}
+        self.variables = _Variables(self.model_description.modelName,
+                                    {v.name: v for v in self.model_description.modelVariables})
         self.messages: list[tuple[int, str]] = []
         self._logger = logger
         self._readers: dict = {}
