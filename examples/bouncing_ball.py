@@ -107,7 +107,7 @@ def run(show_plot: bool = False, fmu_path=None, t_over_d=(0.25, 0.5, 1.0, 2.0), 
         print(f"S2 tool-steel ball, d = 6.35 mm, dropped from {drop_height} m on Al 6061 (first {n_bounces} bounces)")
         print(md)
         for label, b in cases.items():
-            print(f"{label}: {b.n_impacts} impacts, at rest at t = {b.rest_time:.4f} s ({b.stop_reason})")
+            print(f"{label}: {b.n_impacts} impacts, at rest at t = {b.rest_time:.4f} s ({b.why_stopped})")
         print(f"wrote {png}")
     return {"cases": cases, "rows": rows, "markdown": md, "png": png}
 

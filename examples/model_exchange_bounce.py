@@ -110,10 +110,10 @@ def run(show_plot: bool = False, fmu_dir=None, impact: str = "me", drop_height: 
         x = me.extra
         print(f"{folder / 'BouncingBall.fmu'} (FMI {x['fmi_version']}) in model exchange, e from {IMPACTS[impact]}")
         print(md)
-        print(f"model exchange: {me.n_impacts} contacts, at rest at t = {me.rest_time:.9f} s ({me.stop_reason}); "
+        print(f"model exchange: {me.n_impacts} contacts, at rest at t = {me.rest_time:.9f} s ({me.why_stopped}); "
               f"{x['steps']} {x['method']} steps, {x['rhs_calls']} derivative and {x['indicator_calls']} indicator "
               f"evaluations, {x['wall_time'] * 1e3:.1f} ms")
-        print(f"co-simulation: {ref.n_impacts} contacts, at rest at t = {ref.rest_time:.9f} s ({ref.stop_reason})")
+        print(f"co-simulation: {ref.n_impacts} contacts, at rest at t = {ref.rest_time:.9f} s ({ref.why_stopped})")
         print(f"largest differences: {max_dt:.2e} s in the contact instants, {max_dv:.2e} m/s in the impact speeds "
               f"(event_tol = {event_tol:g} s)")
         print(f"wrote {png}")

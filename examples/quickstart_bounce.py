@@ -31,7 +31,7 @@ def run(fmu_path=None, height: float = 0.3, thickness: float = 6.35e-3, show: in
     for i in range(min(show, bounces.n_impacts)):
         print(f"{i + 1:>3} {bounces.time[i]:9.5f} {bounces.v_approach[i]:8.4f} {bounces.e[i]:7.4f} "
               f"{bounces.e_ep[i]:7.4f} {bounces.e_ze[i]:7.4f} {bounces.t_contact[i] * 1e6:9.2f}")
-    print(f"{bounces.n_impacts} impacts; at rest at t = {bounces.rest_time:.4f} s ({bounces.stop_reason})")
+    print(f"{bounces.n_impacts} impacts; at rest at t = {bounces.rest_time:.4f} s ({bounces.why_stopped})")
     return bounces
 
 

@@ -209,6 +209,7 @@ def test_stop_rule_ends_a_zeno_like_sequence():
     runs = [bounce(rebound, DROP, v_min=v_min) for v_min in (1e-1, 1e-3, 1e-5, 1e-7)]
     n = [b.n_impacts for b in runs]
     assert n == sorted(n) and len(set(n)) == 4 and all(b.stop_reason == "v_min" for b in runs)
+    assert runs[1].why_stopped == "the rebound speed fell below v_min = 0.001 m/s"
     assert runs[3].e[-1] > runs[2].e[-1] > runs[0].e[-1] > runs[0].e[0]  # e rises as the ball slows
     # each extra factor 100 in v_min adds more impacts but less and less time: Zeno-like
     rest = np.array([b.rest_time for b in runs])
@@ -222,6 +223,7 @@ def test_perfectly_elastic_ball_hits_the_guard_and_keeps_its_energy():
     rebound = package_rebound(**sphere.params(), **plate.params(), plasticity="off", plate_waves="off")
     b = bounce(rebound, DROP, max_bounces=500)
     assert b.stop_reason == "max_bounces" and b.n_impacts == 500
+    assert b.why_stopped == "500 impacts, the most asked for (max_bounces)"
     assert np.all(b.e == 1.0)
     np.testing.assert_allclose(b.apex, DROP, rtol=1e-14)
     period = 2.0 * math.sqrt(2.0 * DROP / STANDARD_GRAVITY)

@@ -93,10 +93,19 @@ class Bounces(Trajectory):
     v_rebound: np.ndarray  #: rebound speeds [m/s]
     apex: np.ndarray  #: apex height after each impact [m] (0 when the ball stays down)
     rest_time: float  #: when the ball came to rest [s]
-    stop_reason: str  #: "v_min", "e<=0" or "max_bounces"
+    stop_reason: str  #: "v_min", "e<=0", "max_bounces" (or the model-exchange master's "stop_time")
     drop_height: float  #: [m]
     gravity: float  #: [m/s^2]
     extra: dict = field(default_factory=dict)
+    v_min: float = math.nan  #: the rebound speed below which the ball was taken to rest [m/s]
+
+    @property
+    def why_stopped(self) -> str:
+        """Why the drop ended, in words: ``stop_reason`` explained."""
+        return {"v_min": f"the rebound speed fell below v_min = {self.v_min:g} m/s",
+                "e<=0": "e <= 0: the ball stays on the plate",
+                "max_bounces": f"{self.n_impacts} impacts, the most asked for (max_bounces)",
+                "stop_time": "the stop time came first"}.get(self.stop_reason, self.stop_reason)
 
 
 #: The fields :func:`restitution.assumptions.departures` judges an impact by.
@@ -210,4 +219,4 @@ def bounce(rebound, drop_height: float, gravity: float = STANDARD_GRAVITY, v_min
     cols = np.array(rows, dtype=float).T
     return Bounces(time=cols[0], v_approach=cols[1], e=cols[2], e_ep=cols[3], e_ze=cols[4], lam=cols[5],
                    tau0=cols[6], t_contact=cols[7], v_rebound=cols[8], apex=cols[9], rest_time=float(cols[0][-1]),
-                   stop_reason=stop, drop_height=drop_height, gravity=gravity)
+                   stop_reason=stop, drop_height=drop_height, gravity=gravity, v_min=v_min)

@@ -260,13 +260,14 @@ def bounce_model_exchange(ball, rebound, drop_height: float, gravity: float = ST
                              f"{'no variable(s) ' + ', '.join(missing) if missing else 'no states or indicators'})")
         inst.reset(parameters)  # (checked first: the parameters of another FMU are no variables of it)
         return _run(inst, rebound, getattr(integrate, method), stop_time, max_bounces, event_tol, rtol, atol,
-                    drop_height, gravity, method)
+                    drop_height, gravity, method, float(v_min))
     finally:
         if own:
             inst.close()
 
 
-def _run(inst, rebound, stepper, stop_time, max_bounces, event_tol, rtol, atol, drop_height, gravity, method):
+def _run(inst, rebound, stepper, stop_time, max_bounces, event_tol, rtol, atol, drop_height, gravity, method,
+         v_min):
     counts = {"steps": 0, "rhs_calls": 0, "indicator_calls": 0, "events": 0}
     set_e = inst.writer("e")
     read_v = inst.reader("v")
@@ -389,4 +390,4 @@ def _run(inst, rebound, stepper, stop_time, max_bounces, event_tol, rtol, atol, 
     rest = float(table[0][-1]) if rows and stop != "stop_time" else math.inf
     return Bounces(time=table[0], v_approach=table[1], e=table[2], e_ep=table[3], e_ze=table[4], lam=table[5],
                    tau0=table[6], t_contact=table[7], v_rebound=v_reb, apex=apex, rest_time=rest, stop_reason=stop,
-                   drop_height=drop_height, gravity=gravity, extra=extra)
+                   drop_height=drop_height, gravity=gravity, extra=extra, v_min=v_min)
