@@ -134,12 +134,24 @@ def test_contact_durations_force_plate_waves_on():
     assert off.effect_modes() == ("auto", "off")  # an explicit choice is kept
 
 
+def test_a_bare_number_is_si_as_everywhere_in_the_package():
+    with_units = scene_from(MINIMAL)
+    bare = scene_from(MINIMAL.replace('thickness = "3.18 mm"', "thickness = 0.00318")
+                      .replace('diameter = "6.35 mm"', 'diameter = "0.00635"')
+                      .replace('drop_heights = "0.1 m"', "drop_heights = [0.1]"))
+    assert bare.plates[0].thickness == with_units.plates[0].thickness == pytest.approx(3.18e-3, rel=1e-15)
+    assert bare.balls[0].diameter == with_units.balls[0].diameter
+    assert bare.balls[0].drop_heights == with_units.balls[0].drop_heights
+
+
 @pytest.mark.parametrize("old, new, key, words", [
     ('diameter = "6.35 mm"', 'diamter = "6.35 mm"', "balls[0].diamter", ["unknown key", "did you mean 'diameter'"]),
     ('[outputs]', '[outputs]\ncolour = "red"', "outputs.colour", ["unknown key"]),
     ('[scene]', '[scenery]\n[scene]', "scenery", ["unknown key", "did you mean 'scene'"]),
     ('thickness = "3.18 mm"', 'thickness = "3.18 GPa"', "plates[0].thickness", ["GPa is a unit of pressure", "length"]),
-    ('thickness = "3.18 mm"', 'thickness = 3.18', "plates[0].thickness", ["has no unit", '"3.18 mm"']),
+    ('thickness = "3.18 mm"', 'thickness = 3180', "plates[0].thickness", ["outside the range", "did you mean 3180 mm?"]),
+    ('material = "al_6061"', 'material = { E = 114, nu = 0.3, Sy = "1 GPa", rho = "2700 kg/m3" }',
+     "plates[0].material.E", ["outside the range", "did you mean 114 GPa?"]),
     ('thickness = "3.18 mm"', 'thickness = "3.18 blargs"', "plates[0].thickness", ["unknown unit 'blargs'"]),
     ('thickness = "3.18 mm"', 'thickness = "-1 mm"', "plates[0].thickness", ["must be > 0"]),
     ('drop_heights = "0.1 m"', 'drop_heights = ["0.1 m", "20 m/s"]', "balls[0].drop_heights[1]",

@@ -42,8 +42,8 @@ reference; every key not marked optional is required)::
     drop_heights = ["0.2 m", "1 m"]           # one string or a list
     plates = ["table"]                        # optional: default every plate
 
-Units are explicit: a dimensional value is a string "<number> <unit>" (a bare number is
-refused); dimensionless values (nu, tolerances) are plain numbers. Materials are preset
+A dimensional value is a string "<number> <unit>" or a bare number in SI units (as everywhere in
+the package); dimensionless values (nu, tolerances) are plain numbers. Materials are preset
 names (:data:`restitution.MATERIALS`, or ``table4.<A1..B4>.sphere|plate`` for the paper's
 Table 4 cases), a name from ``[materials]``, or an inline table ``{E, nu, Sy, rho}``,
 optionally ``{base = "preset", ...}`` overriding some properties of a preset.
@@ -60,10 +60,11 @@ from pathlib import Path
 
 import tomllib  # Python >= 3.11
 
+from ..domain import TYPICAL, slipped_prefix
 from ..materials import BRITTLE_SY, MATERIALS, TABLE4_CASES, Material, suggest_material, table4_case
 from ..model import DOMAIN, EFFECT_MODES, RESTITUTION_MODELS
 from ..zener import ZENER_METHODS
-from .units import QUANTITIES, UnitError, parse_quantity
+from .units import QUANTITIES, UnitError, parse_quantity, split_quantity
 
 __all__ = ["SceneError", "Scene", "BallSpec", "PlateSpec", "ModelSpec", "SimulationSpec", "Drop",
            "OUTPUTS", "load_scene", "parse_scene", "resolve_material"]
@@ -222,9 +223,24 @@ def _quantity(ctx, table, where, key, kind, *, positive=True, default=None, doma
         raise ctx.error(full, f"{table[key]!r} must be > 0")
     if domain is not None and not domain[0] <= value <= domain[1]:
         unit = QUANTITIES[kind]
-        raise ctx.error(full, f"{table[key]!r} is outside the range the FMU accepts: "
-                              f"{domain[0]:g} {unit} <= value <= {domain[1]:g} {unit}")
+        message = (f"{table[key]!r} is outside the range the FMU accepts: "
+                   f"{domain[0]:g} {unit} <= value <= {domain[1]:g} {unit}")
+        hint = None
+        if not isinstance(table[key], str) or _unit_free(table[key]):  # a bare number: SI, maybe a slip
+            typical = TYPICAL.get(_TYPICAL_KEY.get(key, key), math.sqrt(domain[0] * domain[1]))
+            hint = slipped_prefix(value, unit, lambda x: domain[0] <= x <= domain[1], typical)
+        raise ctx.error(full, f"{message}: did you mean {hint}?" if hint else message)
     return value
+
+
+#: A scene's key -> the key of :data:`restitution.domain.TYPICAL` whose typical value it has.
+_TYPICAL_KEY = {"thickness": "t", "diameter": "d"}
+
+
+def _unit_free(text: str) -> bool:
+    """True for a numeric string without a unit (``"3180"``), which a scene reads as SI."""
+    parsed = split_quantity(text)
+    return parsed is not None and parsed[1] is None
 
 
 def _number(ctx, table, where, key, *, low=None, high=None, low_open=False, high_open=False, default=None):

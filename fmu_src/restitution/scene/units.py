@@ -1,7 +1,7 @@
 """Quantities with explicit units for scene files: ``"3.18 mm"``, ``"69 GPa"``, ``"2700 kg/m3"``.
 
-A dimensional value in a scene is a string "<number> <unit>"; a bare number is refused
-(``thickness = 3.18`` could mean metres or millimetres). Dimensionless values (Poisson's
+A dimensional value in a scene is a string "<number> <unit>", or a bare number in SI units
+(``thickness = 0.00318`` is 3.18 mm), as everywhere in the package. Dimensionless values (Poisson's
 ratio, tolerances) are plain numbers. Units are read by pint, so any unit of the right kind works
 (``"0.125 in"``, ``"1 ft"``, ``"2.7 g/cm3"``, ``"9.81 m/s2"``);
 a digit right after a unit's letters is its exponent (``m3`` is m**3). Everything is converted to SI
@@ -88,26 +88,30 @@ def convert_quantity(name: str, text: str, number: float, unit: str, kind: str) 
 
 
 def parse_quantity(key: str, value, kind: str) -> float:
-    """SI value of ``value`` (a "<number> <unit>" string) for a quantity of ``kind``.
+    """SI value of ``value`` (a "<number> <unit>" string, or a number or numeric string: SI) for a
+    quantity of ``kind``.
 
     ``key`` is the value's key (its last part is used in the examples of error messages; the
-    caller prefixes the full key). Raises :class:`UnitError` for a bare number,
+    caller prefixes the full key). Raises :class:`UnitError` for a value that is not a number,
     an unknown unit or a unit of another kind.
     """
     short = key.rsplit(".", 1)[-1]
     example = f'{short} = "{_EXAMPLE_VALUE[kind]}"'
     if isinstance(value, bool) or not isinstance(value, (str, int, float)):
-        raise UnitError(f"{value!r}: expected a {kind} with its unit, as a string, e.g. {example}")
-    if not isinstance(value, str):
-        raise UnitError(f"{value!r} has no unit: write the {kind} with its unit, e.g. {example} "
-                        f"(units: {EXAMPLES[kind]})")
+        raise UnitError(f"{value!r}: expected a {kind}, a string with its unit or a number in "
+                        f"{QUANTITIES[kind]}, e.g. {example}")
+    if not isinstance(value, str):  # a bare number is SI
+        if not math.isfinite(value):
+            raise UnitError(f"{value!r} is not finite")
+        return float(value)
     parsed = split_quantity(value)
     if parsed is None:
         raise UnitError(f"{value!r} is not '<number> <unit>' (a number in ASCII digits), e.g. {example}")
     number, unit = parsed
-    if unit is None:
-        raise UnitError(f"{value!r} has no unit: write the {kind} with its unit, e.g. {example} "
-                        f"(units: {EXAMPLES[kind]})")
+    if unit is None:  # "0.00318": a number in SI, as a bare one
+        if not math.isfinite(number):
+            raise UnitError(f"{value!r} is not finite")
+        return float(number)
     return convert_quantity(short, value, number, unit, kind)
 
 
