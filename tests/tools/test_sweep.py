@@ -325,6 +325,34 @@ def test_a_few_values_of_one_input_are_drawn_as_curves(tmp_path, monkeypatch, fe
         assert np.array_equal(np.sort(line.get_ydata()), np.sort(res.columns["e"][sel]))  # the data as computed
 
 
+def test_several_pairs_over_one_input_share_one_panel_and_the_title_names_the_fixed_values(tmp_path, monkeypatch):
+    """Two pairs over speeds only: one panel, a curve per pair (labelled by the pair, the data as computed),
+    and the title names what the sweep held fixed."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from matplotlib.figure import Figure
+
+    from restitution.sweep.plot import plot_cor_map
+    from restitution.sweep.spec import pair_label
+
+    pairs = ["s2_tool_steel/al_6061", "chrome_steel/brass_260"]
+    spec = SweepSpec(pairs=pairs, grid={"v_approach": {"geomspace": [0.1, 10.0, 12]}}, fixed={"plate.t": "3mm"})
+    res = run_sweep(spec, scheduler="serial")
+    saved = []
+    monkeypatch.setattr(Figure, "savefig", lambda fig, path, **kw: saved.append(fig))
+    plot_cor_map(res, tmp_path / "map.png")
+    (ax,) = [a for a in saved[0].axes if a.get_visible()]
+    curves = {line.get_label(): line for line in ax.lines if not line.get_label().startswith("_")
+              and len(line.get_xdata()) > 1}
+    assert sorted(curves) == sorted(pair_label(p) for p in pairs)
+    for k, pair in enumerate(pairs):
+        sel = res.columns["pair"] == pair if res.columns["pair"].dtype == object else res.columns["pair"] == k
+        line = curves[pair_label(pair)]
+        assert np.array_equal(np.sort(line.get_ydata()), np.sort(res.columns["e"][sel]))
+    assert "plate.t = 3mm" in saved[0]._suptitle.get_text()
+
+
 def test_local_workers_keep_glibc_allocation_thresholds(cluster):
     """The sweep's LocalCluster starts its workers without Dask's MALLOC_TRIM_THRESHOLD_ (which makes
     glibc map and page-fault every large array afresh: twice the CPU time of a package chunk), and

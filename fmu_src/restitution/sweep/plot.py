@@ -106,6 +106,10 @@ def plot_cor_map(result, path, title: str | None = None, dpi: int = 120, statist
     lo = min(0.0, float(np.nanmin(e_all))) if e_all.size else 0.0
     hi = max(1.0, float(np.nanmax(e_all))) if e_all.size else 1.0
     norm = Normalize(vmin=lo, vmax=hi)
+    spec_fixed = _fixed_text(spec) if spec is not None else ""
+    axis = _shared_axis(cols, pairs, ok)
+    if axis is not None:  # several pairs over one input: one panel, a curve per pair
+        return _pairs_on_one_panel(cols, ok, valid_all, axis, path, title, spec_fixed, dpi)
     n = max(1, len(pairs))
     ncols = min(3, n)
     nrows = math.ceil(n / ncols)
@@ -189,11 +193,43 @@ def plot_cor_map(result, path, title: str | None = None, dpi: int = 120, statist
     if mappable is not None:
         fig.colorbar(mappable, ax=axes, label="apparent COR e", shrink=0.9)
     if title is None:
-        title = f"Apparent COR e (Green 2022), {len(ok)} cases"
+        title = f"Apparent COR e (Green 2022), {len(ok)} cases" + (f"; {spec_fixed}" if spec_fixed else "")
         if boundary:
             title += "; red dashes: edge of the validated range (lambda <= 1.5, V* <= 1000)"
         elif not valid_all.all():
             title += "; red marks: outside the validated range"
+    fit_title(fig, title, fontsize=10)
+    return _save(fig, path, dpi)
+
+
+#: The inputs a COR map draws along, with their axis labels.
+_MAP_AXES = {"v_approach": "approach speed v [m/s]", "t_over_d": "plate thickness / sphere diameter t/d"}
+
+
+def _shared_axis(cols, pairs, ok) -> str | None:
+    """The one input (``v_approach`` or ``t_over_d``) that varies within every pair when there are
+    several pairs and the other input holds one value within each: their curves share one panel."""
+    if len(pairs) < 2:
+        return None
+    shared = set()
+    for pair in pairs:
+        sel = (cols["pair"] == pair) & ok
+        varying = {name for name in _MAP_AXES if np.unique(np.asarray(cols[name], dtype=float)[sel]).size > 1}
+        if len(varying) != 1:
+            return None
+        shared |= varying
+    return shared.pop() if len(shared) == 1 else None
+
+
+def _pairs_on_one_panel(cols, ok, valid_all, axis, path, title, fixed, dpi) -> Path:
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(6.8, 4.4), constrained_layout=True)
+    labels = np.array([pair_label(p) for p in np.asarray(cols["pair"])[ok]], dtype=object)
+    _curves(ax, np.asarray(cols[axis], dtype=float)[ok], labels, np.asarray(cols["e"], dtype=float)[ok],
+            valid_all[ok], _MAP_AXES[axis], "{}")
+    if title is None:
+        title = f"Apparent COR e (Green 2022), {len(ok)} cases" + (f"; {fixed}" if fixed else "")
     fit_title(fig, title, fontsize=10)
     return _save(fig, path, dpi)
 
@@ -219,10 +255,13 @@ def _axis_label(name: str) -> str:
 def _draws_text(spec) -> str:
     """What a random sweep drew and held: ``plate.Sy ~ uniform_rel:0.15; fixed plate.t = 3mm``."""
     text = "; ".join(f"{name} ~ {given}" for name, given in spec.random.items())
-    if spec.fixed:
-        text += "; " + ", ".join(f"{name} = {value}{' ' + unit_of(name) if unit_of(name) and _bare(value) else ''}"
-                                 for name, value in spec.fixed.items())
-    return text
+    return text + ("; " + _fixed_text(spec) if spec.fixed else "")
+
+
+def _fixed_text(spec) -> str:
+    """The values a sweep holds fixed, with their units: ``plate.t = 3mm, sphere.d = 0.01 m``."""
+    return ", ".join(f"{name} = {value}{' ' + unit_of(name) if unit_of(name) and _bare(value) else ''}"
+                     for name, value in spec.fixed.items())
 
 
 def _bare(value) -> bool:
