@@ -402,3 +402,15 @@ def test_serial_in_memory_chunks_are_the_back_ends_own_unless_it_names_bigger_on
     assert run_sweep(spec, "package", scheduler="serial").n_chunks == 1
     assert run_sweep(spec, SmallChunks(), scheduler="serial").n_chunks == 3  # 20 cases, 7 at a time
     assert run_sweep(spec, SmallChunks(), scheduler="serial", parts=tmp_path / "p").n_chunks == 3
+
+
+def test_serial_in_memory_chunks_hold_a_few_seconds_of_work_for_the_progress_bar(monkeypatch):
+    """A slow option (zener_method = ode, about 6 ms a case) makes the in-memory chunks smaller, so that
+    each is about IN_MEMORY_SECONDS of work (made 30 ms here: 5 ode cases, 10^5 default ones)."""
+    from restitution.sweep import run as sweep_run
+
+    monkeypatch.setattr(sweep_run, "IN_MEMORY_SECONDS", 0.03)
+    grid = {"v_approach": [0.5, 1, 2, 3, 4], "t_over_d": [0.5, 1, 2, 4]}
+    ode = SweepSpec(pairs=["s2_tool_steel/al_6061"], grid=grid, fixed={"zener_method": "ode"})
+    assert run_sweep(ode, "package", scheduler="serial").n_chunks == 4  # 20 cases, 5 at a time
+    assert run_sweep(SweepSpec(pairs=["s2_tool_steel/al_6061"], grid=grid), "package", scheduler="serial").n_chunks == 1

@@ -171,14 +171,14 @@ def serial_reason(spec, backends, n_workers: int | None = None) -> str | None:
     if dask.config.get("scheduler-address", None):
         return None
     workers = n_workers or machine_workers()
-    seconds = spec.n_cases * sum(CASE_SECONDS[name][_cost_class(spec)] for name in backends)
+    seconds = spec.n_cases * sum(CASE_SECONDS[name][cost_class(spec)] for name in backends)
     if seconds * (1 - 1 / workers) >= CLUSTER_SECONDS:
         return None
     return (f"serial: about {seconds:.2g} s of work, too little for a LocalCluster of {workers} worker(s) to win "
             f"back its {CLUSTER_SECONDS:g} s start; --scheduler local starts one")
 
 
-def _cost_class(spec) -> int:
+def cost_class(spec) -> int:
     """0, 1 or 2: which column of :data:`CASE_SECONDS` the options that the sweep may take select."""
     from .spec import CODES, START
 

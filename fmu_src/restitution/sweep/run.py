@@ -39,7 +39,7 @@ import numpy as np
 
 from ..cosim.interrupt import DeferredInterrupt
 from .backends import Backend, FmuBackend, code_fingerprint, get_backend, release_fmus
-from .cluster import count_workers, describe_client, open_client
+from .cluster import CASE_SECONDS, cost_class, count_workers, describe_client, open_client
 from .parts import DiskSweepResult, PartStore
 from .size import check_case_numbers
 from .spec import SweepSpec
@@ -77,6 +77,20 @@ def _run_chunk(start: int, stop: int, spec: SweepSpec, backend: Backend, payload
 
 def _chunks(n: int, chunk_size: int):
     return [(s, min(s + chunk_size, n)) for s in range(0, n, chunk_size)]
+
+
+#: A serial sweep kept in memory evaluates chunks of at most about this much work [s] (CASE_SECONDS for
+#: its options), for the progress bar's sake: 10^6 cases of the package's default options are 0.3 s,
+#: but with zener_method = ode they would be an hour and a half.
+IN_MEMORY_SECONDS = 5.0
+
+
+def _in_memory_chunk(spec, backend) -> int:
+    """Cases per chunk of a serial sweep kept in memory: the back end's ``in_memory_chunk``, or fewer
+    where that is more than :data:`IN_MEMORY_SECONDS` of work."""
+    seconds = CASE_SECONDS.get(backend.name, (0.0,) * 3)[cost_class(spec)]
+    return max(1, min(backend.in_memory_chunk, round(IN_MEMORY_SECONDS / seconds))) if seconds > 0 \
+        else backend.in_memory_chunk
 
 
 def run_sweep(spec: SweepSpec | dict, backend: str | Backend = "package", *, fmu=None, scheduler=None,
@@ -126,7 +140,7 @@ def run_sweep(spec: SweepSpec | dict, backend: str | Backend = "package", *, fmu
     if scheduler == "serial":
         default = backend.default_chunk
         if store is None and in_memory and backend.in_memory_chunk:  # nothing on disk: chunks only pace the
-            default = backend.in_memory_chunk                            # progress and bound the memory
+            default = _in_memory_chunk(spec, backend)                    # progress and bound the memory
         chunk_size = _chunk_size(store, resume, chunk_size or default)
         chunks = _chunks(n, chunk_size)
         run.open(chunk_size, resume, len(chunks), "this process (serial)", 1)
