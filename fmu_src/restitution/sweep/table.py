@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from ..output_files import atomic_write as write_atomic
+from . import arrow_arrays
 from .spec import (INPUT_NAMES, INTEGER_INPUTS, OUTPUT_NAMES, OUTPUTS as _OUTPUT_TYPES, T_OVER_D, SweepSpec,
                    is_one_value_view)
 
@@ -303,7 +304,7 @@ def arrow_table(columns: dict):
     Parquet then stores no definition levels, which took a fifth of the write."""
     import pyarrow as pa
 
-    arrays = [pa.array(col, type=pa.string()).dictionary_encode() if col.dtype == object else pa.array(col)
+    arrays = [arrow_arrays.dictionary(col) if col.dtype == object else arrow_arrays.numbers(col)
               for col in columns.values()]
     return pa.Table.from_arrays(arrays, schema=_schema(columns, arrays))
 
@@ -315,9 +316,7 @@ def _schema(names, arrays):
 
 
 def _pair_labels(spec: SweepSpec):
-    import pyarrow as pa
-
-    return pa.array([*spec.pairs, ""], type=pa.string())  # the last: no pairs (index -1)
+    return arrow_arrays.labels([*spec.pairs, ""])  # the last: no pairs (index -1)
 
 
 def chunk_table(spec: SweepSpec, columns: dict | None, keep):
@@ -334,7 +333,8 @@ def chunk_table(spec: SweepSpec, columns: dict | None, keep):
         if name == "pair":
             codes = np.zeros(0, np.int32) if columns is None else np.asarray(columns["pair"], dtype=np.int32)
             codes = np.where(codes < 0, len(spec.pairs), codes) if n and codes.min() < 0 else codes
-            arrays.append(pa.DictionaryArray.from_arrays(pa.array(codes, type=pa.int32()), _pair_labels(spec)))
+            arrays.append(pa.DictionaryArray.from_arrays(arrow_arrays.numbers(codes.astype(np.int32, copy=False)),
+                                                         _pair_labels(spec)))
             continue
         col = np.empty(0, _column_type(name)) if columns is None else np.asarray(columns[name])
         want = np.dtype(_column_type(name))
@@ -343,7 +343,7 @@ def chunk_table(spec: SweepSpec, columns: dict | None, keep):
             continue
         if col.dtype != want or not col.flags.c_contiguous:  # an integer input held as float
             col = np.ascontiguousarray(col, dtype=want)
-        arrays.append(pa.array(col))
+        arrays.append(arrow_arrays.numbers(col))
     return pa.Table.from_arrays(arrays, schema=_schema(names, arrays))
 
 
@@ -356,12 +356,10 @@ _CONSTANTS_BYTES = 64 * 2**20
 
 
 def _constant_array(value: np.ndarray, rows: int):
-    import pyarrow as pa
-
     key = (value.dtype.str, value.tobytes(), rows)
     array = _CONSTANTS.get(key)
     if array is None:
-        array = pa.array(np.repeat(value, rows))
+        array = arrow_arrays.numbers(np.repeat(value, rows))
         if sum(a.nbytes for a in _CONSTANTS.values()) + array.nbytes > _CONSTANTS_BYTES:
             _CONSTANTS.clear()
         if array.nbytes <= _CONSTANTS_BYTES:
