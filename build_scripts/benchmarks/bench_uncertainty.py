@@ -303,8 +303,8 @@ def main(argv=None) -> int:
     mc = mc_in_process(n, args.reps)
     print(f"1(a) Monte Carlo, {n:,} draws, in process (thread CPU, median of {args.reps} interleaved): "
           f"sweep + statistics {mc['sweep']:.3f} s, impact + numpy statistics {mc['plain']:.3f} s: "
-          f"{mc['ratio']:.1f}x (goal <= {GOAL_MC:g}x: {'met' if mc['ratio'] <= GOAL_MC else 'NOT met'}; "
-          f"spread {mc['spread'][0]:.1f}-{mc['spread'][1]:.1f}x)")
+          f"{mc['ratio']:.2f}x (goal <= {GOAL_MC:g}x: {'met' if mc['ratio'] <= GOAL_MC else 'NOT met'}; "
+          f"spread {mc['spread'][0]:.2f}-{mc['spread'][1]:.2f}x)")
     print(f"     of the sweep side: run_sweep with the on_chunk statistics {mc['run_sweep']:.3f} s, summary() "
           f"{mc['summary']:.3f} s; e's mean, std and percentiles agree to {mc['agree']:.1e}")
     with tempfile.TemporaryDirectory(prefix="bench_uncertainty_") as tmp:
@@ -312,10 +312,10 @@ def main(argv=None) -> int:
         pr = mc_processes(n, args.runs, work)
         c, w = pr["cpu"], pr["wall"]
         print(f"1(b) Monte Carlo, {n:,} draws, whole processes (CPU user + sys, median of {pr['runs']} interleaved): "
-              f"sweep command {c['sweep']:.2f} s, plain impact process {c['plain']:.2f} s: {c['ratio']:.1f}x "
+              f"sweep command {c['sweep']:.2f} s, plain impact process {c['plain']:.2f} s: {c['ratio']:.2f}x "
               f"(goal <= {GOAL_MC:g}x: {'met' if c['ratio'] <= GOAL_MC else 'NOT met'})")
         print(f"     wall: sweep command {w['sweep']:.2f} s, plain impact process {w['plain']:.2f} s: "
-              f"{w['ratio']:.1f}x; e's statistics agree to {pr['agree']:.1e}")
+              f"{w['ratio']:.2f}x; e's statistics agree to {pr['agree']:.1e}")
         sp = sobol_in_process(args.sobol_n, args.reps)
         so = sobol_processes(args.sobol_n, args.sobol_runs, work)
     for name, label in (("serial", "--scheduler serial"), ("cluster", "LocalCluster of 2 workers")):
