@@ -88,3 +88,60 @@ def test_small_inputs_and_bad_ranks():
         order_statistics(np.arange(5.0), [5])
     with pytest.raises(IndexError):
         order_statistics(np.arange(5.0), [-1])
+
+
+# --- the moments computed in the same passes --------------------------------------------------------
+def _exact_moments(values):
+    """The mean and the sum of squared deviations by math.fsum (exactly rounded sums): the reference."""
+    import math
+
+    mean = math.fsum(values) / values.size
+    mean += math.fsum(values - mean) / values.size  # the residual's exact sum corrects the division
+    return mean, math.fsum((values - mean) ** 2)
+
+
+@pytest.mark.parametrize("name", ["uniform", "normal", "lognormal sigma 5", "cauchy", "one far outlier",
+                                  "sorted", "three codes", "constant", "a crowded middle"])
+def test_moments_come_with_the_order_statistics(name):
+    """Mean to 1e-13 and sum of squares to 1e-11 relative (of its own size; its shifted form may lose up
+    to 64 + log2(n) ulps by design, and the pairwise sums log2(n) more), order statistics exact."""
+    values = _datasets()[name]
+    with np.errstate(over="ignore"):
+        finite_moments = np.isfinite(np.sum(values ** 2))
+    n = values.size
+    ranks = [n // 40, n // 40 + 1, n // 2, n // 2 + 1, n - n // 40 - 1, n - n // 40]
+    got = osx.moments_and_order_statistics(values, ranks, Scratch())
+    if not finite_moments:  # a square beyond the largest double: the caller is told to take another way
+        assert got is None or np.isfinite(got[1])
+        return
+    mean, squares, picked = got
+    want_mean, want_squares = _exact_moments(values)
+    assert mean == pytest.approx(want_mean, rel=1e-13, abs=1e-300)
+    assert squares == pytest.approx(want_squares, rel=1e-11, abs=1e-300)
+    assert np.array_equal(picked, np.partition(values, ranks)[ranks])
+
+
+def test_a_large_offset_keeps_the_variance():
+    """1e8 + unit noise: squares about a shift far from zero lose nothing (about zero, they would lose all)."""
+    values = 1e8 + np.random.default_rng(5).normal(size=N)
+    mean, squares, _ = osx.moments_and_order_statistics(values, [N // 2], Scratch())
+    want_mean, want_squares = _exact_moments(values)
+    assert mean == pytest.approx(want_mean, rel=1e-15)
+    assert squares == pytest.approx(want_squares, rel=1e-9)  # 64 ulps of 1e16 over a variance of 1: 1e-13
+
+
+def test_an_outlier_at_the_lowest_rank_moves_the_moments_about_the_mean():
+    """Ranks that include the minimum, a far outlier: the shift is far from the mean, and the moments are
+    computed about the mean instead (still to 1e-11)."""
+    values = np.r_[np.random.default_rng(6).random(N), -1e9]
+    mean, squares, picked = osx.moments_and_order_statistics(values, [0, N // 2], Scratch())
+    want_mean, want_squares = _exact_moments(values)
+    assert mean == pytest.approx(want_mean, rel=1e-13) and squares == pytest.approx(want_squares, rel=1e-11)
+    assert picked[0] == -1e9
+
+
+def test_values_not_all_finite_give_none():
+    for bad in (np.nan, np.inf, -np.inf):
+        values = np.r_[np.random.default_rng(1).random(N), bad]
+        assert osx.moments_and_order_statistics(values, [N // 2], Scratch()) is None
+    assert osx.moments_and_order_statistics(np.array([1.0, np.nan]), [0], Scratch()) is None  # small too

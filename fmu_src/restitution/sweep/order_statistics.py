@@ -16,12 +16,17 @@ preserve order, as do clipping and truncation; values outside the span fall into
 every member of a lower bin is <= every member of a higher one, and the values of rank
 ``start .. end - 1`` are exactly the members of the bin whose counts span those ranks. A wanted
 bin's members are selected from the same way.
+
+:func:`moments_and_order_statistics` also gives the mean and the sum of squared deviations, from
+the shifted values before they are scaled into bins: two passes where the mean's own would be four.
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
-__all__ = ["order_statistics", "Scratch"]
+__all__ = ["order_statistics", "moments_and_order_statistics", "Scratch"]
 
 #: Equal-width bins a level counts into (a 16 kB count array; smooth data of 10^6 values leaves a few
 #: hundred in the bin of each rank).
@@ -66,6 +71,56 @@ def order_statistics(values: np.ndarray, ranks, scratch: Scratch | None = None) 
     return _select(values, ranks, scratch or Scratch())
 
 
+def moments_and_order_statistics(values: np.ndarray, ranks, scratch: Scratch | None = None):
+    """(mean, sum of squared deviations from the mean, :func:`order_statistics` of ``ranks``) of
+    ``values`` (1-d floats, n >= 1), in the passes the order statistics make anyway: the values
+    shifted by the bins' lower end are summed and squared before they are scaled into bins. None
+    where the values are not all finite (their sum is not: a NaN or an infinity among them, or a
+    sum beyond the largest double), for the caller to take the finite ones.
+
+    About a shift s, the sum of squares is sum((x - s)^2) - n (mean - s)^2, which loses about
+    (mean - s)^2 / variance ulps of it. The shift is the sample value at the lowest wanted rank,
+    among the values; where it lies more than 8 standard deviations from the mean (an outlier's rank,
+    or extreme data) the moments are computed again about the mean, in two more passes. Small
+    inputs, and values the bins cannot spread, take those two passes too."""
+    values = np.asarray(values, dtype=float)
+    ranks = np.asarray(ranks, dtype=np.int64)
+    scratch = scratch or Scratch()
+    n = values.size
+    lo, hi = _span(values, ranks) if n > DIRECT and ranks.size else (0.0, 0.0)
+    if not lo < hi:
+        moments = _moments(values, scratch)
+        return None if moments is None else (*moments, _select(values, ranks, scratch))
+    work, bins = scratch.arrays(n)
+    with np.errstate(over="ignore", invalid="ignore"):
+        np.subtract(values, lo, out=work)
+        total = float(work.sum())
+        if not math.isfinite(total):
+            return None
+        shift = total / n
+        squares = float(np.dot(work, work)) - n * shift * shift
+    if not (math.isfinite(squares) and n * shift * shift <= 64.0 * max(squares, 0.0)):
+        moments = None  # about the mean instead, once the order statistics are picked
+    else:
+        moments = (lo + shift, squares)
+    picked = _from_shifted(values, ranks, scratch, work, bins, lo, hi)
+    moments = moments or _moments(values, scratch)
+    return None if moments is None else (*moments, picked)
+
+
+def _moments(values: np.ndarray, scratch: Scratch):
+    """(mean, sum of squared deviations from it) about the mean: numpy's pairwise mean refined by the
+    residuals' mean; None where the values are not all finite."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        mean = float(values.mean())
+        if not math.isfinite(mean):
+            return None
+        residual = np.subtract(values, mean, out=scratch.arrays(values.size)[0])
+        shift = float(residual.mean())
+        squares = float(np.dot(residual, residual)) - values.size * shift * shift
+    return (mean + shift, max(squares, 0.0)) if math.isfinite(squares) else None
+
+
 def _select(values: np.ndarray, ranks: np.ndarray, scratch: Scratch) -> np.ndarray:
     n = values.size
     if n <= DIRECT or ranks.size == 0:
@@ -75,8 +130,15 @@ def _select(values: np.ndarray, ranks: np.ndarray, scratch: Scratch) -> np.ndarr
         low = values.min()
         return np.full(ranks.size, low) if low == values.max() else np.partition(values, ranks)[ranks]
     work, bins = scratch.arrays(n)
-    with np.errstate(over="ignore"):  # a far value's distance may overflow to inf: clipped below
+    with np.errstate(over="ignore"):  # a far value's distance may overflow to inf: clipped after scaling
         np.subtract(values, lo, out=work)
+    return _from_shifted(values, ranks, scratch, work, bins, lo, hi)
+
+
+def _from_shifted(values, ranks, scratch, work, bins, lo, hi) -> np.ndarray:
+    """The order statistics, ``work`` holding ``values - lo``."""
+    n = values.size
+    with np.errstate(over="ignore"):  # a far value's scaled distance may overflow to inf: clipped below
         np.multiply(work, BINS / (hi - lo), out=work)
     np.clip(work, 0, BINS - 1, out=work)  # values beyond the span join the first or last bin
     np.copyto(bins, work, casting="unsafe")  # truncation: the floor of a number in [0, BINS - 1]

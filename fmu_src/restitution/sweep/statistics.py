@@ -21,7 +21,7 @@ import numpy as np
 
 from ..fmu.models.sphere_plate_impact.variables import TABLE
 from ..output_files import write_json
-from .order_statistics import Scratch, order_statistics
+from .order_statistics import Scratch, moments_and_order_statistics, order_statistics
 from .spec import OUTPUTS, T_OVER_D, pair_label
 from .table import VALIDITY, table_counts
 from .values import unit_of
@@ -93,37 +93,48 @@ def describe(values: np.ndarray, groups: np.ndarray | None = None, n_groups: int
 
 
 def _describe_one(values: np.ndarray, scratch: Scratch | None = None) -> dict:
-    """:func:`describe` of one group, in a few passes over the values: numpy's pairwise sums for the
-    mean (refined by the residuals' mean, as the grouped form) and the standard deviation, and the
-    order statistics the percentiles need picked by :func:`~.order_statistics.order_statistics`
-    (exact, in a few linear passes, where a full sort of 10^6 values costs thirty times more).
-    ``scratch``: work arrays to reuse (one :class:`~.order_statistics.Scratch` for all outputs)."""
+    """:func:`describe` of one group, in a few passes over the values
+    (:func:`~.order_statistics.moments_and_order_statistics`): the mean and the sum of squared
+    deviations in the passes that count the values into bins for the percentiles' order statistics
+    (exact, where a full sort of 10^6 values costs thirty times more). ``scratch``: work arrays to
+    reuse (one :class:`~.order_statistics.Scratch` for all outputs)."""
     scratch = scratch or Scratch()
-    mean = values.mean() if values.size else math.nan
-    # a finite sum has no NaN or infinity in it: the values are then taken whole, without a mask
-    v = values if math.isfinite(mean) else values[np.isfinite(values)]
-    n = v.size
+    # the values whole (no mask) unless some are not finite, which the fused pass finds
+    got = moments_and_order_statistics(values, _ranks(values.size), scratch) if values.size else None
+    v = values
+    if got is None and values.size:
+        v = values[np.isfinite(values)]
+        got = moments_and_order_statistics(v, _ranks(v.size), scratch) if v.size else None
+        if got is None and v.size:  # finite values whose sums overflow: the order statistics still hold
+            got = (float(v.mean()), math.nan, order_statistics(v, _ranks(v.size), scratch))
+    n = v.size if got is not None else 0
     out = {"n": np.array([n]), "n_not_finite": np.array([values.size - n])}
-    if n == 0:
+    if got is None:
         nan = np.array([np.nan])
         return {**out, "mean": nan, "std": nan.copy(), **{f"p{p:g}": nan.copy() for p in PERCENTILES},
                 "ci_half": nan.copy()}
-    if v is not values:
-        mean = v.mean()
-    residual = np.subtract(v, mean, out=scratch.arrays(n)[0])
-    shift = residual.mean()
-    mean = mean + shift
-    std = math.sqrt(float(np.dot(residual, residual) - n * shift ** 2) / (n - 1)) if n > 1 else math.nan
-    positions = {p: (n - 1) * (p / 100.0) for p in PERCENTILES}
-    ranks = sorted({r for x in positions.values() for r in (math.floor(x), min(math.floor(x) + 1, n - 1))})
-    picked = dict(zip(ranks, order_statistics(v, ranks, scratch)))
+    mean, squares, order = got
+    std = math.sqrt(squares / (n - 1)) if n > 1 else math.nan
+    picked = dict(zip(_ranks(n), order))
     out.update(mean=np.array([mean]), std=np.array([std]))
-    for p, position in positions.items():
-        below = math.floor(position)
-        lo, hi = picked[below], picked[min(below + 1, n - 1)]
+    for p in PERCENTILES:
+        below, above = _bracket(n, p)
+        position = (n - 1) * (p / 100.0)
+        lo, hi = picked[below], picked[above]
         out[f"p{p:g}"] = np.array([lo + (position - below) * (hi - lo)])
     out["ci_half"] = _student_t975(np.array([n - 1])) * std / math.sqrt(n)
     return out
+
+
+def _ranks(n: int) -> list[int]:
+    """The ranks of every order statistic the percentiles of n values need, ascending."""
+    return sorted({r for p in PERCENTILES for r in _bracket(n, p)})
+
+
+def _bracket(n: int, p: float) -> tuple[int, int]:
+    """The ranks (0-based) of the two order statistics numpy's linear rule interpolates for percentile p."""
+    below = math.floor((n - 1) * (p / 100.0))
+    return below, min(below + 1, n - 1)
 
 
 def _kept(column) -> np.ndarray:
