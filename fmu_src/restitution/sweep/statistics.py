@@ -22,6 +22,7 @@ import numpy as np
 from ..fmu.models.sphere_plate_impact.variables import TABLE
 from ..output_files import write_json
 from .order_statistics import Scratch, moments_and_order_statistics, order_statistics
+from .student_t import t975
 from .spec import OUTPUTS, T_OVER_D, pair_label
 from .table import VALIDITY, table_counts
 from .values import unit_of
@@ -43,12 +44,11 @@ MAX_POINTS = 10_000
 
 
 def _student_t975(dof: np.ndarray) -> np.ndarray:
-    """The 97.5 % quantile of Student's t with ``dof`` degrees of freedom (NaN where dof < 1)."""
-    from scipy.special import stdtrit  # the inverse of Student's t distribution: a third of scipy.stats' import
-
+    """The 97.5 % quantile of Student's t with ``dof`` degrees of freedom (NaN where dof < 1), once per
+    distinct dof (:func:`~.student_t.t975`: plain Python, where scipy.special's import took 0.3 s)."""
     dof = np.asarray(dof, dtype=float)
-    with np.errstate(invalid="ignore"):
-        return np.where(dof >= 1, stdtrit(np.maximum(dof, 1), 0.975), np.nan)
+    values, inverse = np.unique(dof, return_inverse=True)
+    return np.array([t975(d) for d in values])[inverse.ravel()].reshape(dof.shape)
 
 
 def describe(values: np.ndarray, groups: np.ndarray | None = None, n_groups: int = 1,
