@@ -373,8 +373,8 @@ class SweepSpec:
             lo = max(start - b * RANDOM_BLOCK, 0)
             hi = min(stop - b * RANDOM_BLOCK, RANDOM_BLOCK)
             at = b * RANDOM_BLOCK + lo - start
+            whole = hi - lo == RANDOM_BLOCK  # a whole block is drawn into place, a part through a buffer
             for k, (kind, args) in self._dists.items():
-                whole = hi - lo == RANDOM_BLOCK  # a whole block is drawn into place, a part through a buffer
                 out = base[k][at:at + RANDOM_BLOCK] if whole else block[k]
                 draw_standard(rng, kind, len(args), out)
                 if not whole:
