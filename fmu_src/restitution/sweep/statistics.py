@@ -149,7 +149,7 @@ def _kept(column) -> np.ndarray:
     return view
 
 
-def _joined(parts: list, dtype) -> np.ndarray:
+def _end_to_end(parts: list, dtype) -> np.ndarray:
     """The parts end to end: the one part itself, without a copy, when there is one."""
     if len(parts) == 1:
         return parts[0]
@@ -199,11 +199,10 @@ class SweepStatistics:
             return
         ok = np.asarray(columns["ok"], dtype=bool)
         if ok.all():  # every case evaluated: no mask; a column that owns its memory is kept without a copy
-            values = {name: _kept(columns[name]) for name in self.names}
-            points = case // self.spec.samples if self.spec.n_grid > 1 else None
+            values, evaluated = {name: _kept(columns[name]) for name in self.names}, case
         else:
-            values = {name: np.asarray(columns[name], dtype=float)[ok] for name in self.names}
-            points = case[ok] // self.spec.samples if self.spec.n_grid > 1 else None
+            values, evaluated = {name: np.asarray(columns[name], dtype=float)[ok] for name in self.names}, case[ok]
+        points = evaluated // self.spec.samples if self.spec.n_grid > 1 else None
         self._chunks[int(case[0])] = (values, points, table_counts(columns), case[~ok][:LISTED_CASES].tolist())
         self._whole = None
 
@@ -218,8 +217,9 @@ class SweepStatistics:
     def _joined(self, names=None):
         """(values per output of ``names``, default all kept; grid points or None) of every chunk, in case order."""
         chunks = [self._chunks[k] for k in sorted(self._chunks)]
-        values = {name: _joined([c[0][name] for c in chunks], float) for name in (self.names if names is None else names)}
-        points = _joined([c[1] for c in chunks], np.int64) if self.spec.n_grid > 1 else None
+        values = {name: _end_to_end([c[0][name] for c in chunks], float)
+                  for name in (self.names if names is None else names)}
+        points = _end_to_end([c[1] for c in chunks], np.int64) if self.spec.n_grid > 1 else None
         return values, points
 
     def values(self, name: str) -> tuple[np.ndarray, np.ndarray | None]:
