@@ -193,7 +193,7 @@ def plot_cor_map(result, path, title: str | None = None, dpi: int = 120, statist
     if mappable is not None:
         fig.colorbar(mappable, ax=axes, label="apparent COR e", shrink=0.9)
     if title is None:
-        title = f"Apparent COR e (Green 2022), {len(ok)} cases" + (f"; {spec_fixed}" if spec_fixed else "")
+        title = _grid_title(len(ok), spec_fixed)
         if boundary:
             title += "; red dashes: edge of the validated range (lambda <= 1.5, V* <= 1000)"
         elif not valid_all.all():
@@ -204,6 +204,11 @@ def plot_cor_map(result, path, title: str | None = None, dpi: int = 120, statist
 
 #: The inputs a COR map draws along, with their axis labels.
 _MAP_AXES = {"v_approach": "approach speed v [m/s]", "t_over_d": "plate thickness / sphere diameter t/d"}
+
+
+def _grid_title(n_cases: int, fixed: str) -> str:
+    """A grid sweep's map title: its cases and the values it held fixed."""
+    return f"Apparent COR e (Green 2022), {n_cases} cases" + (f"; {fixed}" if fixed else "")
 
 
 def _shared_axis(cols, pairs, ok) -> str | None:
@@ -229,7 +234,7 @@ def _pairs_on_one_panel(cols, ok, valid_all, axis, path, title, fixed, dpi) -> P
     _curves(ax, np.asarray(cols[axis], dtype=float)[ok], labels, np.asarray(cols["e"], dtype=float)[ok],
             valid_all[ok], _MAP_AXES[axis], "{}")
     if title is None:
-        title = f"Apparent COR e (Green 2022), {len(ok)} cases" + (f"; {fixed}" if fixed else "")
+        title = _grid_title(len(ok), fixed)
     fit_title(fig, title, fontsize=10)
     return _save(fig, path, dpi)
 
