@@ -2,6 +2,7 @@
 against a serial run, the CLI on an existing scheduler, the table and the COR map."""
 import math
 import os
+import sys
 import time
 import zipfile
 from xml.etree import ElementTree as ET
@@ -190,10 +191,64 @@ def test_serial_backends_agree_and_match_impact(serial):
         # the table publishes t_contact = 0 where the contact never ends (a finite encoding)
         assert fmu["zener.t_contact"][i] == pytest.approx(published(res.as_dict())["t_contact"], rel=1e-12)
         assert bool(fmu["valid"][i]) == bool(res.valid)
-    # the FMU ran the restitution bundled inside it (built from these sources), not this process's copy
-    assert fmu.info["fmu_code_files"][0].endswith(os.path.join("resources", "restitution", "model.py"))
-    assert os.path.dirname(r.__file__) not in fmu.info["fmu_code_files"][0]
+    # the FMU ran the code it ships (built from these sources: the same as this process's package)
+    assert os.path.basename(fmu.info["fmu_code_files"][0]) == "model.py"
     assert fmu.info["code"] == [package.info["code"][0]] == [code_fingerprint()]
+
+
+def test_fmu_instantiation_leaves_the_hosts_modules_in_place(impact_fmu, monkeypatch):
+    """While the back end creates an instance, every ``restitution`` module of this process stays in
+    sys.modules: a Dask worker's other threads import them meanwhile (a task being unpickled), and
+    found them missing when the back end set them aside ("No module named 'restitution.sweep'")."""
+    from restitution.sweep import backends
+
+    before = {k: v for k, v in sys.modules.items() if k == "restitution" or k.startswith("restitution.")}
+    during = []
+
+    def watching(slave):
+        during.append({k: sys.modules.get(k) for k in before})
+        return real(slave)
+
+    real = backends.quiet_instantiate
+    monkeypatch.setattr(backends, "quiet_instantiate", watching)
+    release_fmus()  # a new instance, not one this thread kept from an earlier test
+    try:
+        res = run_sweep(SweepSpec(pairs=["s2_tool_steel/al_6061"], grid={"v_approach": [1.0]}), "fmu",
+                        fmu=impact_fmu, scheduler="serial")
+    finally:
+        release_fmus()
+    assert len(during) == 1
+    moved = [k for k, module in during[0].items() if module is not before[k]]
+    assert not moved, f"set aside while the FMU was instantiated: {moved[:5]}"
+    # the FMU's default case against Eqs. (8), (12), (20) solved independently (tests/independent.py)
+    assert res["e"][0] == pytest.approx(apparent_cor(table_material("s2_tool_steel"), table_material("al_6061"),
+                                                     6.35e-3, 6.35e-3, 1.0), rel=1e-8)
+
+
+def test_an_fmu_built_from_other_sources_runs_its_own_copy(impact_fmu, tmp_path):
+    """An FMU whose package differs from this process's (here: one comment line added to its model.py)
+    runs the copy it ships, under a private name; the results report that copy and its fingerprint."""
+    changed = tmp_path / "SpherePlateImpact.fmu"
+    with zipfile.ZipFile(impact_fmu) as src, zipfile.ZipFile(changed, "w", zipfile.ZIP_DEFLATED) as dst:
+        for item in src.infolist():
+            data = src.read(item)
+            if item.filename == "resources/restitution/model.py":
+                data += b"\n# a build from other sources\n"
+            dst.writestr(item, data)
+    release_fmus()
+    try:
+        res = run_sweep(SweepSpec(pairs=["s2_tool_steel/al_6061"], grid={"v_approach": [0.5, 1.0]}), "fmu",
+                        fmu=changed, scheduler="serial")
+    finally:
+        release_fmus()
+    code_file = res.info["fmu_code_files"][0]
+    assert code_file.endswith(os.path.join("resources", "restitution", "model.py"))
+    assert os.path.dirname(r.__file__) not in code_file
+    assert res.info["code"][0] != code_fingerprint()  # the changed model.py
+    assert "restitution" in sys.modules and sys.modules["restitution"] is r  # the host's package untouched
+    expected = [apparent_cor(table_material("s2_tool_steel"), table_material("al_6061"), 6.35e-3, 6.35e-3, v)
+                for v in (0.5, 1.0)]
+    assert res["e"] == pytest.approx(expected, rel=1e-8)
 
 
 def test_known_value_and_physical_trends():

@@ -11,12 +11,12 @@ parameter-variation example does.
 The FMU file travels with the sweep (as bytes, once per worker), so workers on other
 machines need no shared file system.
 
-A pythonfmu FMU runs in the host's interpreter and imports its bundled ``restitution``
-package by name. A worker that already imported ``restitution`` (to run this module) would
-hand the FMU that copy instead. The instance is therefore created with the host's
-``restitution`` modules set aside, so the FMU imports and keeps its own bundled code; the
-back end checks that the physics the FMU evaluates (``impact_record_at``) comes from the
-extracted FMU and reports the bundled code's fingerprint with the results.
+A pythonfmu FMU runs in the host's interpreter. Its start-up picks the code it runs: the
+``restitution`` package it ships, or the host's when every file it ships is the same there (one
+copy of the code in the process); an FMU built from other sources runs its own copy under a
+private name. The back end checks that the package the FMU evaluates is the code it ships and
+reports that code's fingerprint with the results. It never takes the host's modules out of
+sys.modules: a Dask worker's other threads import them while an instance is created.
 """
 from __future__ import annotations
 
@@ -199,9 +199,6 @@ def impact_groups(cases: dict, rows):
 _LOCK = threading.Lock()
 _EXTRACTED: dict = {}  # sha -> (unzip dir, created-by-us dir or None)
 _INSTANCES: dict = {}  # (sha, thread id) -> _LoadedFmu
-#: This module under a name the FMU's bundled ``restitution`` never shadows: the end of a Dask FMU sweep
-#: calls release_fmus() there without importing it (see restitution.sweep.run._RELEASE_ON_WORKER).
-sys.modules.setdefault("_restitution_sweep_backends", sys.modules[__name__])
 
 
 class _LoadedFmu:
@@ -226,7 +223,7 @@ class _LoadedFmu:
 
     def _instantiate(self, slave):
         if os.path.isfile(os.path.join(self.unzip_dir, "resources", "slavemodule.txt")):  # a pythonfmu FMU
-            self.code_file = _instantiate_with_bundled_code(slave, self.unzip_dir)
+            self.code_file = _instantiate_python_fmu(slave, self.unzip_dir)
             self.code = code_fingerprint(Path(self.code_file).parent)
         else:  # a native FMU (C only): its binary is the code that runs
             quiet_instantiate(slave)
@@ -320,29 +317,28 @@ class _LoadedFmu:
             self.slave = None
 
 
-def _instantiate_with_bundled_code(slave, unzip_dir: str) -> str:
-    """Instantiate a pythonfmu FMU (FMI 2.0) with the host's ``restitution`` (and slave) modules set
-    aside, so the FMU imports its bundled copy; the file of the ``impact`` the FMU runs, checked to be inside the FMU."""
+def _instantiate_python_fmu(slave, unzip_dir: str) -> str:
+    """Instantiate a pythonfmu FMU (FMI 2.0); the file of the ``impact`` the FMU runs, checked to be the
+    code the FMU ships: its own copy, or the host's ``restitution`` when every file the FMU ships is the
+    same (the FMU's start-up decides, as in any Python host). Nothing is taken out of sys.modules: other
+    threads of this process (a Dask worker's) import ``restitution`` modules meanwhile."""
+    from ..fmu.models.restitution_slave_support import SLAVE_PACKAGE, is_shipped_package
+
     resources = os.path.join(unzip_dir, "resources")
-    module_file = os.path.join(resources, "slavemodule.txt")
-    slave_module = Path(module_file).read_text().strip() if os.path.isfile(module_file) else None
-    shadowed = lambda k: k == "restitution" or k.startswith("restitution.") or k == slave_module  # noqa: E731
-    with _LOCK:
-        saved = {k: sys.modules.pop(k) for k in list(sys.modules) if shadowed(k)}
+    slave_module = Path(resources, "slavemodule.txt").read_text().strip()
+    with _LOCK:  # the FMU's start-up reads and extends sys.modules unguarded: one instantiation at a time
         path_before = list(sys.path)
         try:
             quiet_instantiate(slave)
-            fmu_module = sys.modules.get(slave_module) if slave_module else None
-            impact_fn = getattr(fmu_module, "impact_record_at", None)  # what the slave evaluates at each step
-            impact_fn = inspect.unwrap(impact_fn) if impact_fn is not None else None  # past the unit layer
-            code_file = getattr(getattr(impact_fn, "__code__", None), "co_filename", None)
         finally:
-            for k in [k for k in sys.modules if shadowed(k)]:
-                del sys.modules[k]
-            sys.modules.update(saved)
             sys.path[:] = path_before  # pythonfmu prepends resources/; the FMU's modules are loaded
-    if code_file is None or not os.path.realpath(code_file).startswith(os.path.realpath(resources) + os.sep):
-        raise RuntimeError(f"the FMU in {unzip_dir} does not run its bundled restitution package "
+        fmu_module = sys.modules.get(slave_module)
+    impact_fn = getattr(fmu_module, "impact_record_at", None)  # what the slave evaluates at each step
+    impact_fn = inspect.unwrap(impact_fn) if impact_fn is not None else None  # past the unit layer
+    code_file = getattr(getattr(impact_fn, "__code__", None), "co_filename", None)
+    package = getattr(fmu_module, SLAVE_PACKAGE, None)
+    if code_file is None or package is None or not is_shipped_package(package, resources):
+        raise RuntimeError(f"the FMU in {unzip_dir} does not run the restitution package it ships "
                            f"(impact_record_at() comes from {code_file})")
     return code_file
 

@@ -240,15 +240,12 @@ def run_sweep(spec: SweepSpec | dict, backend: str | Backend = "package", *, fmu
         return run.result()
 
 
-#: Run on each worker at the end of an FMU sweep: ``release_fmus()`` if the worker loaded the back end. Sent
-#: as source to the builtin ``exec``, not as the function: a worker unpickles a function by importing its
-#: module, and while a task thread instantiates an FMU the host's ``restitution`` is set aside
-#: (``_instantiate_with_bundled_code``), so a Ctrl-C in the first chunks made that import fail and the
-#: worker log ``distributed.core - ERROR ... No module named 'restitution.sweep'``. The module is found
-#: under a name nothing shadows, and release_fmus() waits for the instantiation (its lock).
+#: Run on each worker at the end of an FMU sweep: ``release_fmus()`` if the worker loaded the back end (sent
+#: as source to the builtin ``exec``: a function would be unpickled by importing its module, on every
+#: worker). release_fmus() waits for an instantiation under way (its lock).
 _RELEASE_ON_WORKER = """
 import sys
-backends = sys.modules.get("_restitution_sweep_backends")
+backends = sys.modules.get("restitution.sweep.backends")
 if backends is not None:
     backends.release_fmus()
 """

@@ -186,7 +186,7 @@ class SweepResult:
     elapsed: float  #: wall time of the evaluation (tasks submitted -> results gathered) [s]
     #: ``info``: ``code`` (fingerprints of the restitution code that ran), ``processes`` (how many
     #: worker processes took part), ``cpu_seconds`` (CPU time of the tasks: building the cases and
-    #: evaluating them), ``fmu_code_files`` (FMU back end: the bundled model.py that ran).
+    #: evaluating them), ``fmu_code_files`` (FMU back end: the model.py that ran, the code the FMU ships).
     n_chunks: int
     info: dict = field(default_factory=dict)
     parts: Path | None = None  #: the directory of the finished chunks (``run_sweep(..., parts=DIR)``)

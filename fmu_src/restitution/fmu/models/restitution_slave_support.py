@@ -263,6 +263,13 @@ def _is_same_package(module, hashes: dict) -> bool:
     return _same_files(os.path.dirname(os.path.dirname(os.path.abspath(init))), hashes)
 
 
+def is_shipped_package(package, resources: str) -> bool:
+    """Whether the loaded package ``package`` is the code the FMU in ``resources`` ships: a copy loaded
+    from it (rules 1 and 3 of the module docstring), or a package with the same files (rule 2)."""
+    hashes = _hash_files(_package_files(resources))
+    return hashes is not None and _is_same_package(package, hashes)
+
+
 def _module_names(root: str) -> list:
     """The dotted names, relative to the package in ``root``, of every module and subpackage in it."""
     names = []
