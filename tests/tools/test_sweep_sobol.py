@@ -123,7 +123,7 @@ def test_the_intervals_cover_the_true_indices_over_many_designs():
     scrambled with its own seed (N = 512): for every index that is not zero the interval holds the true value
     in at least 90 of them (measured: 96 to 100; on a scrambled Sobol' sequence the estimates scatter less than
     the bootstrap, which resamples them as if random, assumes). An index that is exactly zero (x3 alone) is
-    covered less often (measured: 84): docs/sweeps.md says so; here at least 75."""
+    covered less often (measured: 84): docs/uncertainty.md says so; here at least 75."""
     exact = ishigami_exact()
     covered = {(name, field): 0 for name in ISHIGAMI_INPUTS for field in ("S1", "ST")}
     n_designs = 100
