@@ -6,7 +6,7 @@ import pytest
 
 from restitution.sweep import SweepSpec
 from restitution.sweep.backends import PackageBackend
-from restitution.sweep.table import COLUMNS, PackedColumns, assemble, keep_columns
+from restitution.sweep.table import COLUMNS, PackedColumns, TableBuilder, assemble, keep_columns
 
 SPEC = SweepSpec(pairs=["s2_tool_steel/al_6061", "brass_260/borosilicate_glass"],
                  grid={"v_approach": {"geomspace": [0.05, 20.0, 30]}, "t_over_d": {"geomspace": [0.05, 10.0, 20]}})
@@ -128,3 +128,51 @@ def test_assemble_keeps_fixed_inputs_as_views_and_owns_every_other_column(chunks
     for i, a in enumerate(owned):
         for b in owned[i + 1:]:
             assert not np.shares_memory(table[a], table[b]), (a, b)
+
+
+def test_the_table_builder_takes_chunks_in_any_order_and_an_input_that_varies_late():
+    """Chunks added as they finish, out of order, give the table in case order, bit for bit. A sweep over
+    two pairs whose first chunks all lie in the first pair holds the materials as one-value views up to
+    the chunk where the second pair starts: the column then holds the earlier rows' value and the later
+    rows' own. The chunks' arrays are not kept (each can be freed once added)."""
+    import gc
+    import weakref
+
+    n = SPEC.n_cases  # pair 0's cases come first: its materials are one-value views in its chunks
+    bounds = [0, 150, 300, 450, n]
+    own = [_evaluated(SPEC, a, b) for a, b in zip(bounds[:-1], bounds[1:])]
+    assert all(c["sphere.E"].strides == (0,) for c in own[:2])  # views in the first chunks
+    expected = {name: np.concatenate([np.array(c[name]) for c in own]) for name in own[0]}
+    builder = TableBuilder(SPEC, None, n)
+    watched = weakref.ref(own[2]["e"])
+    for k in (2, 0, 3, 1):  # the order a cluster may finish them in
+        builder.add(bounds[k], PackedColumns(own[k]) if k % 2 else own[k])
+    del own
+    gc.collect()
+    assert watched() is None  # copied, not kept
+    table = builder.table()
+    assert list(table["pair"]) == [SPEC.pairs[j] for j in expected["pair"]]
+    for name in COLUMNS:
+        if name != "pair":
+            assert _same_bits(table[name], expected[name].astype(table[name].dtype)), name
+    assert table["sphere.E"].strides != (0,) and len(set(table["sphere.E"].tolist())) == 2
+
+
+@pytest.mark.parametrize("added", [[0, 2], [1], [2], []])
+def test_an_interrupted_table_holds_the_rows_of_the_chunks_added_in_case_order(added):
+    """After an interruption the table holds the finished chunks' rows only (gaps closed), still in case
+    order; a fixed input stays a one-value view where more than one row remains."""
+    n = ONE_PAIR.n_cases
+    bounds = np.linspace(0, n, 4).astype(int)
+    own = {k: _evaluated(ONE_PAIR, bounds[k], bounds[k + 1]) for k in added}
+    builder = TableBuilder(ONE_PAIR, None, n)
+    for k in reversed(added):
+        builder.add(int(bounds[k]), own[k])
+    table = builder.table()
+    rows = sum(int(bounds[k + 1] - bounds[k]) for k in added)
+    assert all(len(col) == rows for col in table.values())
+    if added:
+        want = np.concatenate([own[k]["case"] for k in added])
+        assert np.array_equal(table["case"], want) and np.all(np.diff(table["case"]) > 0)
+        assert _same_bits(table["e"], np.concatenate([own[k]["e"] for k in added]))
+        assert table["sphere.E"].strides == (0,)

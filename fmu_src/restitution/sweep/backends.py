@@ -139,7 +139,7 @@ class PackageBackend(Backend):
     name = "package"
     default_chunk = 100_000
     #: a serial sweep kept in memory only: up to 10^6 cases are one chunk, whose arrays become the table
-    #: without a copy (assemble); impact()'s temporaries for them peak near the table's own size
+    #: without a copy (TableBuilder); impact()'s temporaries for them peak near the table's own size
     in_memory_chunk = 1_000_000
 
     def evaluate(self, cases: dict, payload=None, outputs=None):

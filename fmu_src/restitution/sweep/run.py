@@ -43,7 +43,7 @@ from .cluster import CASE_SECONDS, cost_class, count_workers, describe_client, o
 from .parts import DiskSweepResult, PartStore
 from .size import check_case_numbers
 from .spec import SweepSpec
-from .table import PackedColumns, SweepResult, assemble, keep_columns, table_counts
+from .table import PackedColumns, SweepResult, TableBuilder, keep_columns, table_counts
 
 __all__ = ["run_sweep", "SweepInterrupted"]
 
@@ -275,14 +275,16 @@ class _TransferInterrupt(DeferredInterrupt):
 
 
 class _Run:
-    """The finished chunks of one run: in memory (start -> (columns, info); the columns as they came,
-    packed from a worker), or on disk only (start -> (None, info)) when ``in_memory`` is false;
-    written to ``store`` as they finish, and shown to ``on_chunk`` (see :func:`run_sweep`)."""
+    """The finished chunks of one run (start -> (columns or None, info)): written to ``store`` as they
+    finish, shown to ``on_chunk`` (see :func:`run_sweep`) and, when ``in_memory``, copied into the table
+    at once (:class:`~restitution.sweep.table.TableBuilder`; the columns of chunks reused from the parts
+    wait in ``done`` until the table is taken)."""
 
     def __init__(self, spec, backend, keep, store, in_memory: bool, on_chunk=None):
         self.spec, self.backend, self.keep, self.store, self.in_memory = spec, backend, keep, store, in_memory
         self.on_chunk = on_chunk
         self.done = {}
+        self.table = TableBuilder(spec, keep, spec.n_cases) if in_memory else None
 
     def open(self, chunk_size, resume, n_chunks, where, workers):
         self.n_chunks, self.where, self.workers = n_chunks, where, workers
@@ -304,7 +306,9 @@ class _Run:
                 self.store.write(a, b, (plain, info))
             if self.on_chunk is not None:
                 self.on_chunk(a, b, plain)
-            self.done[a] = (columns if self.in_memory else None, info)
+            if self.in_memory:
+                self.table.add(a, columns)
+            self.done[a] = (None, info)
         held.check()
 
     def result(self) -> SweepResult:
@@ -321,11 +325,11 @@ class _Run:
             info["keep"], info["sweep"] = self.keep, self.store.sweep
             kwargs.update(parts=Path(self.store.path), chunk_counts={a: self.done[a][1]["counts"] for a in starts})
         if self.in_memory:
-            parts = []
             for a in starts:
-                parts.append(self.done[a][0])
-                self.done[a] = (None, self.done[a][1])
-            return SweepResult(columns=assemble(self.spec, parts, self.keep), **kwargs)
+                if self.done[a][0] is not None:  # reused from the parts
+                    self.table.add(a, self.done[a][0])
+                    self.done[a] = (None, self.done[a][1])
+            return SweepResult(columns=self.table.table(), **kwargs)
         return DiskSweepResult(columns={}, **kwargs)
 
     def interrupted(self) -> "SweepInterrupted":

@@ -14,7 +14,7 @@ from .spec import (INPUT_NAMES, INTEGER_INPUTS, OUTPUT_NAMES, OUTPUTS as _OUTPUT
                    is_one_value_view)
 
 __all__ = ["COLUMNS", "VALIDITY", "SweepResult", "PackedColumns", "read_table", "table_counts", "assemble",
-           "keep_columns", "write_atomic", "write_csv_rows", "chunk_table", "pair_codes"]
+           "keep_columns", "TableBuilder", "write_atomic", "write_csv_rows", "chunk_table", "pair_codes"]
 
 #: Column order of a result table.
 COLUMNS = ("case", "pair", *INPUT_NAMES, T_OVER_D, *OUTPUT_NAMES, "ok")
@@ -94,60 +94,92 @@ def _column_type(name: str):
 
 
 def assemble(spec: SweepSpec, parts: list, keep) -> dict:
-    """The table from consecutive chunks (each a dict of columns or a :class:`PackedColumns`).
-
-    An input that holds one value over the whole sweep (a fixed parameter, a single pair's materials,
-    ``pair`` itself then) stays a read-only view of that value (:func:`~restitution.sweep.spec.is_one_value_view`):
-    no memory, as in the chunks. A single chunk's own arrays become the table's columns (no copy). Otherwise
-    ``parts`` is consumed: each chunk is dropped once copied into the table, whose columns are allocated at
-    their final types and filled chunk by chunk, so the memory in use stays near one table (the chunks not
-    yet copied plus the rows filled)."""
-    names = [c for c in COLUMNS if keep is None or c in keep]
-    n = sum(part.rows if isinstance(part, PackedColumns) else int(np.size(part["case"])) for part in parts)
-    packed = len(parts) == 1 and isinstance(parts[0], PackedColumns)
-    chunks = [part.columns() if isinstance(part, PackedColumns) else part for part in parts]
-    parts.clear()  # each chunk's columns (views of a packed buffer) now hold what it holds
-    columns = {name: _one_value_column(name, chunks, n) for name in names}
-    copied = [name for name in names if columns[name] is None]
-    if len(chunks) == 1:
-        columns.update((name, _own_column(chunks[0][name], _column_type(name), packed)) for name in copied)
-    else:
-        columns.update((name, np.empty(n, dtype=_column_type(name))) for name in copied)
-        chunks.reverse()
-        row = 0
-        while chunks:
-            chunk = chunks.pop()
-            end = row + int(np.size(chunk["case"]))
-            for name in copied:
-                columns[name][row:end] = chunk[name]
-            row = end
-            del chunk
-    labels = np.array(list(spec.pairs) + [""], dtype=object)  # pair -1 (no pairs) reads ""
-    pair = columns["pair"]
-    columns["pair"] = (np.broadcast_to(labels[pair[:1]], (n,)) if is_one_value_view(pair) else labels[pair])
-    return columns
+    """The table from consecutive chunks (each a dict of columns or a :class:`PackedColumns`), as
+    :class:`TableBuilder` makes it. ``parts`` is consumed: each chunk is dropped once copied."""
+    rows = sum(part.rows if isinstance(part, PackedColumns) else int(np.size(part["case"])) for part in parts)
+    builder, start = TableBuilder(spec, keep, rows), 0
+    parts.reverse()
+    while parts:
+        part = parts.pop()
+        start = builder.add(start, part)
+        del part
+    return builder.table()
 
 
 #: The columns that may stay one-value views in a table: the inputs (what the spec fixes), never an output.
 _VIEW_COLUMNS = frozenset(("pair", *INPUT_NAMES, T_OVER_D))
 
 
-def _one_value_column(name, chunks, n):
-    """``name``'s column as a read-only view of one value when it is an input that every chunk holds as a
-    view of the same value (bit for bit); else None."""
-    if name not in _VIEW_COLUMNS or n < 2:
-        return None
-    dtype, value = _column_type(name), None
-    for chunk in chunks:
-        col = chunk[name]
-        if not is_one_value_view(col):
-            return None
-        first = np.asarray(col[:1], dtype=dtype)
-        if value is None:
-            value = first
-        elif value.tobytes() != first.tobytes():
-            return None
-    return np.broadcast_to(value, (n,))
+class TableBuilder:
+    """A table of ``rows`` cases filled chunk by chunk as the chunks finish, in any order (:meth:`add`),
+    then taken (:meth:`table`).
+
+    Each chunk is copied into columns allocated once at their final types, and can be dropped at once:
+    the memory in use stays near one table, and the chunks' own pages are reused by the next ones (a
+    serial sweep of 10^7 cases that kept its ten chunks until the end faulted in all their pages as
+    well as the table's, and cost several times the model). An input that holds one value over every
+    chunk (bit for bit: a fixed parameter, a single pair's materials, ``pair`` itself then) stays a
+    read-only view of that value (:func:`~restitution.sweep.spec.is_one_value_view`): no memory, as in
+    the chunks. A chunk that is the whole table gives its own arrays (no copy)."""
+
+    def __init__(self, spec: SweepSpec, keep, rows: int):
+        self.spec, self.rows = spec, rows
+        self.names = [c for c in COLUMNS if keep is None or c in keep]
+        self.filled = {}  #: start -> stop of each chunk added
+        self.values = {}  #: name -> its one value (an array of one), while every chunk added holds it as a view
+        self.columns = {}  #: name -> its column of ``rows`` rows, filled where chunks were added
+
+    def add(self, start: int, part) -> int:
+        """Copy the chunk ``part`` (columns of cases ``start`` ...) into the table; returns where it ends."""
+        packed = isinstance(part, PackedColumns)
+        chunk = part.columns() if packed else part
+        stop = start + int(np.size(chunk["case"]))
+        for name in self.names:
+            self._take(name, chunk[name], start, stop, packed)
+        self.filled[start] = stop
+        return stop
+
+    def _take(self, name, col, start, stop, packed):
+        dtype = _column_type(name)
+        if name not in self.columns:
+            if name in _VIEW_COLUMNS and self.rows > 1 and is_one_value_view(col):
+                value, held = np.asarray(col[:1], dtype=dtype), self.values.get(name)
+                if held is None or held.tobytes() == value.tobytes():
+                    self.values[name] = value
+                    return
+            if start == 0 and stop == self.rows:  # the whole table in one chunk
+                self.columns[name] = _own_column(col, dtype, packed)
+                return
+            column = np.empty(self.rows, dtype=dtype)
+            held = self.values.pop(name, None)
+            if held is not None:  # it was one value up to this chunk
+                for a, b in self.filled.items():
+                    column[a:b] = held
+            self.columns[name] = column
+        self.columns[name][start:stop] = col
+
+    def table(self) -> dict:
+        """The table of the chunks added, in case order (all of them: the columns as filled; fewer, as
+        after an interruption: their rows only, copied). Call once."""
+        spans = sorted(self.filled.items())
+        rows = sum(b - a for a, b in spans)
+        columns = {}
+        for name in self.names:
+            dtype = _column_type(name)
+            if name in self.values:
+                value = self.values[name]
+                columns[name] = np.broadcast_to(value, (rows,)) if rows > 1 else np.repeat(value, rows)
+            elif name not in self.columns:  # no chunk
+                columns[name] = np.empty(0, dtype=dtype)
+            elif rows == self.rows:
+                columns[name] = self.columns[name]
+            else:
+                columns[name] = np.concatenate([self.columns[name][a:b] for a, b in spans] or [np.empty(0, dtype)])
+        self.columns.clear()
+        labels = np.array(list(self.spec.pairs) + [""], dtype=object)  # pair -1 (no pairs) reads ""
+        pair = columns["pair"]
+        columns["pair"] = (np.broadcast_to(labels[pair[:1]], (rows,)) if is_one_value_view(pair) else labels[pair])
+        return columns
 
 
 def _own_column(col, dtype, packed: bool):
