@@ -67,6 +67,20 @@ def test_the_linear_methods_endless_contact_has_an_endless_delay_published_as_ze
     assert shown["wave_delay"] == 0.0 and not shown["contact_ends"]
 
 
+def test_published_arrays_zero_the_endless_contacts_and_leave_the_others():
+    """On arrays whose contacts partly never end (the linear method past lambda = 2) and wholly end: tau0,
+    t_contact and wave_delay read 0 exactly where ``contact_ends`` is false, the result's values elsewhere."""
+    v = np.array([0.05, 0.2, 1.0, 3.0, 6.0])
+    for thickness, some_endless in ((0.2, True), (1.0, False)):
+        res = r.impact(v, **params(thickness), zener_method="linear")
+        ends = np.asarray(res.contact_ends)
+        assert (not ends.all()) == some_endless and ends.any()
+        shown = published(res.as_dict())
+        for name in ("tau0", "t_contact", "wave_delay"):
+            assert np.all(shown[name][~ends] == 0.0), name
+            assert np.array_equal(shown[name][ends], np.asarray(getattr(res, name))[ends]), name
+
+
 def p_wave_speed(E, nu, rho):
     """c_L = sqrt((lambda_L + 2 mu) / rho) with the Lame constants of E and nu."""
     lame = E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu))
