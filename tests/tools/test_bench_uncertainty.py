@@ -17,7 +17,9 @@ def test_quick_run_prints_both_sides_and_the_ratio_of_each_measurement(tmp_path)
         rf"^1\(a\) Monte Carlo, .* sweep \+ statistics ({NUMBER}) s, impact \+ numpy statistics ({NUMBER}) s: "
         rf"({NUMBER})x \(goal <= 2x: (met|NOT met)",
         rf"^1\(b\) Monte Carlo, .* sweep command ({NUMBER}) s, plain impact process ({NUMBER}) s: ({NUMBER})x "
-        rf"\(goal <= 2x: (met|NOT met)\)",
+        rf"\(no goal: more work",
+        rf"^1\(c\) the same with --columns e, .* sweep command ({NUMBER}) s, plain impact process ({NUMBER}) s: "
+        rf"({NUMBER})x \(goal <= 2x: (met|NOT met)\)",
         rf"^     wall: sweep command ({NUMBER}) s, plain impact process ({NUMBER}) s: ({NUMBER})x",
         rf"^2\. .*--scheduler serial .*: wall ({NUMBER}) s \(goal <= 5 s: (met|NOT met)\).* model evaluation "
         rf"({NUMBER}) s, analysis ({NUMBER}) s: analysis / evaluation ({NUMBER})x",
