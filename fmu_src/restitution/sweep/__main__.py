@@ -212,8 +212,9 @@ def main(argv=None) -> int:
     parser.add_argument("--columns", help="keep only these comma-separated columns (plus case and pair), "
                                           "e.g. v_approach,t_over_d,e,valid for a big sweep")
     parser.add_argument("--out", help="table: .csv or .parquet (default: sweep.parquet with pyarrow, else sweep.csv)")
-    parser.add_argument("--plot", help="COR map image (default: <out>_cor_map.png)")
-    parser.add_argument("--no-plot", action="store_true", help="skip the COR map")
+    parser.add_argument("--plot", help="COR map image (default: <out>_cor_map.png); with --sobol the indices' chart "
+                                       "is <out>_sobol.png")
+    parser.add_argument("--no-plot", action="store_true", help="skip the COR map (and the Sobol' chart)")
     parser.add_argument("--summary", metavar="FILE", help="JSON: mean, std, percentiles and the mean's 95 %% "
                                                           "interval of every output, the out-of-range cases, the draws "
                                                           "(printed for the main outputs whenever there are --random inputs), "
@@ -308,6 +309,7 @@ def _main(parser, args) -> int:
                       f"(.csv or .parquet)", EXIT_REFUSED)
     plot = None if (args.no_plot or run.get("plot") is False) else Path(
         args.plot or run.get("plot") or out.with_name(out.stem + "_cor_map.png"))
+    sobol_chart = out.with_name(out.stem + "_sobol.png") if args.sobol and plot is not None else None
     parts = out.with_name(out.name + ".parts")
     summary = args.summary or run.get("summary")
     print(f"sweep: {spec.describe()}")
@@ -333,9 +335,14 @@ def _main(parser, args) -> int:
             check_output(plot, "--plot")
             if os.path.realpath(plot) == os.path.realpath(out):
                 raise OutputPathError(f"--plot {plot}: is the table's file (--out {out}); give another name")
+        if sobol_chart is not None:
+            check_output(sobol_chart, "the Sobol' chart")
+            if os.path.realpath(sobol_chart) == os.path.realpath(plot):
+                raise OutputPathError(f"--plot {plot}: is the Sobol' chart's file; give another name")
         if summary is not None:
             check_output(summary, "--summary")
-            taken = {os.path.realpath(p): o for p, o in ((out, "--out"), (plot, "--plot")) if p is not None}
+            taken = {os.path.realpath(p): o for p, o in ((out, "--out"), (plot, "--plot"),
+                                                          (sobol_chart, "the Sobol' chart")) if p is not None}
             if os.path.realpath(summary) in taken:
                 raise OutputPathError(f"--summary {summary}: is the file of {taken[os.path.realpath(summary)]}; "
                                       f"give another name")
@@ -453,6 +460,15 @@ def _main(parser, args) -> int:
         print(statistics.text())
     sobol_section, sobol_status = _sobol_report(sobol) if sobol is not None else ({}, 0)
     status = max(status, sobol_status)
+    if sobol_chart is not None and sobol_section.get("sobol"):
+        from .sobol_plot import plot_sobol
+
+        try:
+            drawn = plot_sobol({**sobol_section["sobol_design"], "sobol": sobol_section["sobol"]}, sobol_chart)
+            print(f"Sobol' chart: {drawn}")
+        except (OutputWriteError, OutputPathError) as exc:
+            return _error(f"{exc}; the table was written to {out}",
+                          EXIT_REFUSED if isinstance(exc, OutputPathError) else EXIT_IO_ERROR)
     if summary is not None:
         try:
             print(f"summary: {write_summary(summary, statistics.summary(backend=result.backend), sobol_section)}")

@@ -199,7 +199,7 @@ def plot_cor_map(result, path, title: str | None = None, dpi: int = 120, statist
         elif not valid_all.all():
             title += "; red marks: outside the validated range"
     fit_title(fig, title, fontsize=10)
-    return _save(fig, path, dpi)
+    return save_figure(fig, path, dpi)
 
 
 #: The inputs a COR map draws along, with their axis labels.
@@ -236,15 +236,17 @@ def _pairs_on_one_panel(cols, ok, valid_all, axis, path, title, fixed, dpi) -> P
     if title is None:
         title = _grid_title(len(ok), fixed)
     fit_title(fig, title, fontsize=10)
-    return _save(fig, path, dpi)
+    return save_figure(fig, path, dpi)
 
 
-def _save(fig, path, dpi) -> Path:
+def save_figure(fig, path, dpi, what: str = "COR map") -> Path:
+    """Write ``fig`` to ``path`` under a temporary name, renamed when whole (restitution.output_files;
+    ``what`` names it in an error), and close it."""
     import matplotlib.pyplot as plt
 
     path = Path(path)
-    try:  # under a temporary name, renamed when whole (restitution.output_files)
-        atomic_write(path, lambda tmp: fig.savefig(tmp, dpi=dpi), "COR map")
+    try:
+        atomic_write(path, lambda tmp: fig.savefig(tmp, dpi=dpi), what)
     finally:
         plt.close(fig)
     return path
@@ -354,4 +356,4 @@ def plot_random(statistics, path, title: str | None = None, dpi: int = 120) -> P
             title += f" ({counts['cases'] - counts['ok']:,} with inputs out of range left out)"
         title += f": {_draws_text(spec)}"
     fit_title(fig, title, fontsize=10)
-    return _save(fig, path, dpi)
+    return save_figure(fig, path, dpi)
