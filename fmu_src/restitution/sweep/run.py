@@ -284,7 +284,7 @@ class _Run:
         self.spec, self.backend, self.keep, self.store, self.in_memory = spec, backend, keep, store, in_memory
         self.on_chunk = on_chunk
         self.done = {}
-        self.table = TableBuilder(spec, keep, spec.n_cases) if in_memory else None
+        self.builder = TableBuilder(spec, keep, spec.n_cases) if in_memory else None
 
     def open(self, chunk_size, resume, n_chunks, where, workers):
         self.n_chunks, self.where, self.workers = n_chunks, where, workers
@@ -307,7 +307,7 @@ class _Run:
             if self.on_chunk is not None:
                 self.on_chunk(a, b, plain)
             if self.in_memory:
-                self.table.add(a, columns)
+                self.builder.add(a, columns)
             self.done[a] = (None, info)
         held.check()
 
@@ -327,9 +327,9 @@ class _Run:
         if self.in_memory:
             for a in starts:
                 if self.done[a][0] is not None:  # reused from the parts
-                    self.table.add(a, self.done[a][0])
+                    self.builder.add(a, self.done[a][0])
                     self.done[a] = (None, self.done[a][1])
-            return SweepResult(columns=self.table.table(), **kwargs)
+            return SweepResult(columns=self.builder.table(), **kwargs)
         return DiskSweepResult(columns={}, **kwargs)
 
     def interrupted(self) -> "SweepInterrupted":

@@ -29,6 +29,8 @@ __all__ = ["QuantityError", "quantity", "quantities", "unit_of", "outside", "par
 ROWS = {v.name: v for v in TABLE.settable}
 #: SI unit (as the interface table writes it) -> the kind of quantity the scene's parser converts to.
 KINDS = {si: kind for kind, si in QUANTITIES.items()}
+
+
 class QuantityError(ValueError):
     """A value the sweep refuses: not a number, a unit it cannot take, or outside the input's declared
     range. ``name`` is the input, ``section`` where the value was given ("grid", "random", "fixed";
