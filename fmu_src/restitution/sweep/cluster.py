@@ -51,9 +51,39 @@ def open_client(scheduler=None, n_workers: int | None = None, threads_per_worker
         # direct_to_workers: this process takes each finished chunk from its worker. Through the scheduler
         # (Dask's default for a client) every chunk crossed TCP twice and, the LocalCluster's scheduler
         # living in this process, was received here twice, into fresh memory each time.
-        with cluster, Client(cluster, direct_to_workers=True) as client:
+        with _quiet_shutdown() as quiet, cluster, Client(cluster, direct_to_workers=True) as client:
             release()  # a Ctrl-C of the start-up is raised here, where the cluster is closed on the way out
-            yield client
+            try:
+                yield client
+            finally:
+                quiet(client)
+
+
+def _silence_logging() -> None:
+    """No more log records in this process (a worker about to be stopped)."""
+    logging.disable(logging.CRITICAL)
+
+
+@contextlib.contextmanager
+def _quiet_shutdown():
+    """``quiet(client)``, called before the cluster closes: no more logs from its workers, nor from Dask in
+    this process until the cluster is closed (the level is put back on the way out).
+
+    The cluster stops its scheduler (in this process) and its workers one after the other; a worker whose
+    heartbeat found the scheduler gone logged a traceback to the terminal after the sweep's own last line
+    (seen after an interrupt on a loaded machine). Whatever the sweep had to say is said by then; a failure
+    to reach a worker here is of no consequence (it is being stopped)."""
+    logger = logging.getLogger("distributed")
+    level = logger.level
+
+    def quiet(client):
+        with contextlib.suppress(Exception):
+            client.run(_silence_logging, on_error="ignore")
+        logger.setLevel(logging.CRITICAL)
+    try:
+        yield quiet
+    finally:
+        logger.setLevel(level)
 
 
 @contextlib.contextmanager
