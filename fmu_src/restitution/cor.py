@@ -11,15 +11,15 @@ inputs and every field of the result in SI units.
 """
 from __future__ import annotations
 
-import argparse
 import json
 import math
 import sys
 
 from .model import ZENER_METHODS, impact, published
 from .zener import WAVE_DELAY_LIMIT
-from .options import OptionError, input_quantity, material
-from .output_files import EXIT_IO_ERROR, EXIT_REFUSED, OutputPathError, atomic_write, check_output
+from .options import ArgumentParser, OptionError, input_quantity, material
+from .output_files import (EXIT_IO_ERROR, EXIT_REFUSED, OutputPathError, atomic_write, check_output,
+                           finish_stdout)
 
 __all__ = ["main", "evaluate"]
 
@@ -77,9 +77,9 @@ def report(inputs: dict, r: dict) -> str:
 
 
 def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(prog="restitution cor", description=__doc__.split("\n\n")[0],
-                                     epilog="Lengths and speeds take a unit (\"6.35 mm\", \"1/4 in\", \"2 m/s\"); "
-                                            "a bare number is SI.")
+    parser = ArgumentParser(prog="restitution cor", description=__doc__.split("\n\n")[0],
+                            epilog="Lengths and speeds take a unit (\"6.35 mm\", \"1/4 in\", \"2 m/s\"); "
+                                   "a bare number is SI.")
     parser.add_argument("--sphere", required=True, metavar="KEY", help="sphere material (restitution materials)")
     parser.add_argument("--d", required=True, metavar="LEN", help="sphere diameter, e.g. \"6.35 mm\"")
     parser.add_argument("--plate", required=True, metavar="KEY", help="plate material")
@@ -98,15 +98,17 @@ def main(argv=None) -> int:
     except (OptionError, OutputPathError) as exc:
         print(f"restitution cor: error: {exc}", file=sys.stderr)
         return EXIT_REFUSED
-    print(report(inputs, result))
+    status = finish_stdout("restitution cor", report(inputs, result))
+    if status:
+        return status
     if args.json:
         finite = {key: (None if isinstance(value, float) and not math.isfinite(value) else value)
                   for key, value in result.items()}  # m_eff = +inf for a half-space: null, JSON has no inf
         text = json.dumps({"inputs": inputs, "result": finite, "units": UNITS}, indent=1, allow_nan=False)
         try:
             atomic_write(args.json, lambda tmp: tmp.write_text(text + "\n", encoding="utf-8"), "--json")
-        except OSError as exc:
-            print(f"restitution cor: error: {exc}", file=sys.stderr)
+        except (OSError, OutputPathError) as exc:
+            print(f"restitution cor: error: --json: {exc}", file=sys.stderr)
             return EXIT_IO_ERROR
     return 0
 

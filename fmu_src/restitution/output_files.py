@@ -13,6 +13,11 @@ checked before any work, and written whole or not at all. One copy of this logic
   fsynced and visible under the final name as soon as it is whole; an I/O error puts back the file
   that was there before (or removes the new one).
 - :func:`write_json` writes a JSON record that way (non-finite numbers as null, numpy scalars as numbers).
+- :func:`check_outputs` refuses, before any work, an output that names an input of the same command
+  or another of its outputs (by resolved path and by device and inode: symlinks and hard links count),
+  so that no run overwrites its own data.
+- :func:`finish_stdout` flushes what a command printed: standard output on a full disk or a closed
+  pipe is one line on stderr and :data:`EXIT_IO_ERROR` (or the reader's exit, 141), never a traceback.
 - An I/O error (ENOSPC, EIO, EACCES, ...) is an :class:`OutputWriteError`, whose text is one line
   naming the path and the system's reason; the tools print it and exit with :data:`EXIT_IO_ERROR`.
 """
@@ -25,16 +30,19 @@ import json
 import math
 import os
 import stat
+import sys
 import tempfile
 from pathlib import Path
 
-__all__ = ["EXIT_REFUSED", "EXIT_IO_ERROR", "OutputPathError", "OutputWriteError", "os_reason", "describe_os_error",
-           "file_kind", "check_output", "check_output_dir", "atomic_write", "json_ready", "write_json", "GrowingOutput"]
+__all__ = ["EXIT_REFUSED", "EXIT_IO_ERROR", "EXIT_BROKEN_PIPE", "OutputPathError", "OutputWriteError", "os_reason", "describe_os_error",
+           "file_kind", "check_output", "check_outputs", "check_output_dir", "finish_stdout", "atomic_write", "json_ready", "write_json", "GrowingOutput"]
 
 #: Exit status of an output path refused before any work (a user mistake, as the other ones).
 EXIT_REFUSED = 2
 #: Exit status of an I/O error while writing (sysexits.h EX_IOERR).
 EXIT_IO_ERROR = 74
+#: Exit status when the reader of standard output went away (a shell's 128 + SIGPIPE).
+EXIT_BROKEN_PIPE = 141
 
 
 class OutputPathError(ValueError):
@@ -126,6 +134,69 @@ def check_output(path, what: str = "--out") -> Path:
     if st is not None and not os.access(dest, os.W_OK):
         raise OutputPathError(f"{what} {path}: not writable")
     return path
+
+
+def _identity(path) -> tuple[str, tuple[int, int] | None]:
+    """(the resolved absolute path, (device, inode) of the file it names or None if none can be seen)."""
+    resolved = os.path.normcase(os.path.realpath(os.path.abspath(os.fspath(path))))
+    try:
+        st = os.stat(path)
+    except (OSError, ValueError):
+        return resolved, None
+    return resolved, (st.st_dev, st.st_ino)
+
+
+def check_outputs(outputs: dict, inputs: dict | None = None) -> None:
+    """Refuse (OutputPathError, one line naming both) an output of ``outputs`` (option -> path, None
+    skipped) that is the same file as an input of ``inputs`` (name -> path, None skipped) or as
+    another output: the same path once symlinks and ``..`` are resolved, or the same device and inode
+    (a hard link, or another spelling). Call it before any work: writing an output over an input
+    would destroy the data the command reads."""
+    seen: list[tuple[str, object, tuple[str, tuple[int, int] | None], bool]] = []
+    for name, path in (inputs or {}).items():
+        if path is not None:
+            seen.append((name, path, _identity(path), True))
+    for option, path in outputs.items():
+        if path is None:
+            continue
+        here = _identity(path)
+        for name, other, there, is_input in seen:
+            if here[0] == there[0] or (here[1] is not None and here[1] == there[1]):
+                if is_input:
+                    raise OutputPathError(f"{option} {path}: is the input {name} ({other}): writing it would "
+                                          "destroy the data; give another file name")
+                raise OutputPathError(f"{option} {path}: is the same file as {name} {other}: give each output "
+                                      "its own file name")
+        seen.append((option, path, here, False))
+
+
+def _silence_stdout() -> None:
+    """Point file descriptor 1 at the null device: what is left in sys.stdout's buffer goes nowhere
+    at exit instead of failing again ("Exception ignored ...")."""
+    with contextlib.suppress(OSError, ValueError, AttributeError):
+        fd = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(fd, sys.stdout.fileno())
+        os.close(fd)
+
+
+def finish_stdout(prog: str, text: str | None = None) -> int:
+    """Print ``text`` (if given) and flush standard output: 0 if it all went out; else, with standard
+    output pointed at the null device, :data:`EXIT_BROKEN_PIPE` (silently) where the reader went away
+    or :data:`EXIT_IO_ERROR` after one line ``PROG: error: cannot write standard output: REASON`` on
+    stderr (a full disk, an I/O error)."""
+    try:
+        if text is not None:
+            print(text)
+        sys.stdout.flush()
+    except BrokenPipeError:
+        _silence_stdout()
+        return EXIT_BROKEN_PIPE
+    except OSError as exc:
+        _silence_stdout()
+        with contextlib.suppress(OSError, ValueError):
+            print(f"{prog}: error: cannot write standard output: {os_reason(exc)}", file=sys.stderr, flush=True)
+        return EXIT_IO_ERROR
+    return 0
 
 
 def check_output_dir(path, what: str = "--out") -> Path:

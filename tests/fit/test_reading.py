@@ -8,7 +8,7 @@ import wave
 import numpy as np
 import pytest
 
-from restitution.fit.datasets import DataError, ImpactTimes, ReboundPairs
+from restitution.fit.datasets import DataError, ImpactTimes, ReboundPairs, check_drop_speeds
 from restitution.fit.reading import read_csv, read_data, write_times
 
 V_IN = [2.5, 1.75, 0.5, 3.125]  # [m/s]
@@ -99,6 +99,19 @@ BAD_TABLES = {
     "empty cell": ("v_in,v_out\n1,0.5\n,1\n3,1\n", ["line 3 (row 2), column v_in", "''"]),
     "decimal comma": ("v_in,v_out\n1,0,5\n", ["line 2 has 3 cells, the header 2", "decimal comma"]),
     "short row": ("v_in,v_out,sigma\n1,0.5\n", ["line 2 has 2 cells, the header 3"]),
+    # float() takes these, as 10, 1.5 and 1: a table holds plain decimal or scientific numbers only
+    "digit separator": ("v_in,v_out\n1_0,0.5\n2,1\n3,1\n", ["line 2 (row 1), column v_in", "'1_0'", "not a number"]),
+    "other script's digits": ("t_impact\n0.1\n\u0661.\u0665\n3\n", ["line 3 (row 2), column t_impact",
+                                                                       "not a number"]),
+    "padded exponent": ("v_in,v_out\n1e0_0,0.5\n2,1\n3,1\n", ["'1e0_0'", "not a number"]),
+    # physically absurd: beyond the model's largest speed (10 km/s), times whose differences overflow
+    "speed near 1e300": ("v_in,v_out\n1e300,1e299\n2e300,1e299\n3e300,1e299\n", ["v_in = 1e+300 m/s", "row 1",
+                                                                                     "10000 m/s"]),
+    "sigma near 1e-300": ("v_in,v_out,sigma\n1,0.5,0.1\n2,1,1e-300\n3,1,0.1\n", ["sigma = 1e-300 m/s", "row 2",
+                                                                                 "1e-09 m/s"]),
+    "sigma near 1e300": ("v_in,v_out,sigma\n1,0.5,1e300\n2,1,0.1\n3,1,0.1\n", ["sigma = 1e+300 m/s", "row 1"]),
+    "times near 1e308": ("t_impact\n1e308\n1.5e308\n1.7e308\n", ["t_impact = 1e+308 s", "row 1"]),
+    "times spanning 3e308": ("t_impact\n-1.7e308\n0\n1.7e308\n", ["t_impact = -1.7e+308 s", "row 1"]),
 }
 
 
@@ -133,3 +146,23 @@ def test_write_times_reads_back_to_the_same_floats(tmp_path):
     assert "with a newline.wav" in path.read_text().splitlines()[1]  # the origin, in one comment line
     write_times(path, ImpactTimes(t[:3]))  # over the old file, whole
     assert np.array_equal(read_csv(path).t, t[:3])
+
+
+def test_plain_numbers_in_every_notation_are_read_and_nothing_else(tmp_path):
+    """Signs, a bare or leading decimal point, exponents in either case are read; the same table with one
+    digit separator (float() read 2_5 as 25, a silent misread) is refused naming the cell."""
+    text = "v_in,v_out\n+2.5,2.\n1.75E0,.15e1\n5e-1,0.25\n3.125,+2e+0\n"
+    pairs = read_csv(table(tmp_path, text))
+    assert pairs.v_in.tolist() == [2.5, 1.75, 0.5, 3.125] and pairs.v_out.tolist() == [2.0, 1.5, 0.25, 2.0]
+    message = fault(read_csv, table(tmp_path, text.replace("+2.5", "2_5"), "separator.csv"))
+    assert "line 2 (row 1), column v_in: '2_5' is not a number" in message, message
+
+
+def test_a_drop_whose_intervals_imply_a_rebound_beyond_the_domain_is_refused():
+    """Impacts 3000 s apart under g = 9.80665 m/s2: a rebound at 14710 m/s (g dt / 2), beyond the model's
+    10 km/s; 2000 s apart (9807 m/s) is inside."""
+    check_drop_speeds(ImpactTimes([0.0, 2000.0, 3000.0]), 9.80665)
+    with pytest.raises(DataError, match=r"rows 1 and 2 are 3000 s apart: a rebound at 14710 m/s"):
+        check_drop_speeds(ImpactTimes([0.0, 3000.0, 4000.0], source="far.csv"), 9.80665)
+    with pytest.raises(DataError, match="rebound at inf m/s"):  # g dt overflows
+        check_drop_speeds(ImpactTimes([0.0, 1e14, 2e14]), 1e300)

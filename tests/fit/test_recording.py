@@ -215,3 +215,33 @@ def test_files_that_are_not_16_bit_pcm_wav(tmp_path):
     one_line_error(tmp_path / "missing.wav", "cannot read", "No such file")
     (tmp_path / "folder.wav").mkdir()
     one_line_error(tmp_path / "folder.wav", "cannot read", "directory")
+
+
+def _claiming(path, rate, n=4410):
+    """A mono 16-bit WAV file of ``n`` silent frames whose header claims the sample ``rate`` [Hz] (written
+    here, field by field: RIFF's fmt and data chunks)."""
+    data = bytes(2 * n)
+    path.write_bytes(b"RIFF" + struct.pack("<I", 36 + len(data)) + b"WAVEfmt " +
+                     struct.pack("<IHHIIHH", 16, 1, 1, rate, (2 * rate) % 2 ** 32, 2, 16) +
+                     b"data" + struct.pack("<I", len(data)) + data)
+    return path
+
+
+@pytest.mark.parametrize("rate", [1_000_001, 2 ** 31, 4_000_000_000])
+def test_a_sample_rate_beyond_a_megahertz_is_refused_at_once(tmp_path, rate):
+    """Headers claiming a rate above 1 MHz (the stated maximum; the detector's windows grow with the rate,
+    2^31 Hz took 46 s) are refused from the header, in well under the seconds the detector would take."""
+    import time
+
+    start = time.perf_counter()
+    one_line_error(_claiming(tmp_path / "fast.wav", rate), f"sample rate {rate} Hz", "1000000 Hz")
+    assert time.perf_counter() - start < 2.0
+
+
+def test_a_wav_file_over_the_size_limit_is_refused_naming_the_limit(tmp_path):
+    """64 MiB and one byte (a sparse file: no disk used) is refused before it is read; 64 MiB is stated
+    in docs/calibration.md."""
+    path = tmp_path / "long.wav"
+    with open(path, "wb") as f:
+        f.truncate(64 * 2 ** 20 + 1)
+    one_line_error(path, "64 MiB", str(64 * 2 ** 20 + 1))

@@ -92,3 +92,40 @@ def test_the_restitution_command_lists_and_dispatches():
     assert materials.returncode == 0 and "al_6061" in materials.stdout
     version = _run("--version")
     assert version.returncode == 0 and version.stdout.startswith("restitution ")
+
+
+@pytest.mark.parametrize("option", ["--v", "--d", "--sphere", "--zener-method"])
+def test_a_huge_value_is_echoed_shortened(option):
+    """A 100 000-character value is refused in one short line: the first 60 characters, an ellipsis and
+    its length (it was echoed whole)."""
+    huge = "7" + "x" * 99_999
+    args = list(ARGS) + ([option, huge] if option not in ARGS else [])
+    if option in ARGS:
+        args[args.index(option) + 1] = huge
+    done = _run("cor", *args)
+    line = done.stderr.strip().splitlines()[-1]
+    assert done.returncode == 2 and done.stdout == "" and option in line, done.stderr[:300]
+    assert len(done.stderr) < 1000 and "(100000 characters)" in line and "7" + "x" * 59 + "..." in line, line
+
+
+def test_standard_output_on_a_full_disk_is_one_line_and_exit_74():
+    """stdout on /dev/full: ENOSPC when the result is flushed; one line on stderr, exit 74, no traceback and
+    no "Exception ignored" at the interpreter's exit."""
+    with open("/dev/full", "w") as full:
+        done = subprocess.run([sys.executable, "-m", "restitution", "cor", *ARGS], stdout=full,
+                              stderr=subprocess.PIPE, text=True, timeout=120)
+    lines = done.stderr.strip().splitlines()
+    assert done.returncode == 74 and len(lines) == 1, done.stderr
+    assert lines[0].startswith("restitution cor: error: ") and "standard output" in lines[0] and "ENOSPC" in lines[0]
+
+
+@pytest.mark.parametrize("command", ["cor", "fit"])
+def test_help_on_a_full_disk_is_one_line_and_exit_74(command):
+    """--help with stdout on /dev/full: argparse printed the help and exited 0, then the interpreter's
+    final flush failed ("Exception ignored ... OSError"); now one line on stderr and exit 74."""
+    with open("/dev/full", "w") as full:
+        done = subprocess.run([sys.executable, "-m", "restitution", command, "--help"], stdout=full,
+                              stderr=subprocess.PIPE, text=True, timeout=120)
+    lines = done.stderr.strip().splitlines()
+    assert done.returncode == 74 and len(lines) == 1, done.stderr
+    assert lines[0].startswith(f"restitution {command}: error: ") and "ENOSPC" in lines[0], lines

@@ -499,3 +499,25 @@ def test_resume_over_an_unreadable_manifest_says_so_and_runs_everything(tmp_path
     assert sweep_cli([*SWEEP, "--no-plot", "--out", str(out), "--resume"]) == 0
     one_line(capsys.readouterr().err, "manifest.json: unreadable", "the whole sweep runs")  # and nothing else
     assert_table(read_table(out), reference)
+
+
+def test_check_outputs_refuses_an_output_that_is_an_input_or_another_output(tmp_path):
+    """The same file by its name, another spelling (``..``), a symlink or a hard link: refused, one line
+    naming both; distinct files, and outputs not given (None), pass."""
+    data = tmp_path / "data.csv"
+    data.write_text("t_impact\n1\n2\n3\n")
+    (tmp_path / "link.json").symlink_to("data.csv")
+    os.link(data, tmp_path / "hard.json")
+    (tmp_path / "sub").mkdir()
+    inputs = {"DATA": data}
+    output_files.check_outputs({"--json": tmp_path / "r.json", "--plot": tmp_path / "r.png", "--times": None}, inputs)
+    output_files.check_outputs({"--json": None}, {"DATA": None})
+    for path in (data, tmp_path / "sub" / ".." / "data.csv", tmp_path / "link.json", tmp_path / "hard.json"):
+        with pytest.raises(output_files.OutputPathError) as caught:
+            output_files.check_outputs({"--plot": tmp_path / "r.png", "--json": path}, inputs)
+        message = str(caught.value)
+        assert message.startswith(f"--json {path}: is the input DATA ({data})") and "\n" not in message
+    for other in (tmp_path / "r.json", tmp_path / "sub" / ".." / "r.json"):  # not existing yet: by resolved path
+        with pytest.raises(output_files.OutputPathError, match=r"--times .*: is the same file as --json"):
+            output_files.check_outputs({"--json": tmp_path / "r.json", "--times": other}, inputs)
+    assert data.read_text() == "t_impact\n1\n2\n3\n"

@@ -24,11 +24,20 @@ from pathlib import Path
 
 import numpy as np
 
-from restitution.fit.datasets import DataError, ImpactTimes, ReboundPairs, Recording
+from restitution.fit.datasets import DataError, ImpactTimes, ReboundPairs, Recording, read_regular_file
 from restitution.fit.recording import read_recording
-from restitution.output_files import atomic_write, os_reason
+from restitution.output_files import atomic_write
 
-__all__ = ["read_data", "read_csv", "write_times", "TABLE_SUFFIXES", "RECORDING_SUFFIXES", "LAYOUTS"]
+__all__ = ["read_data", "read_csv", "write_times", "TABLE_SUFFIXES", "RECORDING_SUFFIXES", "LAYOUTS",
+           "MAX_TABLE_BYTES", "NUMBER"]
+
+#: The largest table read [bytes] (64 MiB: some three million rows).
+MAX_TABLE_BYTES = 64 * 2 ** 20
+#: A cell that is a number: plain decimal or scientific notation in ASCII digits (no ``_`` digit
+#: separators, no hexadecimal, no other scripts' digits, all of which Python's float() would take),
+#: or nan / inf, which the containers then refuse by name.
+NUMBER = re.compile(r"[+-]?(?:(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?|nan|inf|infinity)",
+                    re.ASCII | re.IGNORECASE)
 
 #: The suffixes of the tables :func:`read_csv` reads (case ignored).
 TABLE_SUFFIXES = (".csv", ".txt")
@@ -63,12 +72,9 @@ def read_data(path) -> ReboundPairs | ImpactTimes | Recording:
 
 
 def _text(path: Path) -> str:
-    """The contents of ``path`` as text (UTF-8, a byte order mark dropped); DataError if missing, a
-    directory, unreadable or not UTF-8."""
-    try:
-        data = path.read_bytes()
-    except OSError as exc:
-        raise DataError(f"{path}: cannot read: {os_reason(exc)}") from None
+    """The contents of ``path`` as text (UTF-8, a byte order mark dropped); DataError if missing, not a
+    regular file, larger than :data:`MAX_TABLE_BYTES`, unreadable or not UTF-8."""
+    data = read_regular_file(path, MAX_TABLE_BYTES, "table")
     try:
         return data.decode("utf-8-sig")
     except UnicodeDecodeError as exc:
@@ -99,12 +105,8 @@ def _column(path: Path, cell: str) -> str:
 
 
 def _is_number(cell: str) -> bool:
-    """Whether ``cell`` reads as a float."""
-    try:
-        float(cell)
-    except ValueError:
-        return False
-    return True
+    """Whether ``cell`` is a number (:data:`NUMBER`)."""
+    return NUMBER.fullmatch(cell) is not None
 
 
 def _layout(path: Path, names: list[str]) -> str:
@@ -154,10 +156,11 @@ def read_csv(path) -> ReboundPairs | ImpactTimes:
             hint = " (a decimal comma? write 0.5, not 0,5)" if len(cells) > len(names) else ""
             raise DataError(f"{path}: line {line} has {len(cells)} cells, the header {len(names)}{hint}")
         for name, cell, column in zip(names, cells, columns):
-            try:
-                column.append(float(cell))
-            except ValueError:
-                raise DataError(f"{path}: line {line} (row {row}), column {name}: '{cell}' is not a number") from None
+            if not _is_number(cell):
+                shown = cell if len(cell) <= 40 else f"{cell[:40]}... ({len(cell)} characters)"
+                raise DataError(f"{path}: line {line} (row {row}), column {name}: '{shown}' is not a number "
+                                "(plain decimal or scientific notation, e.g. 0.25 or 2.5e-1)")
+            column.append(float(cell))
     values = dict(zip(names, (np.asarray(column, dtype=float) for column in columns)))
     source = str(path)
     if layout == "times":

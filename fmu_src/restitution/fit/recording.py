@@ -48,17 +48,17 @@ taken for clicks. Every step is an elementwise comparison, a maximum or a median
 times do not depend on the machine."""
 from __future__ import annotations
 
+import io
 import wave
 from pathlib import Path
 
 import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
 
-from restitution.fit.datasets import MIN_POINTS, DataError, ImpactTimes, Recording
-from restitution.output_files import os_reason
+from restitution.fit.datasets import MIN_POINTS, DataError, ImpactTimes, Recording, read_regular_file
 
 __all__ = ["read_wav", "find_impacts", "read_recording", "noise_sigma", "AHEAD", "BEFORE", "DEAD_TIME", "RISE",
-           "GATE", "LOW", "LOW_RISE", "MIN_RATE"]
+           "GATE", "LOW", "LOW_RISE", "MIN_RATE", "MAX_RATE", "MAX_WAV_BYTES"]
 
 #: Length [s] of the window ahead of each sample whose largest magnitude is tested.
 AHEAD = 0.25e-3
@@ -76,6 +76,13 @@ LOW = 4.0
 LOW_RISE = 1.5
 #: The lowest sample rate [Hz] accepted: 8 kHz times an onset to 0.125 ms (one sample).
 MIN_RATE = 8000
+#: The highest sample rate [Hz] accepted: 1 MHz, over five times the fastest audio recorders (192 kHz);
+#: the detector's windows grow with the rate, and a header claiming gigahertz is not a recording.
+MAX_RATE = 1_000_000
+#: The largest WAV file read [bytes]: 64 MiB, some 12 minutes of mono 16-bit sound at 44.1 kHz (a drop
+#: lasts seconds); read whole into memory, so a header claiming more frames than the file holds costs
+#: nothing.
+MAX_WAV_BYTES = 64 * 2 ** 20
 
 #: One step of a 16-bit sample, as a fraction of full scale [1].
 _LSB = 1.0 / 32768.0
@@ -96,31 +103,32 @@ def _format_name(message: str) -> str:
 def read_wav(path) -> tuple[np.ndarray, float]:
     """The samples of the WAV file ``path`` as floats in [-1, 1] (sample / 32768; a stereo file's two
     channels averaged) and its sample rate [Hz]. DataError (one line naming the file) if it cannot be
-    read, is not a WAV file, is not 16-bit PCM, has a rate below :data:`MIN_RATE`, or holds no sample."""
+    read, is not a regular file, is larger than :data:`MAX_WAV_BYTES`, is not a WAV file, is not 16-bit
+    PCM, has a rate outside :data:`MIN_RATE` .. :data:`MAX_RATE`, or holds no sample. The frames are
+    those the file holds, whatever number its header claims."""
     path = Path(path)
+    raw = read_regular_file(path, MAX_WAV_BYTES, "WAV file")
     try:
-        with open(path, "rb") as stream:
-            try:
-                with wave.open(stream, "rb") as wav:
-                    channels, width, rate = wav.getnchannels(), wav.getsampwidth(), wav.getframerate()
-                    frames = wav.getnframes()
-                    if width != 2:
-                        raise DataError(f"{path}: {8 * width}-bit samples: a 16-bit PCM WAV file is needed")
-                    if channels not in (1, 2):
-                        raise DataError(f"{path}: {channels} channels: a mono or stereo WAV file is needed")
-                    if rate < MIN_RATE:
-                        raise DataError(f"{path}: sample rate {rate} Hz: at least {MIN_RATE} Hz is needed to "
-                                        "time impacts to well under a millisecond")
-                    data = wav.readframes(frames)
-            except wave.Error as exc:
-                text = str(exc)
-                if text.startswith("unknown format"):
-                    raise DataError(f"{path}: {_format_name(text)}: a 16-bit PCM WAV file is needed") from None
-                raise DataError(f"{path}: not a WAV file ({text})") from None
-            except EOFError:
-                raise DataError(f"{path}: not a WAV file (its header is cut short)") from None
-    except OSError as exc:
-        raise DataError(f"{path}: cannot read: {os_reason(exc)}") from None
+        with wave.open(io.BytesIO(raw), "rb") as wav:
+            channels, width, rate = wav.getnchannels(), wav.getsampwidth(), wav.getframerate()
+            if width != 2:
+                raise DataError(f"{path}: {8 * width}-bit samples: a 16-bit PCM WAV file is needed")
+            if channels not in (1, 2):
+                raise DataError(f"{path}: {channels} channels: a mono or stereo WAV file is needed")
+            if rate < MIN_RATE:
+                raise DataError(f"{path}: sample rate {rate} Hz: at least {MIN_RATE} Hz is needed to "
+                                "time impacts to well under a millisecond")
+            if rate > MAX_RATE:
+                raise DataError(f"{path}: sample rate {rate} Hz: above the {MAX_RATE} Hz (1 MHz) accepted; "
+                                "is the header damaged?")
+            data = wav.readframes(min(wav.getnframes(), len(raw) // (width * channels)))
+    except wave.Error as exc:
+        text = str(exc)
+        if text.startswith("unknown format"):
+            raise DataError(f"{path}: {_format_name(text)}: a 16-bit PCM WAV file is needed") from None
+        raise DataError(f"{path}: not a WAV file ({text})") from None
+    except EOFError:
+        raise DataError(f"{path}: not a WAV file (its header is cut short)") from None
     whole = len(data) // (2 * channels)  # a file cut short mid-frame: its whole frames
     if whole == 0:
         raise DataError(f"{path}: no samples: the WAV file is empty")
