@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -248,3 +249,159 @@ def test_an_output_that_is_not_a_regular_file_is_refused_before_any_work(files, 
     lines = done.stderr.strip().splitlines()
     assert done.returncode == 2 and len(lines) == 1 and option in lines[0], done.stderr
     assert sorted(p.name for p in tmp_path.iterdir()) == ["a_folder"] and not any(folder.iterdir())
+
+
+def _one_line(done, status):
+    """The one line on stderr of a run that ended with ``status`` (no traceback, no second line)."""
+    lines = done.stderr.strip().splitlines()
+    assert done.returncode == status and len(lines) == 1, (done.returncode, done.stderr)
+    assert lines[0].startswith("restitution fit: error: ") and "Traceback" not in done.stderr
+    return lines[0]
+
+
+@pytest.mark.parametrize("case", ["times over the wav", "json over the csv", "json through a symlink",
+                                  "json as a hard link", "two outputs, one file", "two outputs via '..'"])
+def test_an_output_that_is_an_input_or_another_output_is_refused_before_any_work(files, tmp_path, case):
+    """An output naming the data (by its name, a symlink or a hard link to it) or another output of the
+    same run would overwrite it: refused in one line, exit 2, the data byte for byte as it was and no
+    output written. The hostile run: `--times d.wav` replaced the recording by 451 bytes of text."""
+    d, _times = files
+    wav, csv = tmp_path / "d.wav", tmp_path / "p.csv"
+    wav.write_bytes((d / "drop.wav").read_bytes())
+    csv.write_bytes((d / "pairs.csv").read_bytes())
+    (tmp_path / "link.json").symlink_to(csv.name)
+    (tmp_path / "hard.json").hardlink_to(csv)
+    (tmp_path / "sub").mkdir()
+    data, extra = {
+        "times over the wav": (wav, ["--times", wav]),
+        "json over the csv": (csv, ["--json", csv]),
+        "json through a symlink": (csv, ["--json", tmp_path / "link.json"]),
+        "json as a hard link": (csv, ["--json", tmp_path / "hard.json"]),
+        "two outputs, one file": (wav, ["--json", tmp_path / "r.json", "--times", tmp_path / "r.json"]),
+        "two outputs via '..'": (wav, ["--json", tmp_path / "r.json", "--times", tmp_path / "sub" / ".." / "r.json"]),
+    }[case]
+    before = {p.name: p.read_bytes() for p in (wav, csv)}
+    listing = sorted(p.name for p in tmp_path.iterdir())
+    done = _run(data, *BODIES, "--fit", "plate.Sy", *extra)
+    line = _one_line(done, 2)
+    want = "is the same file as --json" if case.startswith("two") else "is the input DATA"
+    assert done.stdout == "" and want in line and extra[-2] in line, line
+    assert {p.name: p.read_bytes() for p in (wav, csv)} == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == listing
+
+
+@pytest.mark.parametrize("plot", ["fit.xyz", "fit", "fit.pgf"])
+def test_a_plot_format_that_cannot_be_written_is_refused_before_any_work(files, tmp_path, plot):
+    """.xyz (no such format), no suffix, .pgf (needs LaTeX): refused in one line, exit 2, before the fit:
+    the --json asked for beside it is not written (it was, before a traceback after the whole fit)."""
+    d, _times = files
+    done = _run(d / "pairs.csv", *BODIES, "--fit", "plate.Sy", "--json", tmp_path / "r.json", "--plot", tmp_path / plot)
+    line = _one_line(done, 2)
+    assert "--plot" in line and ".png" in line and ".pdf" in line and ".svg" in line, line
+    assert list(tmp_path.iterdir()) == [] and done.stdout == ""
+
+
+def _fsize_limit():
+    """In the child: writes beyond 100 bytes fail with EFBIG (SIGXFSZ ignored): a full disk, for one process."""
+    import resource
+    import signal
+
+    signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+    resource.setrlimit(resource.RLIMIT_FSIZE, (100, 100))
+
+
+@pytest.mark.parametrize("outputs", [["--times"], ["--json"], ["--plot"], ["--times", "--json", "--plot"]])
+def test_an_output_that_cannot_be_written_is_one_line_and_exit_74(files, tmp_path, outputs):
+    """Every output write failing (a file size limit of 100 bytes: EFBIG, as ENOSPC on a full disk): one
+    line naming the option and the system's reason, exit 74, no traceback (--times gave one), nothing left
+    under the output's name nor a temporary file beside it."""
+    d, _times = files
+    names = {"--times": "t.csv", "--json": "r.json", "--plot": "r.png"}
+    args = [a for option in outputs for a in (option, tmp_path / names[option])]
+    done = subprocess.run([sys.executable, "-m", "restitution", "fit", str(d / "drop.wav"), *BODIES, "--fit",
+                           "plate.Sy", *map(str, args)], capture_output=True, text=True, timeout=300,
+                          preexec_fn=_fsize_limit)
+    line = _one_line(done, 74)
+    assert f"{outputs[0]}: cannot write" in line and "EFBIG" in line, line
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("data", ["pairs.csv", "drop.wav"])
+def test_standard_output_on_a_full_disk_is_one_line_and_exit_74(files, tmp_path, data):
+    """stdout on /dev/full: the result cannot be printed (ENOSPC when flushed): one line, exit 74, no
+    "Exception ignored" at exit."""
+    d, _times = files
+    with open("/dev/full", "w") as full:
+        done = subprocess.run([sys.executable, "-m", "restitution", "fit", str(d / data), *BODIES, "--fit",
+                               "plate.Sy", "--times" if data.endswith(".wav") else "--json", str(tmp_path / "o")],
+                              stdout=full, stderr=subprocess.PIPE, text=True, timeout=300)
+    line = _one_line(done, 74)
+    assert "standard output" in line and "ENOSPC" in line, line
+
+
+def _limited_memory():
+    import resource
+
+    resource.setrlimit(resource.RLIMIT_AS, (4 * 2 ** 30, 4 * 2 ** 30))  # the old reader ran out of memory
+
+
+@pytest.mark.parametrize("kind", ["/dev/zero as .csv", "/dev/full as .wav", "FIFO as .csv", "FIFO as .wav",
+                                  "too large .csv"])
+def test_data_that_is_not_a_regular_file_or_too_large_is_refused_at_once(tmp_path, kind):
+    """DATA must be a regular file of at most 64 MiB (a table; 64 MiB for a WAV file too): a device read
+    without end, a FIFO that blocks, or a file over the limit is refused in one line, exit 2, in seconds."""
+    path = tmp_path / ("data.wav" if kind.endswith(".wav") else "data.csv")
+    if kind.startswith("/dev/"):
+        path.symlink_to(kind.split()[0])
+    elif kind.startswith("FIFO"):
+        os.mkfifo(path)
+    else:
+        with open(path, "wb") as f:  # sparse: no disk used
+            f.truncate(64 * 2 ** 20 + 1)
+    done = subprocess.run([sys.executable, "-m", "restitution", "fit", str(path), *BODIES, "--fit", "plate.Sy"],
+                          capture_output=True, text=True, timeout=60, preexec_fn=_limited_memory)
+    line = _one_line(done, 2)
+    assert str(path) in line, line
+    want = {"/dev/zero as .csv": "character device", "/dev/full as .wav": "character device",
+            "FIFO as .csv": "FIFO", "FIFO as .wav": "FIFO", "too large .csv": "64 MiB"}[kind]
+    assert want in line, line
+
+
+@pytest.mark.parametrize("content, words", [
+    ("v_in,v_out\n1e300,1e299\n2e300,1e299\n3e300,1e299\n", ["v_in = 1e+300 m/s", "10000 m/s"]),
+    ("t_impact\n1e308\n1.5e308\n1.7e308\n", ["t_impact = 1e+308 s"]),
+    ("t_impact\n0\n3000\n4000\n4500\n", ["3000 s apart", "14710 m/s"]),  # g dt / 2 beyond 10 km/s
+])
+def test_physically_absurd_data_is_refused_not_overflowed(tmp_path, content, words):
+    """Speeds near 1e300 and impact times near 1e308 raised OverflowError tracebacks: refused in one line,
+    exit 2, naming the value and the bound (the model's largest approach speed, 10 km/s)."""
+    path = tmp_path / "absurd.csv"
+    path.write_text(content)
+    line = _one_line(_run(path, *BODIES, "--fit", "plate.Sy"), 2)
+    assert all(w in line for w in words), line
+
+
+@pytest.mark.parametrize("options, words", [
+    (["--g", "1e-300"], ["g = 1e-300 m/s2", "[1e-06, 1e+06]"]),  # the BouncingBall FMU's range for g
+    (["--g", "1e300 m/s2"], ["g = 1e+300 m/s2"]),
+    (["--h0", "1e300 m"], ["h0 = 1e+300 m", "10000 m/s"]),  # sqrt(2 g h0) beyond the model's largest speed
+])
+def test_a_drop_outside_the_model_s_reach_is_refused_in_one_line(files, options, words):
+    """A gravity or a drop height the fit cannot compute with (numpy overflow warnings, then a fit of
+    nothing) is refused in one line, exit 2, before any work."""
+    done = _run(files[0] / "times.csv", *BODIES, "--fit", "plate.Sy", *options)
+    line = _one_line(done, 2)
+    assert all(w in line for w in words), line
+    assert "Warning" not in done.stderr, done.stderr
+
+
+def test_the_python_api_checks_a_drop_as_the_command_does(files):
+    """restitution.fit.fit refuses what the command refuses: an interval implying a rebound beyond the
+    model's domain, and a gravity outside [1e-6, 1e6] m/s2 (ValueError, one line)."""
+    from restitution.fit import DataError, ImpactTimes, fit
+
+    times = ImpactTimes(np.array([0.0, 3000.0, 4000.0, 4500.0]))
+    with pytest.raises(DataError, match="3000 s apart"):
+        fit(times, SPHERE, PLATE, ["plate.Sy"])
+    with pytest.raises(ValueError, match="g = 1e-300 m/s2"):
+        fit(files[0] / "times.csv", SPHERE, PLATE, ["plate.Sy"], g=1e-300)

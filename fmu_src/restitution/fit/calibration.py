@@ -7,7 +7,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-from .datasets import ImpactTimes, Recording, ReboundPairs
+from .datasets import ImpactTimes, Recording, ReboundPairs, check_drop, check_drop_speeds
 from .estimate import FitResult, base_of, fit_parameters
 from .forward import G_STANDARD, KEYS
 
@@ -33,9 +33,13 @@ class Calibration:
 
     @property
     def fitted_params(self) -> dict:
-        """impact keyword -> value [SI] at the estimate: ``base`` with the identifiable estimates."""
-        return {**self.base, **{KEYS[p.name]: p.estimate for p in self.result.parameters.values()
-                                if p.estimate is not None}}
+        """impact keyword -> value [SI] of the fitted curve: ``base`` with the identifiable estimates and, for a
+        practically non-identifiable parameter, the value where the likelihood is largest (the best fit, where
+        the residuals are taken; the data do not determine it, so it is not reported as an estimate). A
+        structurally non-identifiable parameter keeps its given value."""
+        best = {KEYS[p.name]: p.estimate if p.estimate is not None else p.best
+                for p in self.result.parameters.values()}
+        return {**self.base, **{key: value for key, value in best.items() if value is not None}}
 
     def to_dict(self) -> dict:
         """The result as JSON-ready values (:meth:`FitResult.to_dict`), with each parameter's posterior
@@ -78,7 +82,10 @@ def fit(data, sphere, plate, fit, *, g: float = G_STANDARD, h0: float | None = N
     of :func:`restitution.fit.estimate.fit_parameters` (``restitution_model``, ``zener_method``, ...).
     Returns a :class:`Calibration` (``str()`` a table with units, ``to_dict()`` the JSON). DataError or
     ValueError, one line, for bad data or names."""
+    check_drop(g, h0)
     dataset = _dataset(data)
+    if dataset.kind != "rebound_pairs":
+        check_drop_speeds(dataset.times if isinstance(dataset, Recording) else dataset, g)
     names = [fit] if isinstance(fit, str) else list(fit)
     base = base_of(sphere, plate)
     times = dataset.times if isinstance(dataset, Recording) else dataset

@@ -1,15 +1,14 @@
 """Estimating model parameters from measurements: maximum likelihood, profile-likelihood intervals and
 identifiability (:func:`fit_parameters`).
 
-Identifiability comes before any number. A requested parameter that does not enter e for these bodies at
-the data's speeds (e does not change, to within rounding, when it is scaled by 0.5 and by 2) is not fitted:
-``identifiable`` False, no estimate, no interval, and a one-line reason. The chief case is Eq. (2) of the
-paper: only the body with the smaller C(nu) Sy yields, so the other body's Sy enters neither V_c (Eq. 6)
-nor eps_y (Eq. 3). A parameter the data bound on neither side inside its domain is reported the same way
-(practically non-identifiable); one bounded on one side only gets the domain bound on the other and a note.
-Parameters that the data determine only in combination (|correlation| > 0.95) get a ``combinations`` entry:
-the product of powers (exponents from the stiff eigenvector of the Hessian in log space) that is determined,
-and the direction that is not.
+Identifiability comes before any number (:mod:`restitution.fit.identifiability`). A requested parameter
+that does not enter e for these bodies at the data's speeds is not fitted (structurally non-identifiable:
+Eq. 2 of the paper, or every impact elastic). One whose 95 % profile interval reaches the edge of its
+domain is practically non-identifiable: no estimate, no interval, and where the other side is bounded the
+bound the data give (``bound``: the end of the 95 % profile set). Parameters that the data determine only
+in combination (|correlation| > 0.95) get a ``combinations`` entry: the product of powers (exponents from the stiff
+eigenvector of the Hessian in log space) that is determined, and the direction that is not. Whether the
+model describes the data at all is checked too (:mod:`restitution.fit.goodness`: ``lack_of_fit``).
 
 The fit: least squares (:func:`scipy.optimize.least_squares`, trust-region reflective within the domain)
 on the coordinates of :mod:`restitution.fit.likelihood` (log of each positive parameter), from the given
@@ -33,22 +32,22 @@ import numpy as np
 from scipy import stats
 from scipy.optimize import brentq, least_squares
 
-from ..jgm import poisson_coefficient
 from ..model import impact
 from .datasets import DataError
-from .forward import FIT_OPTIONS, G_STANDARD, KEYS, UNITS, check_base, check_names, domain, restitution_at
+from .forward import FIT_OPTIONS, G_STANDARD, KEYS, UNITS, check_base, check_names, domain
+from .goodness import jacobian, lack_of_fit
+from .identifiability import (CORRELATED, IDENTIFIABLE, PRACTICAL, STRUCTURAL, combinations, correlation_of,
+                              practical_reason, structural_reason)
 from .likelihood import CHI2_1_95, Problem, make_likelihood, parameter_coordinate
 
 __all__ = ["fit_parameters", "FitResult", "ParameterEstimate", "base_of", "structural_reason", "CORRELATED"]
 
-#: |correlation| above which two fitted parameters are reported as determined only in combination.
-CORRELATED = 0.95
-#: Tolerance on e for "does not change" (rounding: e is computed to ~1e-15; a parameter that does not
-#: enter leaves it bit-identical).
-_E_ROUNDING = 1e-13
 #: Finite-difference step of the least-squares Jacobian in the fit coordinates (ln theta): 1e-7 relative
 #: (truncation ~1e-7 of the slope; rounding: e ~1e-15 / 1e-7, a drop's 20 compounded impacts ~1e-14 / 1e-7).
 _DIFF_STEP = 1e-7
+#: The level of the profile-likelihood set whose end is the ``bound`` of a practically non-identifiable
+#: parameter: 0.95, the same set that is the 95 % interval of an identifiable one (:mod:`.identifiability`).
+BOUND_LEVEL = 0.95
 #: Root-finding tolerance on an interval end, in the fit coordinate (ln theta): 1e-5 relative.
 _XTOL = 1e-5
 
@@ -60,10 +59,14 @@ def base_of(sphere, plate) -> dict:
 
 @dataclass(frozen=True)
 class ParameterEstimate:
-    """One requested parameter: ``estimate`` [``unit``] (None when not identifiable from the model),
-    ``ci95`` (lo, hi) its 95 % profile-likelihood interval (None when not identifiable), ``reason`` why not,
-    ``note`` on the interval (an end at the domain bound), ``se`` the standard error of its fit coordinate
-    (ln theta; nu itself) from the Hessian."""
+    """One requested parameter: ``estimate`` [``unit``] and ``ci95`` (lo, hi) its 95 % profile-likelihood
+    interval, both None unless ``identifiable``; ``identifiability`` "identifiable", "structural" (it does not
+    enter e) or "practical" (its profile interval reaches the domain's edge: :mod:`.identifiability`);
+    ``bound`` {"lower": value} or {"upper": value}, the bound (the end of the 95 % profile set) of a practically
+    non-identifiable parameter open on one side (None otherwise); ``reason`` why not identifiable, in words;
+    ``note`` on the interval; ``se`` the standard error of its fit coordinate (ln theta; nu itself) from the
+    Hessian; ``best`` where the likelihood is largest (the fitted curve's value; not an estimate when the
+    parameter is not identifiable, and not reported)."""
 
     name: str
     key: str
@@ -74,10 +77,15 @@ class ParameterEstimate:
     reason: str = ""
     note: str = ""
     se: float | None = None
+    identifiability: str = IDENTIFIABLE
+    bound: dict | None = None
+    best: float | None = None
 
     def to_dict(self) -> dict:
         return {"estimate": self.estimate, "ci95": None if self.ci95 is None else [float(v) for v in self.ci95],
-                "identifiable": self.identifiable, "reason": self.reason, "unit": self.unit, "note": self.note}
+                "identifiable": self.identifiable, "identifiability": self.identifiability,
+                "bound": None if self.bound is None else {k: float(v) for k, v in self.bound.items()},
+                "reason": self.reason, "unit": self.unit, "note": self.note}
 
 
 @dataclass(frozen=True, eq=False)
@@ -88,7 +96,8 @@ class FitResult:
     fitted parameters' coordinates (ln theta), from the Hessian at the optimum (nuisances profiled out);
     ``combinations``: what strongly correlated parameters determine together; ``flags``: per point,
     the model outside its validated range (lambda > 1.5, V* > 1000) or e < 0 ("any"), ``out_of_range``
-    their count (the points are kept)."""
+    their count (the points are kept); ``lack_of_fit``: the checks of :mod:`restitution.fit.goodness` and
+    their verdict ``detected``."""
 
     kind: str
     n: int
@@ -105,6 +114,7 @@ class FitResult:
     evaluations: int
     elapsed: float
     options: dict = field(default_factory=dict)
+    lack_of_fit: dict = field(default_factory=dict)
 
     def __getitem__(self, name: str) -> ParameterEstimate:
         return self.parameters[name]
@@ -132,14 +142,17 @@ class FitResult:
                 "out_of_range_rows": [int(i) + 1 for i in np.flatnonzero(self.flags["any"])],  # from 1
                 "correlation": self.correlation,
                 "combinations": [_plain(c) for c in self.combinations],
+                "lack_of_fit": _plain(self.lack_of_fit),
                 "log_likelihood": float(self.log_likelihood)}
 
     def __str__(self) -> str:
         lines = [f"fit of {self.n} {self.kind.replace('_', ' ')} ({self.evaluations} model evaluations, "
                  f"{self.elapsed:.3g} s)"]
+        if self.lack_of_fit.get("detected"):
+            lines.append(f"  WARNING: the model does not describe these data: {self.lack_of_fit['words']}")
         for p in self.parameters.values():
             if not p.identifiable:
-                lines.append(f"  {p.name}: not identifiable: {p.reason}")
+                lines.append(f"  {p.name}: not identifiable from these data ({p.identifiability}ly): {p.reason}")
                 continue
             lines.append(f"  {p.name} = {p.estimate:.5g} {p.unit}, 95 % [{p.ci95[0]:.5g}, {p.ci95[1]:.5g}]"
                          + (f" ({p.note})" if p.note else ""))
@@ -163,53 +176,6 @@ def _plain(d):
     if isinstance(d, (np.floating, np.integer, np.bool_)):
         return d.item()
     return d
-
-
-# ---------------------------------------------------------------------------------------------------------
-# identifiability from the model
-
-
-def _scaled_values(name: str, value: float) -> list[float]:
-    low, high = domain(name)
-    if KEYS[name].endswith("_nu"):
-        candidates = [0.5 * value, min(2.0 * value, 0.49)] if value > 0.0 else [0.1, 0.25]
-    else:
-        candidates = [0.5 * value, 2.0 * value]
-    return [min(max(c, low), high) for c in candidates if min(max(c, low), high) != value]
-
-
-def _who_yields(params: dict) -> tuple[str, float, float]:
-    """("sphere" or "plate", C(nu) Sy of the sphere, of the plate) [Pa] (Eq. 2; the sphere on a tie)."""
-    cs = poisson_coefficient(params["sphere_nu"]) * params["sphere_Sy"]
-    cp = poisson_coefficient(params["plate_nu"]) * params["plate_Sy"]
-    return ("sphere" if cs <= cp else "plate"), cs, cp
-
-
-def structural_reason(speeds, base: dict, name: str, options: dict | None = None) -> str | None:
-    """Why the parameter ``name`` (FMU name) cannot be estimated from e at ``speeds`` [m/s] with the other
-    parameters at ``base`` (impact keywords), or None when e depends on it there: e unchanged, to within
-    rounding, with the parameter scaled by 0.5 and by 2 (clipped to its domain)."""
-    key = KEYS[name]
-    speeds = np.asarray(speeds, dtype=float)
-    e0 = np.asarray(restitution_at(speeds, base, options).e)
-    for value in _scaled_values(name, base[key]):
-        e1 = np.asarray(restitution_at(speeds, {**base, key: value}, options).e)
-        if not np.all(np.abs(e1 - e0) <= _E_ROUNDING):
-            return None
-    given = f"left at its given value {base[key]:.4g} {UNITS[name]}"
-    if key.endswith("_Sy"):
-        body = key.split("_")[0]
-        yields, cs, cp = _who_yields(base)
-        if yields != body:
-            other = "plate" if body == "sphere" else "sphere"
-            sign = "<" if yields == "sphere" else ">"
-            return (f"{name} does not enter e: the {other} yields first, C(nu) Sy = {cs:.3g} Pa (sphere) {sign} "
-                    f"{cp:.3g} Pa (plate) (Eq. 2), so only the {other}'s Sy sets V_c and eps_y; {given}")
-        vstar = np.asarray(restitution_at(speeds, base, options).V_star)
-        if np.all(vstar <= 1.0):
-            return (f"{name} does not enter e: every impact stays elastic (V* = v/V_c <= {vstar.max():.3g} <= 1 at "
-                    f"the data's speeds, Eqs. 6, 8: e_ep = 1); {given}")
-    return (f"{name} does not enter e at the data's speeds (e unchanged when it is scaled by 0.5 and 2); {given}")
 
 
 # ---------------------------------------------------------------------------------------------------------
@@ -297,87 +263,12 @@ def _grid_start(problem: Problem, grid: int) -> np.ndarray | None:
 def _covariance(problem: Problem, x) -> np.ndarray:
     """Covariance of the fit coordinates at the optimum x from the Gauss-Newton Hessian of the deviance
     (central differences of the residuals): sigma^2 (J^T J)^-1, sigma^2 = S/n when the noise is profiled."""
-    h = 1e-5
-    r0 = problem.residuals(x)
-    J = np.empty((r0.size, problem.k))
-    for j in range(problem.k):
-        step = np.zeros(problem.k)
-        # one-sided at a bound
-        up = min(h, problem.upper[j] - x[j])
-        dn = min(h, x[j] - problem.lower[j])
-        step[j] = up
-        rp = problem.residuals(x + step)
-        step[j] = -dn
-        rm = problem.residuals(x + step)
-        J[:, j] = (rp - rm) / max(up + dn, 1e-300)
-    scale = float(np.sum(r0 * r0)) / r0.size if problem.likelihood.profiled else 1.0
     if problem.k == 0:
         return np.zeros((0, 0))
+    r0 = problem.residuals(x)
+    J = jacobian(problem, x, r0=r0)
+    scale = float(np.sum(r0 * r0)) / r0.size if problem.likelihood.profiled else 1.0
     return scale * np.linalg.pinv(J.T @ J)
-
-
-def _correlation(cov: np.ndarray) -> np.ndarray:
-    sd = np.sqrt(np.clip(np.diag(cov), 0.0, None))
-    with np.errstate(all="ignore"):
-        corr = cov / np.outer(sd, sd)
-    corr[~np.isfinite(corr)] = np.nan
-    corr = 0.5 * (corr + corr.T)  # symmetric to the last bit (the inverse is not)
-    np.fill_diagonal(corr, 1.0)
-    return corr
-
-
-def _term(coord, a: float) -> str:
-    return f"{coord.name}^{a:.3g}" if coord.log else f"exp({a:.3g} {coord.name})"
-
-
-def _combinations(problem: Problem, x, cov, corr, fitted: list[int]) -> tuple:
-    """For each group of fitted parameters linked by |correlation| > CORRELATED: the determined combination
-    (stiff eigenvector of the group's Hessian, the other parameters profiled: inv of the covariance block)
-    and the undetermined direction (the sloppy one)."""
-    groups, seen = [], set()
-    for i in range(len(fitted)):
-        if i in seen:
-            continue
-        group, stack = [], [i]
-        while stack:
-            j = stack.pop()
-            if j in seen:
-                continue
-            seen.add(j)
-            group.append(j)
-            stack.extend(k for k in range(len(fitted)) if k not in seen and abs(corr[j, k]) > CORRELATED)
-        if len(group) > 1:
-            groups.append(sorted(group))
-    out = []
-    for group in groups:
-        idx = [fitted[g] for g in group]
-        coords = [problem.coordinates[i] for i in idx]
-        C = cov[np.ix_(idx, idx)]
-        w, V = np.linalg.eigh(C)  # ascending variance: first = stiffest direction of the Hessian
-        comb = {}
-        for label, vec, var in (("determined", V[:, 0], w[0]), ("undetermined", V[:, -1], w[-1])):
-            a = vec / vec[np.argmax(np.abs(vec))]
-            sd = math.sqrt(max(float(a @ C @ a), 0.0))
-            comb[label] = (a, sd)
-        a, sd = comb["determined"]
-        log_value = float(sum(ai * (math.log(c.to_value(x[i])) if c.log else c.to_value(x[i]))
-                              for ai, c, i in zip(a, coords, idx)))
-        value = math.exp(log_value)
-        sub = corr[np.ix_(group, group)]
-        rho = float(sub[np.unravel_index(np.argmax(np.abs(sub - np.eye(len(group)))), sub.shape)])
-        a_sloppy, sd_sloppy = comb["undetermined"]
-        out.append({
-            "parameters": [c.name for c in coords],
-            "exponents": {c.name: float(ai) for c, ai in zip(coords, a)},
-            "expression": " * ".join(_term(c, ai) for c, ai in zip(coords, a)),
-            "value": value, "relative_sd": sd, "ci95": [value * math.exp(-1.96 * sd), value * math.exp(1.96 * sd)],
-            "correlation": rho,
-            "undetermined_exponents": {c.name: float(ai) for c, ai in zip(coords, a_sloppy)},
-            "undetermined_relative_sd": sd_sloppy,
-            "description": "the data determine this product of powers (stiff eigenvector of the Hessian in log "
-                           "space, the other parameters profiled); along the undetermined exponents the "
-                           "parameters trade off against each other"})
-    return tuple(out)
 
 
 class _BetterOptimum(Exception):
@@ -385,16 +276,20 @@ class _BetterOptimum(Exception):
         self.x, self.d = x, d
 
 
-def profile_threshold(n: int, p: int, noise_estimated: bool) -> float:
-    """The rise of the deviance -2 log L that bounds a 95 % profile-likelihood interval of one parameter:
-    chi2_1(0.95) = 3.841 with a known noise; with the noise level estimated from the same ``n`` points and
-    ``p`` fitted quantities of the mean, n ln(1 + F_(1, n-p)(0.95)/(n - p)) (for a linear Gaussian model
-    the likelihood-ratio statistic is that function of an F(1, n-p) variable; it tends to 3.841 as n grows).
+def profile_threshold(n: int, p: int, noise_estimated: bool, level: float = 0.95) -> float:
+    """The rise of the deviance -2 log L that bounds a two-sided profile-likelihood interval of one parameter
+    at ``level``: chi2_1(level) (3.841 at 0.95) with a known noise; with the noise level estimated from the
+    same ``n`` points and ``p`` fitted quantities of the mean, n ln(1 + F_(1, n-p)(level)/(n - p)) (for a
+    linear Gaussian model the likelihood-ratio statistic is that function of an F(1, n-p) variable; it tends
+    to chi2_1(level) as n grows). At ``level`` 0.90 each end of the interval would be a one-sided 95 % bound
+    of a regular likelihood (chi2_1(0.90) = 2.706 = 1.645^2; F_(1, nu)(0.90) = t_nu(0.95)^2); the ``bound``
+    of a practically non-identifiable parameter uses 0.95 instead (:data:`BOUND_LEVEL`, the reasons in
+    :mod:`restitution.fit.identifiability`).
     """
     dof = n - p
     if not noise_estimated or dof < 1:
-        return CHI2_1_95
-    return n * math.log1p(float(stats.f.ppf(0.95, 1, dof)) / dof)
+        return CHI2_1_95 if level == 0.95 else float(stats.chi2.ppf(level, 1))
+    return n * math.log1p(float(stats.f.ppf(level, 1, dof)) / dof)
 
 
 def _profile_end(fitter: _Fitter, x_hat, d_min, i: int, direction: int, se: float, strict: bool = True,
@@ -439,18 +334,6 @@ def _profile_end(fitter: _Fitter, x_hat, d_min, i: int, direction: int, se: floa
         step *= 2.0
 
 
-def _bound_note(name: str, coord, side: str, bound_value: float, params_at_bound: dict) -> str:
-    note = (f"the profile stays within the 95 % threshold of its maximum up to the domain's {side} bound: the interval's "
-            f"{side} end is that bound, {bound_value:.4g} {coord.unit}")
-    key = KEYS.get(name, "")
-    if key.endswith("_Sy"):
-        body = key.split("_")[0]
-        yields, _, _ = _who_yields(params_at_bound)
-        if yields != body:
-            note += f" (there the {yields} yields first and {name} no longer enters e, Eq. 2)"
-    return note
-
-
 def _n_mean(lik, free) -> int:
     """The quantities fitted to the mean: the free parameters, the nuisance coordinates (v_1 of a drop) and
     a drop's profiled time origin."""
@@ -492,6 +375,40 @@ def _optimum(problem: Problem, grid: int):
     if grid_x is not None:
         candidates.append(grid_x)
     return min((fitter.solve(x) for x in candidates), key=lambda t: t[1])
+
+
+def _estimate(name, reason, free, problem, fitter, x_hat, d_min, se, ends, threshold,
+              one_sided) -> ParameterEstimate:
+    """The :class:`ParameterEstimate` of ``name``: structurally non-identifiable (``reason``), or from its
+    profile ``ends`` (None: not computed): both inside the domain, identifiable; one or both at the domain's
+    bound, practically non-identifiable, with the bound the data give on the other side (the profile's end at
+    ``one_sided``, the threshold of :data:`BOUND_LEVEL`: the end of the 95 % profile set)."""
+    if reason is not None:
+        return ParameterEstimate(name, KEYS[name], UNITS[name], None, None, False, reason,
+                                 identifiability=STRUCTURAL)
+    i = free.index(name)
+    c = problem.parameters[i]
+    est = float(c.to_value(x_hat[i]))
+    if ends is None:
+        return ParameterEstimate(name, c.key, c.unit, est, None, True, "", "profile not computed", float(se[i]),
+                                 best=est)
+    (x_lo, full_lo, at_lo), (x_hi, full_hi, at_hi) = ends[i]
+    if not (at_lo or at_hi):
+        return ParameterEstimate(name, c.key, c.unit, est, (float(c.to_value(x_lo)), float(c.to_value(x_hi))), True,
+                                 se=float(se[i]), best=est)
+    if at_lo and at_hi:
+        return ParameterEstimate(name, c.key, c.unit, None, None, False, practical_reason(name, c, None, None, {}),
+                                 se=float(se[i]), identifiability=PRACTICAL, best=est)
+    side = -1 if at_hi else +1  # the side the data bound
+    x_end, at_bound = (x_lo, at_lo) if side < 0 else (x_hi, at_hi)
+    if one_sided != threshold:  # the bound's own level (BOUND_LEVEL)
+        x_end, _, at_bound = _profile_end(fitter, x_hat, d_min, i, side, se[i], False, one_sided)
+    value = float(c.to_value(x_end)) if not at_bound else (c.low if side < 0 else c.high)
+    open_side, full_open = ("upper", full_hi) if at_hi else ("lower", full_lo)
+    return ParameterEstimate(name, c.key, c.unit, None, None, False,
+                             practical_reason(name, c, open_side, value, problem.split(full_open)[0]),
+                             se=float(se[i]), identifiability=PRACTICAL,
+                             bound={"lower" if side < 0 else "upper": value}, best=est)
 
 
 def fit_parameters(data, base: dict, names, *, g: float = G_STANDARD, v1: float | None = None,
@@ -538,37 +455,14 @@ def fit_parameters(data, base: dict, names, *, g: float = G_STANDARD, v1: float 
             ends = {}
 
     params_hat, z_hat = problem.split(x_hat)
-    estimates = {}
-    for name in names:
-        if reasons[name] is not None:
-            estimates[name] = ParameterEstimate(name, KEYS[name], UNITS[name], None, None, False, reasons[name])
-            continue
-        i = free.index(name)
-        c = coords[i]
-        est = float(c.to_value(x_hat[i]))
-        if not profile:
-            estimates[name] = ParameterEstimate(name, c.key, c.unit, est, None, True, "", "profile not computed",
-                                                float(se[i]))
-            continue
-        (x_lo, full_lo, at_lo), (x_hi, full_hi, at_hi) = ends[i]
-        lo = c.low if at_lo else float(c.to_value(x_lo))  # the bound itself, not exp(ln) of it
-        hi = c.high if at_hi else float(c.to_value(x_hi))
-        if at_lo and at_hi:
-            reason = (f"the data do not bound {name}: the profile likelihood stays within the 95 % threshold of its maximum "
-                      f"over the whole domain [{c.low:.3g}, {c.high:.3g}] {c.unit}")
-            estimates[name] = ParameterEstimate(name, c.key, c.unit, est, None, False, reason, "", float(se[i]))
-            continue
-        notes = []
-        if at_lo:
-            notes.append(_bound_note(name, c, "lower", lo, problem.split(full_lo)[0]))
-        if at_hi:
-            notes.append(_bound_note(name, c, "upper", hi, problem.split(full_hi)[0]))
-        estimates[name] = ParameterEstimate(name, c.key, c.unit, est, (lo, hi), True, "", "; ".join(notes),
-                                            float(se[i]))
+    one_sided = profile_threshold(lik.n, _n_mean(lik, free), lik.profiled, level=BOUND_LEVEL)
+    estimates = {name: _estimate(name, reasons[name], free, problem, fitter, x_hat, d_min, se,
+                                 ends if profile else None, threshold, one_sided)
+                 for name in names}
 
     cov_p = cov[np.ix_(range(len(free)), range(len(free)))]
-    corr = _correlation(cov_p) if free else np.zeros((0, 0))
-    combinations = _combinations(problem, x_hat, cov, corr, list(range(len(free)))) if len(free) > 1 else ()
+    corr = correlation_of(cov_p) if free else np.zeros((0, 0))
+    combined = combinations(problem, x_hat, cov, corr, list(range(len(free)))) if len(free) > 1 else ()
 
     nuisance = {}
     if lik.kind == "impact_times":
@@ -578,10 +472,12 @@ def fit_parameters(data, base: dict, names, *, g: float = G_STANDARD, v1: float 
             entry["se_log"] = float(se[len(coords)])
         nuisance = {"v1": entry, "t1": {"estimate": lik.t1(params_hat, z_hat), "unit": "s", "fitted": True}}
     flags = lik.flags(params_hat, z_hat)
+    lof = lack_of_fit(problem, x_hat)
     d_final = fitter.deviance(x_hat)
     return FitResult(
         kind=lik.kind, n=lik.n, parameters=estimates, noise=lik.noise(params_hat, z_hat, len(free)),
         nuisance=nuisance, residuals=np.asarray(lik.data_residuals(params_hat, z_hat), dtype=float),
-        correlation_names=tuple(free), correlation_matrix=corr, combinations=combinations,
+        correlation_names=tuple(free), correlation_matrix=corr, combinations=combined,
         out_of_range=int(np.count_nonzero(flags["any"])), flags=flags, log_likelihood=-0.5 * d_final,
-        evaluations=problem.evaluations, elapsed=time.perf_counter() - t_start, options=options)
+        evaluations=problem.evaluations, elapsed=time.perf_counter() - t_start, options=options,
+        lack_of_fit=lof)

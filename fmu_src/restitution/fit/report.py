@@ -10,7 +10,7 @@ import numpy as np
 from .datasets import ImpactTimes, Recording, ReboundPairs
 from .forward import KEYS, bounce_train, restitution_at
 
-__all__ = ["table", "write_json", "plot", "band_params"]
+__all__ = ["table", "write_json", "plot", "band_params", "bound_words"]
 
 #: SI unit -> the kind of quantity restitution.scene.units formats (MPa, GPa, mm, ...).
 _KINDS = {"Pa": "pressure", "m": "length", "kg/m3": "density"}
@@ -32,13 +32,18 @@ def table(calibration) -> str:
     kind = {"rebound_pairs": "rebound pairs", "impact_times": "impact times", "recording": "impacts found in a recording"}
     lines = [f"fit of {result.n} {kind.get(data.kind, data.kind)}{' from ' + data.source if data.source else ''} "
              f"({result.evaluations} model evaluations, {result.elapsed:.2g} s)"]
+    lof = result.lack_of_fit
+    if lof.get("detected"):
+        lines.append(f"  WARNING: the model does not describe these data: {lof['words']}. The numbers below assume "
+                     "it does; do not trust them")
     width = max(len(name) for name in result.parameters)
     for p in result.parameters.values():
         if not p.identifiable:
-            lines.append(f"  {p.name:<{width}}  not identifiable: {p.reason}")
+            lines.append(f"  {p.name:<{width}}  {_not_identifiable(p)}")
             continue
-        text = f"  {p.name:<{width}}  {_value(p.estimate, p.unit):>12}   95 % [{_value(p.ci95[0], p.unit)}, " \
-               f"{_value(p.ci95[1], p.unit)}] (profile likelihood)"
+        interval = ("no 95 % interval" if p.ci95 is None else
+                    f"95 % [{_value(p.ci95[0], p.unit)}, {_value(p.ci95[1], p.unit)}] (profile likelihood)")
+        text = f"  {p.name:<{width}}  {_value(p.estimate, p.unit):>12}   {interval}"
         post = calibration.posterior
         if post is not None and p.name in post.interval95:
             lo, hi = post.interval95[p.name]
@@ -59,6 +64,26 @@ def table(calibration) -> str:
         lines.append(f"  {result.out_of_range} of {result.n} points outside the model's validated range "
                      "(lambda > 1.5, V* > 1000 or e < 0): kept, marked in the plot and the JSON")
     return "\n".join(lines)
+
+
+def bound_words(p) -> str:
+    """"plate.Sy > 400 MPa" for a parameter with a one-sided ``bound`` ("" without one)."""
+    if not p.bound:
+        return ""
+    side, value = next(iter(p.bound.items()))
+    return f"{p.name} {'>' if side == 'lower' else '<'} {_value(value, p.unit)}"
+
+
+def _not_identifiable(p) -> str:
+    if p.identifiability != "practical":
+        return f"not identifiable: {p.reason}"
+    if not p.bound:
+        return f"not identifiable from these data (practically): {p.reason}"
+    words = "from below" if "lower" in p.bound else "from above"
+    hint = p.reason[p.reason.index(" (there the"):] if " (there the" in p.reason else ""
+    return (f"not identifiable from these data (practically): the data bound it only {words}, {bound_words(p)} at "
+            f"95 %; its profile likelihood stays within the 95 % threshold up to the edge of its "
+            f"domain{hint}")
 
 
 def write_json(path, calibration) -> None:
@@ -178,9 +203,15 @@ def plot(path, calibration) -> None:
         ax.set_xlabel("time [s]")
         ax.set_ylabel("recording [1]")
         ax.set_title(f"{data.times.n} impacts found (red)", fontsize=9)
-    estimates = ", ".join(f"{p.name} = {_value(p.estimate, p.unit)}" for p in calibration.result.parameters.values()
-                          if p.estimate is not None)
-    axes[0, 0].set_title(f"restitution fit: {estimates or 'nothing identifiable'}", fontsize=10)
+    result = calibration.result
+    estimates = ", ".join([f"{p.name} = {_value(p.estimate, p.unit)}" for p in result.parameters.values()
+                           if p.estimate is not None]
+                          + [f"{bound_words(p)} (95 %, not identifiable)" for p in result.parameters.values()
+                             if p.bound])
+    title = f"restitution fit: {estimates or 'nothing identifiable'}"
+    if result.lack_of_fit.get("detected"):
+        title += "\nlack of fit: the model does not describe these data"
+    axes[0, 0].set_title(title, fontsize=10, color="tab:red" if result.lack_of_fit.get("detected") else "black")
     axes[0, 0].legend(fontsize=8)
     fig.tight_layout()
     atomic_write(path, lambda tmp: fig.savefig(tmp), "--plot")
