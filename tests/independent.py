@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 import tomllib
+from fractions import Fraction
 from pathlib import Path
 
 import mpmath as mp
@@ -104,3 +105,82 @@ def apparent_cor(a: dict, b: dict, d: float, t: float, v: float, half_space: boo
     e_ep = max(float(e45_printed(v_star, eps_y)), 0.0) if v_star > 1 else 1.0
     e_ze = 1.0 if half_space else solve_zener(float(lam))[0]
     return (e_ep + e_ze + e_ep * e_ze - 1.0) / 2.0
+
+
+# --- The monitors of the assumptions (docs/assumptions.md): Zener's time unit and contact time, the
+# --- half-space and the two approximate methods' tau0 as printed, the plate's P-wave speed
+
+def zener_time_unit(a: dict, b: dict, d: float, v: float):
+    """Zener's time unit T = (m / (k v^(1/2)))^(2/5) [s], Eq. (9), in mpmath: m = rho_a pi d^3/6 the
+    sphere's mass, k = (4/3) E' sqrt(d/2) the Hertz stiffness with E' of Eq. (1); a and b hold E, nu,
+    rho of the sphere and the plate (SI)."""
+    mp.mp.dps = 30
+    ea = mp.mpf(repr(float(a["E"]))) / (1 - mp.mpf(repr(float(a["nu"]))) ** 2)
+    eb = mp.mpf(repr(float(b["E"]))) / (1 - mp.mpf(repr(float(b["nu"]))) ** 2)
+    k = mp.mpf(4) / 3 * (ea * eb / (ea + eb)) * mp.sqrt(mp.mpf(d) / 2)
+    m = mp.mpf(repr(float(a["rho"]))) * mp.pi * mp.mpf(d) ** 3 / 6
+    return (m / (k * mp.sqrt(mp.mpf(v)))) ** (mp.mpf(2) / 5)
+
+
+def tau0_hertz():
+    """tau0 at lambda = 0, the Hertz impact on a half-space, in Zener's unit: the Hertz contact time
+    2 (5 m / (4 k))^(2/5) v^(-1/5) int_0^1 dx / sqrt(1 - x^(5/2)) (Johnson, Contact Mechanics, 11.4)
+    over T: 2 (5/4)^(2/5) int_0^1 dx / sqrt(1 - x^(5/2)), by mpmath's quadrature."""
+    mp.mp.dps = 30
+    return 2 * (mp.mpf(5) / 4) ** (mp.mpf(2) / 5) * mp.quad(lambda x: 1 / mp.sqrt(1 - x ** mp.mpf(2.5)), [0, 1])
+
+
+def tau0_paper_fit(lam):
+    """tau0 of Eq. (13a) as printed: 3.215 exp(0.318 lambda^(3/2)) (3.215 at lambda = 0)."""
+    mp.mp.dps = 30
+    return mp.mpf("3.215") * mp.exp(mp.mpf("0.318") * mp.mpf(lam) ** mp.mpf(1.5))
+
+
+def tau0_linear(lam):
+    """First return to 0 of the linearised Eq. (22), sigma'' + lambda sigma' + sigma = 0, sigma(0) = 0,
+    sigma'(0) = 1: sigma = exp(-lambda tau/2) sin(w tau)/w with w = sqrt(1 - lambda^2/4), back at
+    tau = pi/w (pi at lambda = 0); never for lambda >= 2 (critically or over-damped): +inf."""
+    mp.mp.dps = 30
+    lam = mp.mpf(lam)
+    return mp.pi / mp.sqrt(1 - lam ** 2 / 4) if lam < 2 else mp.inf
+
+
+def p_wave_speed(E: float, nu: float, rho: float):
+    """The bulk P-wave speed c_L = sqrt((lambda_L + 2 mu) / rho) [m/s] with the Lame constants
+    lambda_L = E nu / ((1 + nu)(1 - 2 nu)), mu = E / (2 (1 + nu)), in mpmath."""
+    mp.mp.dps = 30
+    E, nu, rho = (mp.mpf(repr(float(x))) for x in (E, nu, rho))
+    lame = E * nu / ((1 + nu) * (1 - 2 * nu))
+    return mp.sqrt((lame + 2 * E / (2 * (1 + nu))) / rho)
+
+
+# --- BouncingBall's contact indicator (docs/host_contract.md): h + max(v, 0)^2/(2 g) in flight
+
+#: (h [m], v [m/s]) in flight: rising, falling, at the apex (v = +0 and -0), below the plate either way.
+INDICATOR_IN_FLIGHT = ((0.2, 1.5), (0.0, 3.0), (1.0, 0.25), (-0.05, 2.0), (0.2, -1.5), (0.7, -0.3), (-0.01, -2.0),
+                       (0.3, 0.0), (0.3, -0.0))
+#: (g [m/s2], h [m], v [m/s]) a host may set, far beyond any flight, up to the largest double.
+_BIG = 1.7976931348623157e308
+INDICATOR_EXTREME = ((9.80665, 1e308, _BIG), (9.80665, _BIG, _BIG), (9.80665, -_BIG, _BIG), (9.80665, 0.0, _BIG),
+                     (9.80665, 1e308, -_BIG), (9.80665, -_BIG, -_BIG), (9.80665, 1.0, 1e154),
+                     (9.80665, -1e308, 1.4e154), (1e6, 0.0, 2e154), (1e6, -1e308, 2e154), (1e6, _BIG, 2e154),
+                     (1e6, -_BIG, 1e160), (1e-6, _BIG, _BIG), (1e-6, -_BIG, _BIG), (1e-6, -1e300, 1e150))
+
+
+def apex_height_exact(h: float, v: float, g: float):
+    """(h + max(v, 0)^2/(2 g), |h| + max(v, 0)^2/(2 g)) as exact Fractions: the indicator's closed form
+    and the scale of its rounding error in doubles."""
+    term = Fraction(max(v, 0.0)) ** 2 / (2 * Fraction(g))
+    return Fraction(h) + term, abs(Fraction(h)) + term
+
+
+def assert_indicator(got: float, h: float, v: float, g: float, ulps: float = 2):
+    """``got`` is finite and the closed form within ``ulps`` eps of its scale (at most 3 roundings of
+    half an ulp of the scale: v * v, the division by the exact 2 g, the sum; no cancellation amplifies
+    an absolute bound); where the exact value is above the largest double, that double (the indicator's
+    documented saturation)."""
+    exact, scale = apex_height_exact(h, v, g)
+    assert math.isfinite(got), (h, v, g, got)
+    expected = min(exact, Fraction(_BIG))
+    assert abs(Fraction(got) - expected) <= ulps * 2.0 ** -52 * min(scale, Fraction(_BIG)), (h, v, g, got,
+                                                                                            float(expected))

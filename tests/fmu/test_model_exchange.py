@@ -5,6 +5,7 @@ has no states and its outputs are a function of its inputs."""
 from __future__ import annotations
 
 import ctypes
+import json
 import math
 
 import numpy as np
@@ -12,6 +13,7 @@ import pytest
 from fmpy import extract, read_model_description, simulate_fmu
 
 from fmi_child import run_child
+from independent import INDICATOR_EXTREME, INDICATOR_IN_FLIGHT, assert_indicator
 from script_host import free_fall_contacts
 
 H0, G = 0.3, 9.80665
@@ -197,3 +199,125 @@ def test_derivatives_and_indicator_follow_a_restored_fmu_state(me_ball):
     fmu.freeInstance()
     assert list(x) == [0.25, -1.0]
     assert list(dx) == [-1.0, -G] and list(z) == [0.25], (list(dx), list(z))
+
+
+# --- the event indicator by value: h + max(v, 0)^2/(2 g) in flight, 1 m at rest (docs/host_contract.md),
+# --- against its closed form in exact rational arithmetic (tests/independent.py: apex_height_exact, with
+# --- the error bound of its evaluation in doubles, assert_indicator), the host setting h and v
+
+#: A gravity that is neither 1 nor a power of 2 (a factor 2 lost or doubled in 2 g shows at once).
+G_INDICATOR = 3.7
+
+#: The child: a model-exchange instance per (g, h0) of ARGS[0]; for each, the host sets every (h, v) in
+#: continuous-time mode and reads the indicator, derivatives, nominals and v_approach with their statuses.
+#: ARGS[1]: e, and (h, v) of a contact event (enterEventMode, one event update) at the end.
+ME_CHILD = r'''
+from fmpy.fmi2 import FMU2Model
+from fmpy.fmi3 import FMU3Model
+
+groups, (e, contact) = json.loads(ARGS[0]), json.loads(ARGS[1])
+three = MD.fmiVersion.startswith("3")
+out = []
+
+
+def vector(*values):
+    return (c_double * len(values))(*values)
+
+
+def event_iteration(fmu):
+    while (fmu.updateDiscreteStates() if three else fmu.newDiscreteStates())[0]:
+        pass
+
+
+def read(fmu):
+    z, dx, nominal = vector(0.0), vector(0.0, 0.0), vector(0.0, 0.0)
+    got = {"z_status": status(fmu.getEventIndicators, z, 1),
+           "dx_status": status(fmu.getContinuousStateDerivatives if three else fmu.getDerivatives, dx, 2),
+           "nominal_status": status(fmu.getNominalsOfContinuousStates, nominal, 2)}
+    got.update(z=z[0], dx=list(dx), nominal=list(nominal),
+               v_approach=(fmu.getFloat64 if three else fmu.getReal)([VR["v_approach"]])[0])
+    return got
+
+
+for g, h0, states in groups:
+    cls = FMU3Model if three else FMU2Model
+    fmu = cls(guid=MD.instantiationToken if three else MD.guid, unzipDirectory=UNZIP,
+              modelIdentifier=MD.modelExchange.modelIdentifier, instanceName="indicator")
+    fmu.instantiate()
+    if three:
+        fmu.enterInitializationMode(startTime=0.0)
+    else:
+        fmu.setupExperiment(startTime=0.0)
+        fmu.enterInitializationMode()
+    (fmu.setFloat64 if three else fmu.setReal)([VR["g"], VR["h0"], VR["e"]], [g, h0, e])
+    fmu.exitInitializationMode()
+    event_iteration(fmu)
+    fmu.enterContinuousTimeMode()
+    group = {"initial": read(fmu), "states": []}
+    fmu.setTime(0.1)
+    for h, v in states:
+        got = {"set_status": status(fmu.setContinuousStates, vector(h, v), 2)}
+        got.update(read(fmu))
+        group["states"].append(got)
+    if h0 > 0.0:  # a contact: the host puts the ball at the plate, falling, and hands over the event
+        fmu.setContinuousStates(vector(*contact), 2)
+        fmu.enterEventMode()
+        event_iteration(fmu)
+        fmu.enterContinuousTimeMode()
+        x = vector(0.0, 0.0)
+        fmu.getContinuousStates(x, 2)
+        group["after_contact"] = dict(read(fmu), x=list(x))
+    out.append(group)
+    fmu.terminate()
+    fmu.freeInstance()
+report(groups=out)
+'''
+
+
+def run_model_exchange(fmu, tmp_path, groups, e=0.5, contact=(-1e-9, -2.0)):
+    unzip = extract(str(fmu), str(tmp_path / "unzip"))
+    child = run_child(ME_CHILD, fmu, unzip, json.dumps(groups), json.dumps([e, contact]))
+    assert child.returncode == 0 and child.report is not None, child.explain()
+    return child.report["groups"]
+
+
+def test_the_native_indicator_is_the_apex_height_in_flight_and_1_m_at_rest(me_ball, tmp_path):
+    """In flight the indicator is h + max(v, 0)^2/(2 g) (rising: the apex; falling or at the apex: h),
+    for two gravities; right after exitInitializationMode it is h0 (released from rest); after a contact
+    with e = 0.5 at 2 m/s the ball is at the plate rising at 1 m/s: (0.5 * 2)^2/(2 g); released on the
+    plate (h0 = 0) the ball is at rest and the indicator is 1 m, whatever state the host sets."""
+    states = [list(s) for s in INDICATOR_IN_FLIGHT]
+    groups = run_model_exchange(me_ball, tmp_path, [[G_INDICATOR, 0.4, states], [G, 0.3, states],
+                                                    [G_INDICATOR, 0.0, states]])
+    for (g, h0), group in zip(((G_INDICATOR, 0.4), (G, 0.3)), groups):
+        assert_indicator(group["initial"]["z"], h0, 0.0, g)
+        for (h, v), got in zip(INDICATOR_IN_FLIGHT, group["states"]):
+            assert got["set_status"] == 0 and got["z_status"] == 0, got
+            assert_indicator(got["z"], h, v, g)
+        after = group["after_contact"]
+        assert after["x"] == [0.0, 1.0]  # h = 0, v = e |v| = 0.5 * 2 exactly
+        assert_indicator(after["z"], 0.0, 1.0, g)
+    at_rest = groups[2]
+    assert at_rest["initial"]["z"] == 1.0  # the documented value at rest: no more contacts
+    for got in at_rest["states"]:
+        assert got["set_status"] == 0 and got["z"] == 1.0 and got["dx"] == [0.0, 0.0], got
+
+
+def test_the_native_indicator_stays_finite_for_any_finite_state(me_ball, tmp_path):
+    """Repro: (h, v) = (1e308, DBL_MAX) set by the host gave an indicator of +inf with status OK. Every
+    finite state gives a finite indicator with status OK: the closed form where it is a double, DBL_MAX
+    where it is above, within 4 eps of |h| + max(v, 0)^2/(2 g) (the rescaled form
+    v' = v / sqrt(2 g) adds a square root and a rounding to the 3 of the closed form); -1e308 with a term of 1e302 stays
+    negative (below the plate). The derivatives, nominals and v_approach are finite there too."""
+    groups = {}
+    for g, h, v in INDICATOR_EXTREME:
+        groups.setdefault(g, []).append([h, v])
+    found = run_model_exchange(me_ball, tmp_path, [[g, 0.3, states] for g, states in groups.items()])
+    for (g, states), group in zip(groups.items(), found):
+        for (h, v), got in zip(states, group["states"]):
+            for key in ("set_status", "z_status", "dx_status", "nominal_status"):
+                assert got[key] == 0, (h, v, g, key, got)
+            assert_indicator(got["z"], h, v, g, ulps=4)
+            assert all(math.isfinite(x) for x in (*got["dx"], *got["nominal"], got["v_approach"])), (h, v, got)
+    below = found[list(groups).index(1e6)]["states"][1]  # (-1e308, 2e154) under g = 1e6
+    assert below["z"] < -0.99e308

@@ -10,13 +10,17 @@ plus 1e-12 s absolute), never bit for bit; the integer and Boolean state must be
 from __future__ import annotations
 
 import ctypes
+import json
 import math
 import shutil
 import subprocess
 
 import numpy as np
 import pytest
+from fmpy import extract
 
+from fmi_child import run_child
+from independent import INDICATOR_EXTREME, INDICATOR_IN_FLIGHT, assert_indicator
 from restitution.fmu.describe.c_header import variables
 from restitution.fmu.build.native import write_backend
 from restitution.fmu.build.compile import CFLAGS
@@ -95,3 +99,89 @@ def test_ball_follows_the_python_slave(ball, contact_mode, h0, g, v_min, start, 
         if py._s["at_rest"]:
             break
     assert contacts >= 3  # the comparison went through several contacts
+
+
+# --- the contact indicator by value: h + max(v, 0)^2/(2 g) in flight, 1 m at rest (docs/host_contract.md),
+# --- against its closed form in exact rational arithmetic (tests/independent.py: apex_height_exact, with
+# --- the error bound of its evaluation in doubles, assert_indicator); the native model exchange's is in
+# --- test_model_exchange.py
+
+
+def python_ball(g):
+    import bouncing_ball_slave
+
+    ball = bouncing_ball_slave.BouncingBall(instance_name="indicator-test", visible=False)
+    ball._values["g"] = g
+    return ball
+
+
+@pytest.mark.parametrize("g", [3.7, 9.80665])
+def test_the_python_indicator_is_the_apex_height_in_flight_and_1_m_at_rest(g):
+    """The Python ball's function and its derivative update (what its FMU reports): the same closed form
+    and the same bound as the native one; at rest 1 m."""
+    import bouncing_ball_slave
+
+    ball = python_ball(g)
+    for h, v in INDICATOR_IN_FLIGHT:
+        assert_indicator(bouncing_ball_slave.contact_indicator(h, v, g), h, v, g)
+        ball._s.update(h=h, v=v, at_rest=False, in_contact=False)
+        ball._update_derivatives()
+        assert_indicator(ball._s["contact_indicator"], h, v, g)
+    ball._s.update(h=0.0, v=0.0, at_rest=True)
+    ball._update_derivatives()
+    assert ball._s["contact_indicator"] == 1.0
+
+
+def test_the_python_indicator_stays_finite_for_any_finite_state():
+    """The Python twin of the native repro: finite, and the closed form or DBL_MAX."""
+    import bouncing_ball_slave
+
+    for g, h, v in INDICATOR_EXTREME:
+        assert_indicator(bouncing_ball_slave.contact_indicator(h, v, g), h, v, g, ulps=4)
+        ball = python_ball(g)
+        ball._s.update(h=h, v=v, at_rest=False, in_contact=False)
+        ball._update_derivatives()
+        assert_indicator(ball._s["contact_indicator"], h, v, g, ulps=4)
+    assert bouncing_ball_slave.contact_indicator(-1e308, 2e154, 1e6) < -0.99e308
+
+
+#: The child: co-simulation, contact_mode = 2 (immediate), e = 0.5; the indicator and the state at each
+#: communication point of ARGS[0] (seconds).
+CS_CHILD = r'''
+points = json.loads(ARGS[0])
+s = instance("cs", {"h0": 0.3, "g": 9.80665, "e": 0.5, "contact_mode": 2})
+t, rows = 0.0, []
+for end in points:
+    s.doStep(currentCommunicationPoint=t, communicationStepSize=end - t)
+    t = end
+    rows.append(reals(s, ["h", "v", "contact_indicator", "flight.h_start", "flight.v_start"]))
+s.terminate()
+s.freeInstance()
+report(rows=rows)
+'''
+
+
+def test_the_co_simulation_indicator_follows_the_flight(any_ball_fmu, tmp_path):
+    """Both FMI 2.0 implementations (pythonfmu and native), co-simulation: the indicator reported at each
+    communication point is the apex height of the flight, h_s + v_s^2/(2 g) of the flight's start while it
+    rises, h(t) = 0.3 - g t^2/2 on the drop. Dropped from 0.3 m the ball meets the plate at t1 = 0.247 s
+    and rebounds at half its speed, to an apex of 0.3/4 m at t1 + 0.124 s. The reported h and v come
+    from a parabola (a few roundings of terms up to 2 h0 = 0.6 m): within 1e-13 m (about 100 ulps of 0.6 m)."""
+    g, h0 = 9.80665, 0.3
+    t1 = math.sqrt(2 * h0 / g)
+    points = [0.1, 0.2, t1 + 0.02, t1 + 0.1, t1 + 0.2]
+    unzip = extract(str(any_ball_fmu), str(tmp_path / "unzip"))
+    child = run_child(CS_CHILD, any_ball_fmu, unzip, json.dumps(points))
+    assert child.returncode == 0 and child.report is not None, child.explain()
+    rows = child.report["rows"]
+    for t, (h, v, z, h_start, v_start) in zip(points, rows):
+        if t < t1:
+            assert v < 0.0 and z == pytest.approx(h0 - g * t * t / 2, abs=1e-13) and z == h, (t, z)
+        else:
+            v_up = 0.5 * math.sqrt(2 * g * h0)
+            apex = v_up ** 2 / (2 * g)  # = h0 / 4
+            assert v_start == pytest.approx(v_up, rel=1e-14) and h_start == 0.0
+            falling = t - t1 > v_up / g
+            want = v_up * (t - t1) - g * (t - t1) ** 2 / 2 if falling else apex  # h(t), then the apex
+            assert z == pytest.approx(want, abs=1e-13), (t, z, want)
+            assert (v < 0.0) == falling

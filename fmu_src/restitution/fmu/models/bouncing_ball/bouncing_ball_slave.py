@@ -156,8 +156,21 @@ def contact_indicator(h, v, g):
     reaches before it falls (h [m], v [m/s] upward, g [m/s2]). It equals h while the ball falls, so
     its crossing to <= 0 is the contact; while the ball rises it stays at the apex height, which right
     after a rebound is v^2/(2 g) > 0: the ball is then strictly in flight, never at the indicator's
-    zero (a host that compares each indicator with its value after the last event sees every contact)."""
-    return h + v * v / (2.0 * g) if v > 0.0 else h
+    zero (a host that compares each indicator with its value after the last event sees every contact).
+
+    Evaluated as written wherever that is finite. Departure, for states a host may set (any finite h
+    and v): where v * v or the sum overflows, the apex term is v'^2 with v' = v / sqrt(2 g) (no overflow
+    for the speeds whose term is finite: sqrt(2 g) >= 1.4e-3), and a sum that still overflows, whose
+    exact value is above the largest float, is held at sys.float_info.max: the indicator stays finite,
+    with its sign right. A NaN stays NaN (as rst_native_ball.c's contact_indicator)."""
+    if not v > 0.0:
+        return h
+    apex = h + v * v / (2.0 * g)
+    if not math.isinf(apex):
+        return apex
+    scaled = v / math.sqrt(2.0 * g)
+    apex = h + scaled * scaled
+    return sys.float_info.max if math.isinf(apex) else apex
 
 
 _INITIAL_STATE = {

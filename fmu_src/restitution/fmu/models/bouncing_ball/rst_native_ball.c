@@ -2,6 +2,7 @@
  * Python slave (bouncing_ball_slave.BouncingBall) it transcribes, in the same order of operations. */
 #include "rst_native_ball.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 
@@ -50,8 +51,23 @@ static double flight_duration(double h_start, double v_start, double g)
     return (v_start + sqrt(v_start * v_start + 2.0 * g * h_start)) / g;
 }
 
-/* contact_indicator: the height [m] the ball reaches before it falls, h + max(v, 0)^2/(2 g). */
-static double contact_indicator(double h, double v, double g) { return v > 0.0 ? h + v * v / (2.0 * g) : h; }
+/* contact_indicator: the height [m] the ball reaches before it falls, h + max(v, 0)^2/(2 g), evaluated
+ * as written wherever that is finite. Departure, for states a host may set (any finite h and v): where
+ * v * v or the sum overflows, the apex term is v'^2 with v' = v / sqrt(2 g) (no overflow for the
+ * speeds whose term is finite: sqrt(2 g) >= 1.4e-3), and a sum that still overflows, whose exact value
+ * is above DBL_MAX, is held at DBL_MAX: the indicator stays finite, with its sign right. A NaN stays NaN. */
+static double contact_indicator(double h, double v, double g)
+{
+    double apex, scaled;
+    if (!(v > 0.0))
+        return h;
+    apex = h + v * v / (2.0 * g);
+    if (!isinf(apex)) /* (a NaN stays NaN) */
+        return apex;
+    scaled = v / sqrt(2.0 * g);
+    apex = h + scaled * scaled;
+    return isinf(apex) ? DBL_MAX : apex;
+}
 
 /* _update_derivatives: der(h), der(v) and the contact indicator from the state (flight under
  * gravity; nothing moves at the plate; at rest the indicator stays at 1 m: no more contacts). */
