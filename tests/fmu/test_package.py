@@ -86,15 +86,17 @@ def test_a_failed_build_leaves_the_previous_fmu_untouched(built, monkeypatch):
 
 
 def test_staleness_is_decided_by_the_recorded_source_hash(built, monkeypatch):
+    from restitution.fmu.build import plan
+
     out, fmu = built
     builds = []
-    monkeypatch.setattr(fmu_build, "build_all", lambda *a, **k: builds.append(a))
-    assert fmu_build.default_fmu(out) == fmu and builds == []  # fresh: even if older than a source
+    monkeypatch.setattr(fmu_build, "run", lambda todo, out_dir, **k: builds.append([p.name for p in todo]))
+    assert fmu_build.default_fmu(out, scope="model") == fmu and builds == []  # fresh: even if older than a source
     os.utime(fmu, (0, 0))
-    assert fmu_build.default_fmu(out) == fmu and builds == []
-    monkeypatch.setattr(fmu_build, "source_hash", lambda model: "0" * 64)
-    fmu_build.default_fmu(out)
-    assert len(builds) == 1  # sources changed: rebuilt
+    assert fmu_build.default_fmu(out, scope="model") == fmu and builds == []
+    monkeypatch.setattr(plan, "source_hash", lambda model: "0" * 64)
+    fmu_build.default_fmu(out, scope="model")
+    assert builds == [["SpherePlateImpact.fmu"]]  # sources changed: rebuilt, that one alone
 
 
 def test_unwritable_output_is_one_line_exit_2(tmp_path):

@@ -18,11 +18,12 @@ class FmiStatusError(RuntimeError):
 
 
 def build_default_fmu(out_dir: str | Path | None = None, model: str = "SpherePlateImpact",
-                      rebuild: bool = False, log=None) -> Path:
-    """Path of ``<model>.fmu``, built when missing or stale: :func:`restitution.fmu.default_fmu`."""
+                      rebuild: bool = False, log=None, scope: str = "all") -> Path:
+    """Path of ``<model>.fmu``, built when missing or stale: :func:`restitution.fmu.default_fmu` (``scope``
+    "all": with every other FMU, every platform; "model": that one alone, the pythonfmu FMU)."""
     from ..fmu.build import default_fmu
 
-    return default_fmu(out_dir, model=model, rebuild=rebuild, log=log)
+    return default_fmu(out_dir, model=model, rebuild=rebuild, log=log, scope=scope)
 
 
 def check_impact_fmu(path, option: str = "--fmu") -> Path:

@@ -85,26 +85,33 @@ def write_backend(model: str, directory: Path) -> None:
 
 
 def compile_binary(model: str, sources: Path, c_files: list[str], folder: str, out: Path,
-                   extra_flags=(), fmi_version: str = "2.0") -> tuple[Path, str]:
+                   extra_flags=(), fmi_version: str = "2.0", step=None) -> tuple[Path, str]:
     """Compile ``out/binaries/<folder>/<model>.<so|dll|dylib>`` (``folder``: a binaries/ folder of
     ``fmi_version``, see toolchains.folders) with the compiler toolchains picks; returns (the binary, the
-    compiler, e.g. "gcc" or "zig cc"); NativeBuildSkipped when there is none here."""
+    compiler, e.g. "gcc" or "zig cc"); NativeBuildSkipped when there is none here. ``step``: see
+    :func:`toolchains.build_binary`."""
     try:
         binary, compilers = toolchains.build_binary(model, folder, fmi_version, sources, c_files, out / "binaries",
                                                     system_include_dirs=[fmi_include_dir(fmi_version)],
-                                                    extra_flags=extra_flags)
+                                                    extra_flags=extra_flags, step=step)
     except toolchains.ToolchainMissing as exc:
         raise NativeBuildSkipped(str(exc)) from None
     return binary, ", ".join(dict.fromkeys(compilers))
 
 
-def build_native_one(model: str, out_dir: Path, log=None, fmi_version: str = "2.0") -> Path:
+def build_native_one(model: str, out_dir: Path, log=None, fmi_version: str = "2.0", folders=None,
+                     progress=None) -> Path:
     """Build and validate ``out_dir/fmi2/<model>.fmu`` (FMI 2.0) or ``out_dir/fmi3/<model>.fmu`` (FMI 3.0)
     from the package alone; its GUID (FMI 3.0: instantiation token) is the model's
-    :meth:`~restitution.fmu.table.Table.instantiation_token`."""
+    :meth:`~restitution.fmu.table.Table.instantiation_token`. ``folders``: the binaries/ folders to build
+    (default every one of :func:`toolchains.folders`); ``log``: warnings (default stderr); ``progress``: a
+    :class:`~restitution.fmu.build.progress.Progress` told each platform's compilation (default: none)."""
     from fmpy.validation import validate_fmu
 
-    log = log or (lambda message: print(message, file=sys.stderr))
+    from .progress import quiet
+
+    log = log or (lambda message: print(message, file=sys.stderr, flush=True))
+    step = (progress or quiet()).compile_step(f"{VERSION_DIRS[fmi_version]}/{model}.fmu")
     front_files(fmi_version)  # before anything is written: no empty folder where the front is missing
     fmi_include_dir(fmi_version)
     target_dir = Path(out_dir) / VERSION_DIRS[fmi_version]
@@ -123,8 +130,11 @@ def build_native_one(model: str, out_dir: Path, log=None, fmi_version: str = "2.
         (sources / MODEL_INFO_HEADER).write_text(model_info_header(model, token), encoding="ascii")
         built = {}
         for folder in toolchains.folders(fmi_version):
+            if folders is not None and folder not in folders:
+                continue
             try:
-                binary, compilers = compile_binary(model, sources, c_files, folder, stage, fmi_version=fmi_version)
+                binary, compilers = compile_binary(model, sources, c_files, folder, stage, fmi_version=fmi_version,
+                                                   step=step)
                 built[binary.parent.name] = compilers
             except NativeBuildSkipped as exc:
                 log(f"warning: native FMI {fmi_version} {model}.fmu: {exc}")
@@ -145,16 +155,16 @@ def build_native_one(model: str, out_dir: Path, log=None, fmi_version: str = "2.
         return place(fmu, target_dir / f"{model}.fmu")
 
 
-def build_native(out_dir: Path, log=None) -> list[Path]:
+def build_native(out_dir: Path, log=None, progress=None) -> list[Path]:
     """Every native FMU there is a backend for, FMI 2.0 (``fmi2/``) and FMI 3.0 (``fmi3/``), into
     ``out_dir``; a model that cannot be built here is skipped with a message (the Python FMUs stay
     usable)."""
-    log = log or (lambda message: print(message, file=sys.stderr))
+    log = log or (lambda message: print(message, file=sys.stderr, flush=True))
     built = []
     for fmi_version in VERSION_DIRS:
         for model in BACKENDS:
             try:
-                built.append(build_native_one(model, out_dir, log=log, fmi_version=fmi_version))
+                built.append(build_native_one(model, out_dir, log=log, fmi_version=fmi_version, progress=progress))
             except NativeBuildSkipped as exc:
                 log(f"warning: native FMI {fmi_version} {model}.fmu not built: {exc}")
     return built

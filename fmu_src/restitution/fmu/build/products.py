@@ -3,8 +3,9 @@
     python -m restitution.fmu build [--out DIR]      (or: restitution-fmu build, build_scripts/build_fmu.py)
 
 writes ``DIR/<model>.fmu`` (pythonfmu, :mod:`.python_fmu`), ``DIR/fmi2/<model>.fmu`` and
-``DIR/fmi3/<model>.fmu`` (native C, :mod:`.native`) for every model. Each builder reads the package
-only, never another builder's output.
+``DIR/fmi3/<model>.fmu`` (native C, :mod:`.native`, for every platform) for every model, a line per
+product and platform as it goes (:mod:`.plan`, :mod:`.progress`). Each builder reads the package only,
+never another builder's output.
 """
 from __future__ import annotations
 
@@ -12,18 +13,23 @@ import os
 from pathlib import Path
 
 from .files import BuildError
+from .plan import full_plan, model_plan, run, to_build
+from .progress import PREFIX, stderr_line
 from .python_fmu import FMUS, build_one
 from .sources import PACKAGE, recorded_source_hash, source_hash
 
-__all__ = ["FMUS", "BuildError", "build_all", "build_one", "default_fmu", "default_fmu_dir"]
+__all__ = ["FMUS", "SCOPES", "BuildError", "build_all", "build_one", "default_fmu", "default_fmu_dir"]
+
+#: What :func:`default_fmu` keeps up to date: "all", every FMU for every platform buildable here (what the
+#: tools that use the directory's other FMUs, fmi2/ and fmi3/, need); "model", ``<model>.fmu`` alone.
+SCOPES = ("all", "model")
 
 
 def build_all(out_dir: Path, standalone: bool = True, log=None) -> list[Path]:
     """Build every FMU of the project into ``out_dir``: the pythonfmu ones, then the native ones into
-    ``out_dir/fmi2`` and ``out_dir/fmi3``."""
-    built = [build_one(model, out_dir, standalone=standalone, log=log) for model in FMUS]
-    from .native import build_native  # skipped with a message where they cannot be built
-    return built + build_native(out_dir, log=log)
+    ``out_dir/fmi2`` and ``out_dir/fmi3``, every platform (:func:`~restitution.fmu.build.plan.full_plan`).
+    ``log``: the build's lines and warnings (default stderr)."""
+    return run(full_plan(), out_dir, standalone=standalone, log=log)
 
 
 def _checkout_dist() -> Path | None:
@@ -44,21 +50,34 @@ def default_fmu_dir() -> Path:
 
 
 def default_fmu(out_dir: str | Path | None = None, model: str = "SpherePlateImpact",
-                rebuild: bool = False, log=None) -> Path:
+                rebuild: bool = False, log=None, scope: str = "all") -> Path:
     """Path of ``<model>.fmu`` (default SpherePlateImpact) in ``out_dir`` (default :func:`default_fmu_dir`).
 
-    The FMUs are (re)built when missing, built from other sources than the installed package's
-    (the source hash recorded in the FMU differs; a stale build would run old code), or when
-    ``rebuild``. ``log(message)`` is told when a build starts. Raises :class:`BuildError` with a
-    one-line reason naming ``--fmu PATH`` when no FMU can be built here.
+    What ``scope`` names (:data:`SCOPES`) is built first where it is missing, was built from other
+    sources than the installed package's (the source hash recorded in the FMU differs; a stale build
+    would run old code), lacks a platform a compiler here builds, or when ``rebuild``; the rest is left
+    as it is. "all" (the default): every FMU of the project, each native one for every platform this
+    machine can build (a directory the demo filled with ``<model>.fmu`` alone is completed); "model":
+    ``<model>.fmu`` alone, the pythonfmu FMU (seconds, no zig: the Quickstart demo). ``log(message)`` is
+    told what is built and why, and gets the build's lines (default: stderr). Raises :class:`BuildError`
+    with a one-line reason naming ``--fmu PATH`` when no FMU can be built here.
     """
+    if scope not in SCOPES:
+        raise ValueError(f"scope={scope!r}: one of {', '.join(SCOPES)}")
     out = Path(out_dir) if out_dir is not None else default_fmu_dir()
     fmu = out / f"{model}.fmu"
-    if rebuild or recorded_source_hash(fmu) != source_hash(model):
-        if log is not None:
-            log(f"building {fmu} ...")
+    plan = full_plan() if scope == "all" else model_plan(model)
+    todo = [(p, "rebuild asked") for p in plan] if rebuild else to_build(plan, out)
+    if todo:
+        say = log if log is not None else stderr_line
+        reasons = {}
+        for product, why in todo:
+            reasons.setdefault(why, []).append(product.name)
+        say(f"{PREFIX}in {out}, " + "; ".join(f"{', '.join(names)} {why}" for why, names in reasons.items())
+            + ("" if scope == "all" else f": building {model}.fmu alone, what this uses (`restitution fmu build` "
+                                        "builds every FMU for every platform)"))
         try:
-            build_all(out, log=log)
+            run([p for p, _ in todo], out, log=log)
         except BuildError as exc:
             raise BuildError(f"no usable {fmu.name} at {out} and it cannot be built here ({exc}); "
                              f"pass --fmu PATH to use an existing one") from None

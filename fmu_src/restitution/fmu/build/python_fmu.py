@@ -76,23 +76,50 @@ def _check_registration(model: str, xml_text: str) -> None:
                          f"table {expected[first:first + 1]})")
 
 
-def build_one(model: str, out_dir: Path, standalone: bool = True, log=None) -> Path:
+#: The binaries/ folders pythonfmu's own binaries fill (its wheel's; the guard replaces the Linux one).
+PYTHONFMU_FOLDERS = ("linux64", "win64")
+
+
+def toolchain_label(standalone: bool = True) -> str:
+    """What builds a pythonfmu FMU here, as the build's lines say it: pythonfmu and its version, and the
+    compiler of the guard (gcc) or why there is none."""
+    from importlib import metadata
+
+    try:
+        label = f"pythonfmu {metadata.version('pythonfmu')}"
+    except metadata.PackageNotFoundError:
+        label = "pythonfmu (not installed)"
+    if not standalone:
+        return f"{label}, no guard"
+    return f"{label}, guard gcc" if shutil.which("gcc") else f"{label}, no guard (no gcc)"
+
+
+def build_one(model: str, out_dir: Path, standalone: bool = True, log=None, progress=None) -> Path:
     """Build, complete and validate ``out_dir/<model>.fmu``; return its path.
 
     The FMU is built and validated in a temporary directory inside ``out_dir`` and moved into
     place only then, readable as the umask allows (0644 typically). ``log(message)`` receives
-    warnings (default: stderr).
+    warnings (default: stderr); ``progress`` (a :class:`~restitution.fmu.build.progress.Progress`),
+    a start and an end line (default: none).
     """
+    from .progress import quiet
+
     if log is None:
         def log(message):
-            print(message, file=sys.stderr)
+            print(message, file=sys.stderr, flush=True)
     FmuBuilder, validate_fmu = _require_build_tools()
     try:
         generation_date_and_time()  # a malformed SOURCE_DATE_EPOCH stops the build before anything is built
     except ValueError as exc:
         raise BuildError(str(exc)) from None
-    script = FMUS[model]
     out_dir = writable_dir(out_dir)
+    with (progress or quiet()).step(f"{model}.fmu", ", ".join(PYTHONFMU_FOLDERS), toolchain_label(standalone)):
+        return _build(model, out_dir, standalone, log, FmuBuilder, validate_fmu)
+
+
+def _build(model: str, out_dir: Path, standalone: bool, log, FmuBuilder, validate_fmu) -> Path:
+    """:func:`build_one`'s work, its checks done."""
+    script = FMUS[model]
     with tempfile.TemporaryDirectory(prefix=f".{model}-build-", dir=out_dir) as tmp:
         staged = Path(tmp) / "stage" / "restitution"
         shutil.copytree(PACKAGE, staged, ignore=bundle_filter)

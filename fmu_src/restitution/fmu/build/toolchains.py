@@ -30,10 +30,12 @@ stamp and a fixed image base; macOS: the install name is ``@rpath/<name>.dylib``
 zig keeps what it compiled for each target (its C runtime libraries the first time, ~1 min for Windows;
 then each object) in its cache: ``ZIG_GLOBAL_CACHE_DIR`` and ``ZIG_LOCAL_CACHE_DIR`` where set, else
 ``$XDG_CACHE_HOME/zig`` or ``~/.cache/zig``, else a folder in the temporary directory where that is not
-writable (:func:`zig_environment`).
+writable (:func:`zig_environment`). :func:`zig_cache_cold` tells, from what that cache holds, which targets'
+C runtimes zig has yet to build (what makes a first build slow), so a build can say so before it starts.
 """
 from __future__ import annotations
 
+import contextlib
 import importlib.util
 import os
 import shutil
@@ -174,6 +176,58 @@ def zig_environment(environ=None) -> dict:
     return env
 
 
+#: What zig's cache holds once zig has built a target's C runtime (its first use for that target, the slow
+#: part: about a minute and a half for Windows' on two cores): a file of that name in one of its o/<hash>/
+#: folders, whose first bytes name the target where several targets have one (ELF machine at byte 18, or a
+#: thin 64-bit Mach-O header of the architecture in a static archive).
+_ELF_MACHINE = {"x86_64": 62, "aarch64": 183}
+_MACHO_CPU = {"x86_64": 0x01000007, "aarch64": 0x0100000C}
+
+
+def _zig_runtime_marker(target: Platform) -> tuple[str, object]:
+    """(file name, test of its first 64 KiB) of what zig's cache holds once ``target``'s C runtime is built."""
+    arch, _, system = target.name.partition("-")
+    if system == "windows":
+        return "libmingw32.lib", None  # mingw-w64's C runtime, built for the one Windows target
+    if system == "linux":
+        machine = _ELF_MACHINE[arch].to_bytes(2, "little")
+        return "libc.so.6", lambda head: head[:4] == b"\x7fELF" and head[18:20] == machine
+    header = struct.pack("<Ii", MACHO_MAGIC_64, _MACHO_CPU[arch])
+    return "libcompiler_rt.a", lambda head: header in head
+
+
+def zig_cache_cold(targets, cache: Path | None = None) -> list[Platform] | None:
+    """Of ``targets``, those whose C runtime zig's cache (``cache``, default the one :func:`zig_environment`
+    gives zig) does not hold yet: zig builds it on its first use for that target. None where the cache
+    cannot be read (then nobody can tell)."""
+    targets = [platform(t) if isinstance(t, str) else t for t in targets]
+    cache = Path(cache if cache is not None else zig_environment()["ZIG_GLOBAL_CACHE_DIR"])
+    markers = {t.name: _zig_runtime_marker(t) for t in targets}
+    wanted = {name for name, _ in markers.values()}
+    found: dict[str, list[Path]] = {}
+    try:
+        if not (cache / "o").is_dir():
+            return targets
+        with os.scandir(cache / "o") as entries:
+            for entry in entries:
+                if entry.is_dir():
+                    for name in wanted:
+                        candidate = Path(entry.path) / name
+                        if candidate.is_file():
+                            found.setdefault(name, []).append(candidate)
+
+        def holds(name, test) -> bool:
+            for path in found.get(name, ()):
+                with contextlib.suppress(OSError), open(path, "rb") as f:
+                    if test is None or test(f.read(1 << 16)):
+                        return True
+            return False
+
+        return [t for t in targets if not holds(*markers[t.name])]
+    except OSError:
+        return None
+
+
 def zig_compiler(target: Platform) -> Compiler:
     """zig for ``target``; ToolchainMissing without the ziglang package."""
     zig = zig_command()
@@ -255,12 +309,23 @@ def universal_binary(slices, out: Path) -> Path:
     return Path(out)
 
 
+def compiler_label(target: Platform | str, cc: Compiler) -> str:
+    """What build lines call ``cc`` compiling for ``target``: "gcc", "x86_64-w64-mingw32-gcc", "zig cc
+    -target x86_64-windows-gnu"."""
+    target = platform(target) if isinstance(target, str) else target
+    return f"{cc.name} -target {target.zig_target}" if cc.name == "zig cc" else cc.name
+
+
 def build_binary(name: str, folder: str, fmi_version: str, sources: Path, c_files, binaries: Path, include_dirs=(),
-                 system_include_dirs=(), extra_flags=(), use: str | None = None) -> tuple[Path, list[str]]:
+                 system_include_dirs=(), extra_flags=(), use: str | None = None,
+                 step=None) -> tuple[Path, list[str]]:
     """``binaries/<folder>/<name><suffix>`` of an FMU of ``fmi_version``: each platform of that folder
     compiled (:func:`compiler`, :func:`compile_library`), several merged into one universal file. Returns
     (the library, the name of each platform's compiler, in the order of ``folders(fmi_version)[folder]``).
-    ToolchainMissing where a platform of the folder has no compiler here (nothing is written)."""
+    ToolchainMissing where a platform of the folder has no compiler here (nothing is written).
+    ``step(platform, compiler)``: a context manager around each platform's compilation (the build's
+    progress lines)."""
+    step = step or (lambda target, cc: contextlib.nullcontext())
     platforms = folders(fmi_version)[folder]
     try:
         compilers = [compiler(p, use) for p in platforms]  # every one found before anything is compiled
@@ -268,13 +333,17 @@ def build_binary(name: str, folder: str, fmi_version: str, sources: Path, c_file
         raise ToolchainMissing(f"no binaries/{folder}: {exc}") from None
     target = Path(binaries) / folder / f"{name}{platforms[0].suffix}"
     if len(platforms) == 1:
-        compile_library(platforms[0], compilers[0], sources, c_files, target, include_dirs, system_include_dirs,
-                        extra_flags)
+        with step(platforms[0], compilers[0]):
+            compile_library(platforms[0], compilers[0], sources, c_files, target, include_dirs, system_include_dirs,
+                            extra_flags)
     else:
         Path(binaries).mkdir(parents=True, exist_ok=True)
         with tempfile.TemporaryDirectory(prefix=".slices-", dir=Path(binaries)) as scratch:
-            slices = [compile_library(p, cc, sources, c_files, Path(scratch) / p.name / target.name, include_dirs,
-                                      system_include_dirs, extra_flags) for p, cc in zip(platforms, compilers)]
+            slices = []
+            for p, cc in zip(platforms, compilers):
+                with step(p, cc):
+                    slices.append(compile_library(p, cc, sources, c_files, Path(scratch) / p.name / target.name,
+                                                  include_dirs, system_include_dirs, extra_flags))
             target.parent.mkdir(parents=True, exist_ok=True)
             universal_binary(slices, target)
     return target, [cc.name for cc in compilers]
