@@ -7,8 +7,9 @@
     restitution materials        the material presets
     restitution fmu build ...    build the FMUs (restitution.fmu; the `fmu` extra)
 
-Each subcommand is the tool's own command line (``restitution sweep --help`` is ``restitution-sweep
---help``); the older console scripts stay.
+Each subcommand is the tool's own command line, and names itself ``restitution X`` in its usage line and
+its errors however it is started: ``restitution-sweep``, ``python -m restitution.sweep`` (and the same for
+scene, fmu) still run it, as aliases.
 """
 from __future__ import annotations
 

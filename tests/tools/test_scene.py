@@ -471,3 +471,17 @@ def test_a_scene_outside_the_validated_domain_says_so_once_per_condition(impact_
     names = [name for name, _flag, _message in CONDITIONS]
     first_words = [text.split(" = ")[0] for text in said]
     assert len(first_words) == len(set(first_words)) <= len(names)  # once per condition, over both drops
+
+
+def test_a_report_over_a_scene_file_is_refused_before_any_work(tmp_path, capsys):
+    """`restitution scene report a.toml --out a.toml` wrote the Markdown report over the scene it reads;
+    refused in one line, exit 2, the scene file left as it was (a hard link counts as the same file)."""
+    scene = tmp_path / "scene.toml"
+    scene.write_bytes(EXAMPLES[0].read_bytes())
+    link = tmp_path / "report.md"
+    link.hardlink_to(scene)
+    for out in (scene, link):
+        status = main(["report", str(scene), "--out", str(out), "--no-progress"])
+        err = capsys.readouterr().err
+        assert status == 2 and err.count("\n") == 1 and "is the input FILE 1" in err, err
+    assert scene.read_bytes() == EXAMPLES[0].read_bytes()

@@ -4,6 +4,7 @@ The expected numbers come from outside the statistics code: a Monte Carlo of res
 draws made here (another generator, another seed), numpy's mean, std and percentiles of the written
 table's rows, and counts of the drawn inputs in the table. Sampling tolerances are derived in the
 comments; every bound is 5 standard errors (a false failure about once in 1.7 million runs)."""
+import os
 import json
 import math
 
@@ -174,7 +175,7 @@ def test_a_directory_is_refused_as_summary_in_one_line(tmp_path, capsys):
     assert not (tmp_path / "s.csv").exists() and list(folder.iterdir()) == []
     status = sweep_cli([*POINT, "--samples", "10", "--scheduler", "serial", "--out", str(tmp_path / "s.csv"),
                         "--summary", str(tmp_path / "s.csv"), "--no-plot"])
-    assert status == 2 and "is the file of --out" in capsys.readouterr().err
+    assert status == 2 and "is the same file as --out" in capsys.readouterr().err
 
 
 def test_grid_points_and_the_plot_of_a_random_sweep(tmp_path, monkeypatch):
@@ -263,3 +264,24 @@ def test_the_interval_of_the_mean_covers_the_true_mean_over_many_datasets():
                        (np.array([d["mean"][0] for d in one_by_one]), np.array([d["ci_half"][0] for d in one_by_one]))):
         hits = int(np.count_nonzero(np.abs(mean - mu) <= half))
         assert abs(hits - 0.95 * n_sets) <= 3 * math.sqrt(n_sets * 0.95 * 0.05), hits
+
+
+def test_an_output_over_an_input_or_a_hard_link_of_another_output_is_refused(tmp_path, capsys):
+    """No sweep output over its inputs (the spec file, the FMU) nor over another output by another name: a
+    hard link of --out given as --summary wrote the summary over the table. Refused before any work, in
+    one line, exit 2, the inputs left as they were."""
+    spec = tmp_path / "spec.toml"
+    spec.write_text('samples = 10\n[run]\nscheduler = "serial"\n')
+    before = spec.read_bytes()
+    table = tmp_path / "s.csv"
+    status = sweep_cli([str(spec), *POINT, "--out", str(table), "--summary", str(spec), "--no-plot"])
+    err = capsys.readouterr().err
+    assert status == 2 and err.count("\n") == 1 and "is the input SPEC" in err, err
+    assert spec.read_bytes() == before and not table.exists()
+    table.write_text("kept\n")
+    os.link(table, tmp_path / "same.json")
+    status = sweep_cli([*POINT, "--samples", "10", "--scheduler", "serial", "--out", str(table),
+                        "--summary", str(tmp_path / "same.json"), "--no-plot"])
+    err = capsys.readouterr().err
+    assert status == 2 and "is the same file as --out" in err, err
+    assert table.read_text() == "kept\n"

@@ -34,7 +34,7 @@ def _refused(tmp_path, capsys, *args):
     assert len(lines) == 1, captured.err  # no usage, no traceback, no second line
     assert captured.out == ""  # refused before the sweep said what it covers
     assert not out.exists() and not out.with_name(out.name + ".parts").exists()
-    prefix = "python -m restitution.sweep: error: "
+    prefix = "restitution sweep: error: "
     assert lines[0].startswith(prefix), lines[0]
     return lines[0][len(prefix):]
 
@@ -149,7 +149,7 @@ def test_as_a_command_one_line_and_no_file(tmp_path):
                            "--out", str(tmp_path / "s.csv")], capture_output=True, text=True, env=env,
                           cwd=tmp_path, timeout=120)
     assert proc.returncode == 2 and proc.stdout == "", proc
-    assert proc.stderr == ("python -m restitution.sweep: error: --grid v_approach = -1 m/s is outside "
+    assert proc.stderr == ("restitution sweep: error: --grid v_approach = -1 m/s is outside "
                            "0 <= value <= 10000 m/s\n")
     assert list(tmp_path.iterdir()) == []
 

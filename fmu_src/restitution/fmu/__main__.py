@@ -1,4 +1,7 @@
-"""Command line: ``python -m restitution.fmu build [--out DIR] [--python-hosts-only]``."""
+"""Command line: ``restitution fmu build [--out DIR] [--python-hosts-only]``; also run as ``python -m restitution.fmu``
+and ``restitution-fmu``, which show the same name. It builds every FMU, the native ones for every platform,
+with a line per product and platform on stderr as it goes (zig's first use fills its cache: a few
+minutes), then a line per FMU built on stdout."""
 from __future__ import annotations
 
 import argparse
@@ -6,13 +9,18 @@ import sys
 from pathlib import Path
 
 from .build import FMUS, BuildError, build_all, default_fmu_dir
+from .build.progress import stderr_line
+
+#: The command's name in its usage line and its errors, however it was started.
+PROG = "restitution fmu"
 
 
 def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(prog="restitution-fmu",
+    parser = argparse.ArgumentParser(prog=PROG,
                                      description="Build and validate the project's FMUs.")
     commands = parser.add_subparsers(dest="command", required=True)
-    build = commands.add_parser("build", help=f"build {', '.join(f'{m}.fmu' for m in FMUS)}")
+    build = commands.add_parser("build", help=f"build {', '.join(f'{m}.fmu' for m in FMUS)} (pythonfmu) and their "
+                                              "native FMI 2.0 and 3.0 twins, for every platform")
     build.add_argument("--out", type=Path, default=None,
                        help=f"output directory (default: {default_fmu_dir()})")
     build.add_argument("--python-hosts-only", action="store_true",
@@ -20,10 +28,10 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     out = args.out if args.out is not None else default_fmu_dir()
     try:
-        for fmu in build_all(out, standalone=not args.python_hosts_only):
+        for fmu in build_all(out, standalone=not args.python_hosts_only, log=stderr_line):
             print(f"built {fmu} (fmpy validation: 0 problems)")
     except BuildError as exc:
-        print(f"restitution-fmu: error: {exc}", file=sys.stderr)
+        print(f"{PROG}: error: {exc}", file=sys.stderr)
         return 2
     return 0
 

@@ -1,8 +1,8 @@
 """Scenes: balls dropped on plates, described in TOML files and simulated through the FMU,
 computing only the effects the requested outputs need.
 
-    python -m restitution.scene run examples/scenes/steel_ball_thick_steel_table.toml
-    python -m restitution.scene report examples/scenes/*.toml --out docs/scenes.md
+    restitution scene run examples/scenes/steel_ball_thick_steel_table.toml
+    restitution scene report examples/scenes/*.toml --out docs/scenes.md
 
 Host side only (needs the ``fmu`` extra, matplotlib for plots, tqdm for progress bars);
 nothing in the physics modules or the FMU imports this subpackage. See docs/scenes.md.

@@ -1,4 +1,5 @@
-"""Command line: ``python -m restitution.scene {check,run,report} ...``.
+"""Command line: ``restitution scene {check,run,report} ...`` (also run as ``python -m restitution.scene`` and
+``restitution-scene``, which show the same name).
 
     check FILE...                      load and check scene files, print what they contain
     run FILE [--out DIR] [--all-on] [--zener-method M] [--fmu PATH] [--rebuild] [--no-plot]
@@ -17,7 +18,7 @@ from pathlib import Path
 from ..extras import MissingExtra, require
 from ..fmu.build import BuildError
 from ..output_files import (EXIT_IO_ERROR, EXIT_REFUSED, OutputPathError, check_output, check_output_dir,
-                            describe_os_error)
+                            check_outputs, describe_os_error)
 from .loader import SceneError, load_scene
 
 
@@ -31,6 +32,8 @@ def _check(args) -> int:
     return 0
 
 
+#: The command's name in its usage line and its errors, however it was started.
+PROG = "restitution scene"
 #: Exit status of an interrupted run (128 + SIGINT, as a shell reports Ctrl-C).
 EXIT_INTERRUPTED = 130
 #: `run` finished and wrote everything, but some drop stopped at its bounce limit still bouncing.
@@ -68,6 +71,8 @@ def _run(args) -> int:
     for path in (table, summary, plot):  # before any work: a regular file or nothing
         if path is not None:
             check_output(path)
+    check_outputs({"the drops' table": table, "the summary": summary, "the plot": plot},
+                  {"FILE": args.file, "--fmu": args.fmu})
     fmu = _fmu(args)
     # Each finished drop is on disk (fsynced) before the next starts; the CSV is kept with the drops
     # that finished, whatever stops the run, except on an I/O error (writing it or the summary): then
@@ -88,7 +93,7 @@ def _run(args) -> int:
         try:
             written.append(result.plot(plot))
         except OSError as exc:
-            print(f"error: {describe_os_error(exc)}; wrote {table} and {summary}", file=sys.stderr)
+            print(f"{PROG}: error: {describe_os_error(exc)}; wrote {table} and {summary}", file=sys.stderr)
             return EXIT_IO_ERROR
     print(result.summary())
     print("wrote " + ", ".join(str(p) for p in written))
@@ -112,6 +117,8 @@ def _report(args) -> int:
         load_scene(path)
     if args.out is not None:
         check_output(args.out)
+        check_outputs({"--out": args.out}, {**{f"FILE {i + 1}": path for i, path in enumerate(args.files)},
+                                            "--fmu": args.fmu})
     fmu = _fmu(args)
     reports, table = write_report(args.files, out=args.out, fmu=fmu, repeat=args.repeat, methods=methods,
                                   progress=False if args.no_progress else None,
@@ -137,7 +144,8 @@ def _repeat(text: str) -> int:
 
 
 def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m restitution.scene", description=__doc__.split("\n\n")[0])
+    parser = argparse.ArgumentParser(prog=PROG, description=(
+        "Drop scenes: balls dropped on plates, described in TOML files and simulated through the FMU."))
     sub = parser.add_subparsers(dest="command", required=True)
 
     p = sub.add_parser("check", help="load and check scene files")
@@ -168,10 +176,10 @@ def main(argv=None) -> int:
     try:
         status = args.func(args)
     except (SceneError, BuildError, UsageError, OutputPathError, MissingExtra) as exc:
-        print(f"error: {exc}", file=sys.stderr)
+        print(f"{PROG}: error: {exc}", file=sys.stderr)
         return EXIT_REFUSED
     except OSError as exc:  # an I/O error (ENOSPC, EIO, EACCES, ...): nothing half written under an output's name
-        print(f"error: {describe_os_error(exc)}", file=sys.stderr)
+        print(f"{PROG}: error: {describe_os_error(exc)}", file=sys.stderr)
         return EXIT_IO_ERROR
     except KeyboardInterrupt:  # outside the drops (FMU build or load, report): nothing finished to keep
         print("\ninterrupted", file=sys.stderr)

@@ -13,7 +13,7 @@ import numpy as np
 from ..cosim.bouncing import Trajectory
 from ..fmu.models.sphere_plate_impact.variables import TABLE
 from ..output_files import GrowingOutput, atomic_write
-from .explain import explain
+from .explain import explain, meaning_lines
 from .loader import MAX_BOUNCES, Drop, Scene
 
 __all__ = ["DropResult", "SceneResult", "DropWriter", "COLUMNS", "READ_OUTPUTS", "VALIDITY", "apex_heights"]
@@ -71,6 +71,12 @@ class DropResult(Trajectory):
         return 0 if valid is None else int(np.count_nonzero(~valid))
 
     @property
+    def e_negative(self) -> int:
+        """Impacts with e < 0 (the FMU's ``e_negative``: a rebound speed below 0, the sphere moving on with
+        the plate; the drop ends at the first)."""
+        return int(np.count_nonzero(self.v_rebound < 0.0))
+
+    @property
     def apex(self) -> np.ndarray:
         """Height the ball reaches after each impact [m] (0 where it does not leave the plate)."""
         return apex_heights(self.v_rebound, self.gravity)
@@ -124,6 +130,11 @@ class SceneResult:
         """Impacts outside the models' validated ranges (``valid`` false), over every drop."""
         return sum(d.out_of_range for d in self.drops)
 
+    @property
+    def e_negative(self) -> int:
+        """Impacts with e < 0 (``e_negative``), over every drop."""
+        return sum(d.e_negative for d in self.drops)
+
     def not_at_rest(self) -> list:
         """The drops that stopped at ``simulation.max_bounces`` with the ball still bouncing."""
         return [d for d in self.drops if not d.at_rest]
@@ -176,9 +187,10 @@ class SceneResult:
         """One row per drop; written under a temporary name, fsynced and renamed when whole
         (:func:`restitution.output_files.atomic_write`)."""
         rows = [["ball", "plate", "drop_height_m", "impacts", "rest_time_s", "stop_reason",
-                 "plasticity_impacts", "plate_wave_impacts", "out_of_range_impacts"]]
+                 "plasticity_impacts", "plate_wave_impacts", "out_of_range_impacts", "e_negative_impacts"]]
         rows += [[d.drop.ball.name, d.drop.plate.name, f"{d.drop.drop_height:.9g}", d.n_impacts, f"{d.rest_time:.9g}",
-                  d.stop_reason, int(d.plasticity.sum()), int(d.plate_waves.sum()), d.out_of_range] for d in self.drops]
+                  d.stop_reason, int(d.plasticity.sum()), int(d.plate_waves.sum()), d.out_of_range, d.e_negative]
+                 for d in self.drops]
         text = _csv_text(rows)
         return atomic_write(path, lambda tmp: Path(tmp).write_text(text, encoding="utf-8", newline=""), "summary CSV")
 
@@ -192,6 +204,11 @@ class SceneResult:
         for d in self.drops:
             lines.append(f"  {d.drop.label:<{width}}  {d.n_impacts:7d}  {int(d.plasticity.sum()):10d}  "
                          f"{int(d.plate_waves.sum()):11d}  {d.out_of_range:12d}  {d.stop_reason}")
+        said = meaning_lines(self.e_negative, self.out_of_range, self.n_impacts, zero_negative=False)
+        lines += [f"  out of range: {said[-1]}"]  # the column's meaning, beside it
+        if self.e_negative:
+            first = next(d for d in self.drops if d.e_negative)
+            lines.append(f"  {said[0]}; those drops end there (stop e<=0; first: {first.drop.label})")
         lines += [f"  {line}" for line in explain(self)]
         lines += self._bounce_table()
         return "\n".join(lines)

@@ -2,7 +2,7 @@
 parameter and the approach speed, evaluated by the vectorized package or by the FMU itself.
 From the command line::
 
-    python -m restitution.sweep --pair s2_tool_steel/al_6061 \\
+    restitution sweep --pair s2_tool_steel/al_6061 \\
         --grid v_approach=geomspace:0.1:10:60 --grid t_over_d=geomspace:0.1:10:50 --out map.csv
 
 See docs/sweeps.md. Needs ``dask[distributed]`` (the ``sweep`` extra); the FMU back end

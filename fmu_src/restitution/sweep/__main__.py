@@ -1,4 +1,5 @@
-"""Command line: ``python -m restitution.sweep [SPEC.toml|SPEC.json] [options]`` (see --help, docs/sweeps.md)."""
+"""Command line: ``restitution sweep [SPEC.toml|SPEC.json] [options]`` (see --help, docs/sweeps.md); also run as
+``python -m restitution.sweep`` and ``restitution-sweep``, which show the same name."""
 from __future__ import annotations
 
 import argparse
@@ -11,11 +12,13 @@ from pathlib import Path
 from ..extras import MissingExtra, require
 from ..materials_table import text as materials_text
 from ..output_files import (EXIT_IO_ERROR, EXIT_REFUSED, OutputPathError, OutputWriteError,
-                            check_output, describe_os_error)
+                            check_output, check_outputs, describe_os_error)
 from .sobol import SOBOL_OUTPUTS, SobolCollector, SobolError, SobolSpec
 from .spec import CODES, INPUT_NAMES, INPUTS, MAX_SAMPLES, MAX_SEED, T_OVER_D, SweepSpec, canonical_name, load_spec
 from .values import QuantityError
 
+#: The command's name in its usage line and its errors, however it was started.
+PROG = "restitution sweep"
 #: Exit status of an interrupted sweep (128 + SIGINT, as a shell reports Ctrl-C).
 EXIT_INTERRUPTED = 130
 #: Largest --chunk-size and --workers.
@@ -53,7 +56,7 @@ def _bytes_arg(text: str) -> int:
 
 def _error(text: str, status: int) -> int:
     """One line on stderr, no usage: the error is about a file, not about how the command is called."""
-    print(f"python -m restitution.sweep: error: {text}", file=sys.stderr, flush=True)
+    print(f"{PROG}: error: {text}", file=sys.stderr, flush=True)
     return status
 
 
@@ -76,24 +79,24 @@ def _kept(parts: Path) -> str:
 
 EXAMPLES = """examples:
   # e over speed and t/d for two material pairs, on a local Dask cluster (one worker per core)
-  python -m restitution.sweep --pair s2_tool_steel/al_6061 --pair chrome_steel/s7_tool_steel \\
+  restitution sweep --pair s2_tool_steel/al_6061 --pair chrome_steel/s7_tool_steel \\
       --grid v_approach=geomspace:0.1:10:60 --grid t_over_d=geomspace:0.1:10:50 --out map.csv
 
   # Monte Carlo: 10000 draws of scattered speed and moduli, checked through the FMU itself
-  python -m restitution.sweep --pair brass_260/al_6061 --random v_approach=uniform:0.5:3 \\
+  restitution sweep --pair brass_260/al_6061 --random v_approach=uniform:0.5:3 \\
       --random sphere.E=normal_rel:0.03 --random plate.E=normal_rel:0.03 --samples 10000 \\
       --backend fmu --out mc.csv
 
   # values with their units (a bare number is SI)
-  python -m restitution.sweep --set sphere.d="1/4 in" --set plate.E=114GPa --grid plate.t=linspace:1mm:5mm:9 \\
+  restitution sweep --set sphere.d="1/4 in" --set plate.E=114GPa --grid plate.t=linspace:1mm:5mm:9 \\
       --grid v_approach=geomspace:10cm/s:10m/s:40 --out t.csv
 
   # Sobol' indices of e, e_ep, e_ze and t_contact: 1024 base samples, 1024 x (2 + 2) cases
-  python -m restitution.sweep --random plate.t=uniform_rel:0.15 --random v_approach=uniform:0.5:3 \\
+  restitution sweep --random plate.t=uniform_rel:0.15 --random v_approach=uniform:0.5:3 \\
       --samples 1024 --sobol --summary sobol.json --out sobol.csv
 
   # the same sweep on an existing cluster
-  python -m restitution.sweep spec.toml --scheduler tcp://scheduler-host:8786
+  restitution sweep spec.toml --scheduler tcp://scheduler-host:8786
 """
 
 
@@ -170,9 +173,10 @@ def _value_error(exc: QuantityError, given: set, spec_file) -> str:
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(
-        prog="python -m restitution.sweep", formatter_class=argparse.RawDescriptionHelpFormatter,
+        prog=PROG, formatter_class=argparse.RawDescriptionHelpFormatter,
         description="Sweep the apparent COR (Green 2022) over material pairs, FMU parameters and the "
-                    "approach speed, on Dask; write a table and a COR map.", epilog=EXAMPLES)
+                    "approach speed, on Dask; write a table (CSV headers with units) and a plot: a grid's "
+                    "COR map, or the histogram of e of random draws.", epilog=EXAMPLES)
     parser.add_argument("spec", nargs="?", help="TOML or JSON spec file (pairs, [grid], [random], [fixed], "
                                                 "samples, seed, [run]); options below add to or override it")
     parser.add_argument("--pair", action="append", metavar="SPHERE/PLATE",
@@ -212,9 +216,10 @@ def main(argv=None) -> int:
     parser.add_argument("--columns", help="keep only these comma-separated columns (plus case and pair), "
                                           "e.g. v_approach,t_over_d,e,valid for a big sweep")
     parser.add_argument("--out", help="table: .csv or .parquet (default: sweep.parquet with pyarrow, else sweep.csv)")
-    parser.add_argument("--plot", help="COR map image (default: <out>_cor_map.png); with --sobol the indices' chart "
-                                       "is <out>_sobol.png")
-    parser.add_argument("--no-plot", action="store_true", help="skip the COR map (and the Sobol' chart)")
+    parser.add_argument("--plot", help="the plot's image: a grid's COR map (default: <out>_cor_map.png), the histogram "
+                                       "of e of random draws around one point (default: <out>_hist.png); with "
+                                       "--sobol the indices' chart is <out>_sobol.png")
+    parser.add_argument("--no-plot", action="store_true", help="skip the plot (and the Sobol' chart)")
     parser.add_argument("--summary", metavar="FILE", help="JSON: mean, std, percentiles and the mean's 95 %% "
                                                           "interval of every output, the out-of-range cases, the draws "
                                                           "(printed for the main outputs whenever there are --random inputs), "
@@ -307,8 +312,11 @@ def _main(parser, args) -> int:
     if out.name in ("", ".."):  # ".", "/", "..": no file name to write (nor to derive the map's from)
         return _error(f"--out {out}: is a directory, not a regular file; give the name of a file to write "
                       f"(.csv or .parquet)", EXIT_REFUSED)
+    from .plot import plot_kind
+
+    plot_suffix, plot_name = plot_kind(spec)  # a histogram of e, or a COR map
     plot = None if (args.no_plot or run.get("plot") is False) else Path(
-        args.plot or run.get("plot") or out.with_name(out.stem + "_cor_map.png"))
+        args.plot or run.get("plot") or out.with_name(out.stem + plot_suffix))
     sobol_chart = out.with_name(out.stem + "_sobol.png") if args.sobol and plot is not None else None
     parts = out.with_name(out.name + ".parts")
     summary = args.summary or run.get("summary")
@@ -333,19 +341,13 @@ def _main(parser, args) -> int:
                 raise OutputPathError(f"--out {out}: {where} (where finished chunks go) exists and is not a directory")
         if plot is not None and not plan.stream:
             check_output(plot, "--plot")
-            if os.path.realpath(plot) == os.path.realpath(out):
-                raise OutputPathError(f"--plot {plot}: is the table's file (--out {out}); give another name")
         if sobol_chart is not None:
             check_output(sobol_chart, "the Sobol' chart")
-            if os.path.realpath(sobol_chart) == os.path.realpath(plot):
-                raise OutputPathError(f"--plot {plot}: is the Sobol' chart's file; give another name")
         if summary is not None:
             check_output(summary, "--summary")
-            taken = {os.path.realpath(p): o for p, o in ((out, "--out"), (plot, "--plot"),
-                                                          (sobol_chart, "the Sobol' chart")) if p is not None}
-            if os.path.realpath(summary) in taken:
-                raise OutputPathError(f"--summary {summary}: is the file of {taken[os.path.realpath(summary)]}; "
-                                      f"give another name")
+        # no output over an input (the FMU, the spec file) or over another output, links and hard links included
+        check_outputs({"--out": out, "--plot": plot if not plan.stream else None, "the Sobol' chart": sobol_chart,
+                       "--summary": summary}, {"--fmu": fmu, "SPEC": args.spec})
     except OutputPathError as exc:
         return _error(str(exc), EXIT_REFUSED)
     try:
@@ -391,7 +393,7 @@ def _main(parser, args) -> int:
                     target = stack.enter_context(open_client(scheduler, workers))
                 except OSError as exc:  # an address nothing answers at (Dask waits its connect timeout)
                     parser.error(f"--scheduler {scheduler}: cannot connect: {exc}")
-            # the columns stay in memory only for what reads them here: the COR map, the comparison of
+            # the columns stay in memory only for what reads them here: the plot, the comparison of
             # two back ends; the table itself is joined from the parts, and the statistics come chunk by chunk
             in_memory = not plan.stream and (plot is not None or backend == "both")
             for name in backends:
@@ -475,20 +477,29 @@ def _main(parser, args) -> int:
         except (OutputWriteError, OutputPathError) as exc:
             return _error(f"{exc}; the table was written to {out}",
                           EXIT_REFUSED if isinstance(exc, OutputPathError) else EXIT_IO_ERROR)
-    if plot is not None and plan.stream:
-        print(f"no COR map: the table is too big for memory (streamed to {out}); plot a smaller sweep",
-              file=sys.stderr)
-    elif plot is not None:
-        try:
-            print(f"COR map: {result.plot(plot, statistics=statistics)}")
-        except ModuleNotFoundError as exc:
-            print(f"no COR map ({exc}; pip install matplotlib)", file=sys.stderr)
-        except (OutputWriteError, OutputPathError) as exc:
-            status = EXIT_REFUSED if isinstance(exc, OutputPathError) else EXIT_IO_ERROR
-            return _error(f"{exc}; the table was written to {out}", status)
-        except ValueError as exc:  # --columns left out what it draws (after OutputPathError, a ValueError too)
-            print(f"no COR map: {exc} (keep it with --columns)", file=sys.stderr)
-    return status
+    if plot is None:
+        return status
+    return _draw(result, plot, plot_name, out, statistics, streamed=plan.stream) or status
+
+
+def _draw(result, plot: Path, name: str, out: Path, statistics, streamed: bool) -> int:
+    """Draw the sweep's plot (``name``: a COR map, a histogram of e) into ``plot`` and say where; one line
+    saying why when there is none. The exit status of a file that cannot be written (0 otherwise)."""
+    from .plot import NoPlot
+
+    if streamed:
+        print(f"no {name}: the table is too big for memory (streamed to {out}); plot a smaller sweep", file=sys.stderr)
+        return 0
+    try:
+        print(f"{name}: {result.plot(plot, statistics=statistics)}")
+    except ModuleNotFoundError as exc:
+        print(f"no {name} ({exc}; pip install matplotlib)", file=sys.stderr)
+    except (OutputWriteError, OutputPathError) as exc:
+        return _error(f"{exc}; the table was written to {out}",
+                      EXIT_REFUSED if isinstance(exc, OutputPathError) else EXIT_IO_ERROR)
+    except NoPlot as exc:  # --columns left out what it draws: one line, why
+        print(f"no {name}: {exc}", file=sys.stderr)
+    return 0
 
 
 def _sobol_report(collector) -> tuple[dict, int]:
@@ -500,7 +511,7 @@ def _sobol_report(collector) -> tuple[dict, int]:
     section = collector.analyze()
     print(format_indices(section))
     for line in refusals(section):
-        print(f"python -m restitution.sweep: error: {line}", file=sys.stderr)
+        print(f"{PROG}: error: {line}", file=sys.stderr)
     warning = ranking_warning(section)
     if warning:
         print(warning, file=sys.stderr)

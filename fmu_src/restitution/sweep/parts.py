@@ -40,8 +40,8 @@ import numpy as np
 
 from ..output_files import OutputWriteError, atomic_write, file_kind, os_reason
 from .parquet_join import MAGIC
-from .table import (COLUMNS, VALIDITY, SweepResult, assemble, chunk_table, parquet_options, pair_codes,
-                    table_counts, write_csv_rows)
+from .table import (COLUMNS, VALIDITY, SweepResult, assemble, chunk_table, csv_header, parquet_options,
+                    pair_codes, table_counts, write_csv_rows)
 
 __all__ = ["PartStore", "DiskSweepResult", "ResumeError", "PartError", "write_from_parts"]
 
@@ -318,7 +318,7 @@ def write_from_parts(result, path: Path, suffix: str) -> None:
     store.spec, store.keep, store.sweep = result.spec, keep, result.info.get("sweep")
     names = [c for c in COLUMNS if keep is None or c in keep]
     with open(path, "w", encoding="utf-8", newline="") as f:
-        f.write(",".join(names) + "\n")
+        f.write(csv_header(names))
         for a, counts in sorted(result.chunk_counts.items()):
             write_csv_rows(f, assemble(result.spec, [store.read(a, a + counts["cases"])[0]], keep))
 

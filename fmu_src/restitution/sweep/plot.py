@@ -1,5 +1,7 @@
-"""COR map of a sweep: e against approach speed and t/d, one panel per material pair (matplotlib); for a
-sweep with random draws, the distribution of e (a histogram, or its median and 95 % band along a grid axis)."""
+"""The plot of a sweep (matplotlib). A grid sweep's COR map: e against approach speed and t/d, one panel per
+material pair; with ``--columns`` that leave one of them out, e against the inputs the table keeps that the
+sweep varies (a curve for one, a map for two). A sweep with random draws: the distribution of e (a histogram
+of e around one point, or its median and 95 % band along a grid axis)."""
 from __future__ import annotations
 
 import math
@@ -11,10 +13,23 @@ from ..output_files import atomic_write
 from .spec import T_OVER_D, pair_label
 from .values import unit_of
 
-__all__ = ["plot_cor_map", "plot_random"]
+__all__ = ["plot_cor_map", "plot_random", "NoPlot", "plot_kind", "map_axes"]
 
 LAMBDA_MAX = 1.5  #: Zener's studied range, lambda <= 1.5
 VSTAR_MAX = 1000.0  #: range of the JGM fits, V* <= 1000
+
+
+class NoPlot(ValueError):
+    """Why the table's kept columns allow no plot (one line, said instead of the plot)."""
+
+
+def plot_kind(spec) -> tuple[str, str]:
+    """(file name suffix, what it is called) of the plot a sweep draws: ``("_hist.png", "histogram of e")``
+    for random draws around one point (no grid axis besides the pairs), else ``("_cor_map.png", "COR map")``
+    (a grid's map or curves; with random draws, the median and band of e along the grid)."""
+    if spec is not None and spec.random and not spec.grid:
+        return "_hist.png", "histogram of e"
+    return "_cor_map.png", "COR map"
 
 
 def _log_axis(values) -> bool:
@@ -71,7 +86,9 @@ def fit_title(fig, title: str, fontsize: float = 10):
 
 
 def plot_cor_map(result, path, title: str | None = None, dpi: int = 120, statistics=None) -> Path:
-    """Draw e over (v_approach, t/d) for each material pair of a :class:`SweepResult` into ``path``.
+    """Draw e over (v_approach, t/d) for each material pair of a :class:`SweepResult` into ``path``
+    (over the inputs :func:`map_axes` finds when the table leaves one of the two out: a curve of e for one
+    input, a map for two; :class:`NoPlot`, saying why, when it keeps neither e nor an input the sweep varies).
 
     A grid sweep gives a colour map (each cell the mean e of its cases, with e contours and
     a dashed line where the validity range ends: lambda <= 1.5 and V* <= 1000), or curves when one
@@ -88,17 +105,17 @@ def plot_cor_map(result, path, title: str | None = None, dpi: int = 120, statist
             statistics = SweepStatistics(spec, keep=set(result.columns))
             statistics.add(result.columns)
         return plot_random(statistics, path, title=title, dpi=dpi)
+    cols = result.columns if hasattr(result, "columns") else result
+    if "e" not in cols:
+        raise NoPlot("--columns leaves out e, which the COR map draws")
+    xname, yname = (map_axes(cols, spec) + [None])[:2]
     import matplotlib
 
     matplotlib.use("Agg", force=False)
     import matplotlib.pyplot as plt
     from matplotlib.colors import Normalize
 
-    cols = result.columns if hasattr(result, "columns") else result
     pairs = list(dict.fromkeys(cols["pair"].tolist()))
-    missing = {"e", "v_approach", "t_over_d"} - set(cols)
-    if missing:
-        raise ValueError(f"the COR map needs the column(s) {sorted(missing)}")
     n_all = np.size(cols["e"])
     ok = np.asarray(cols["ok"], dtype=bool) if "ok" in cols else np.isfinite(cols["e"])
     valid_all = np.asarray(cols["valid"], dtype=bool) if "valid" in cols else np.ones(n_all, dtype=bool)
@@ -107,7 +124,7 @@ def plot_cor_map(result, path, title: str | None = None, dpi: int = 120, statist
     hi = max(1.0, float(np.nanmax(e_all))) if e_all.size else 1.0
     norm = Normalize(vmin=lo, vmax=hi)
     spec_fixed = _fixed_text(spec) if spec is not None else ""
-    axis = _shared_axis(cols, pairs, ok)
+    axis = _shared_axis(cols, pairs, ok, [a for a in (xname, yname) if a is not None])
     if axis is not None:  # several pairs over one input: one panel, a curve per pair
         return _pairs_on_one_panel(cols, ok, valid_all, axis, path, title, spec_fixed, dpi)
     n = max(1, len(pairs))
@@ -120,8 +137,8 @@ def plot_cor_map(result, path, title: str | None = None, dpi: int = 120, statist
     for k, pair in enumerate(pairs):
         ax = axes[k // ncols][k % ncols]
         sel = (cols["pair"] == pair) & ok
-        v = np.asarray(cols["v_approach"], dtype=float)[sel]
-        td = np.asarray(cols["t_over_d"], dtype=float)[sel]
+        v = np.asarray(cols[xname], dtype=float)[sel]  # v_approach, or the first input kept that varies
+        td = np.asarray(cols[yname], dtype=float)[sel] if yname else np.zeros(v.size)  # t_over_d, or the second
         e = np.asarray(cols["e"], dtype=float)[sel]
         valid = valid_all[sel]
         ax.set_title(pair_label(pair), fontsize=10)
@@ -138,9 +155,9 @@ def plot_cor_map(result, path, title: str | None = None, dpi: int = 120, statist
                 # a few values of one input over many of the other (COR against thickness at 1, 3 and
                 # 5 m/s): one curve per value, not a colour map of a few wide blocks
                 if uv.size < ut.size:
-                    _curves(ax, td, v, e, valid, "plate thickness / sphere diameter t/d", "v = {:g} m/s")
+                    _curves(ax, td, v, e, valid, _map_label(yname), _value_label(xname))
                 else:
-                    _curves(ax, v, td, e, valid, "approach speed v [m/s]", "t/d = {:g}")
+                    _curves(ax, v, td, e, valid, _map_label(xname), _value_label(yname))
                 continue
             if gridded:
                 flat = iv.ravel() * ut.size + it.ravel()
@@ -172,10 +189,10 @@ def plot_cor_map(result, path, title: str | None = None, dpi: int = 120, statist
                                alpha=0.6)
             ax.set_xscale("log" if logv else "linear")
             ax.set_yscale("log" if logt else "linear")
-            ax.set_xlabel("approach speed v [m/s]")
-            ax.set_ylabel("plate thickness / sphere diameter t/d")
+            ax.set_xlabel(_map_label(xname))
+            ax.set_ylabel(_map_label(yname))
         else:
-            x, name = (v, "approach speed v [m/s]") if uv.size > 1 else (td, "t/d")
+            x, name = (v, _map_label(xname)) if uv.size > 1 or not yname else (td, _map_label(yname, short=True))
             order = np.argsort(x, kind="stable")
             if np.unique(x).size == x.size:
                 ax.plot(x[order], e[order], "-", lw=1.2)
@@ -198,12 +215,71 @@ def plot_cor_map(result, path, title: str | None = None, dpi: int = 120, statist
             title += "; red dashes: edge of the validated range (lambda <= 1.5, V* <= 1000)"
         elif not valid_all.all():
             title += "; red marks: outside the validated range"
+        hidden = _hidden_axes(spec, cols, (xname, yname))
+        if hidden:
+            title += f"; {', '.join(hidden)} not kept by --columns: the points of its values are not told apart"
     fit_title(fig, title, fontsize=10)
     return save_figure(fig, path, dpi)
 
 
 #: The inputs a COR map draws along, with their axis labels.
 _MAP_AXES = {"v_approach": "approach speed v [m/s]", "t_over_d": "plate thickness / sphere diameter t/d"}
+#: Their labels of one curve's value.
+_VALUE_LABELS = {"v_approach": "v = {:g} m/s", "t_over_d": "t/d = {:g}"}
+
+
+def _map_label(name: str, short: bool = False) -> str:
+    """An axis label: the COR map's own for speed and t/d, else the input's name with its SI unit."""
+    if short and name == T_OVER_D:
+        return "t/d"
+    return _MAP_AXES.get(name) or _axis_label(name)
+
+
+def _value_label(name: str) -> str:
+    """A curve's label for one value of input ``name``, a format with one field."""
+    unit = unit_of(name)
+    return _VALUE_LABELS.get(name) or f"{name} = {{:g}}{' ' + unit if unit else ''}"
+
+
+def _varies(cols, name: str, pairs, ok) -> bool:
+    """Whether input ``name`` takes more than one value within some material pair."""
+    values = np.asarray(cols[name], dtype=float)
+    return any(np.unique(values[(cols["pair"] == pair) & ok]).size > 1 for pair in pairs)
+
+
+def _hidden_axes(spec, cols, drawn) -> list:
+    """The sweep's grid axes that the plot does not draw and the table does not keep (nor their twin,
+    plate.t for t_over_d and back): their values are drawn on top of each other."""
+    twins = {"plate.t": T_OVER_D, T_OVER_D: "plate.t"}
+    grid = [name for name in (spec.grid if spec is not None else ()) if name != "pair"]
+    seen = {*drawn, *cols} - {None}
+    return [name for name in grid if name not in seen and twins.get(name, name) not in seen]
+
+
+def map_axes(cols, spec=None) -> list:
+    """The inputs a grid sweep's plot draws e along: ``v_approach`` and ``t_over_d`` when the table keeps
+    both (the COR map); else those of the kept inputs that vary within a pair, up to two, the sweep's grid
+    axes first (a curve of e for one, a map for two). :class:`NoPlot` when the table keeps none."""
+    if "v_approach" in cols and T_OVER_D in cols:
+        return ["v_approach", T_OVER_D]
+    from .spec import INPUT_NAMES
+
+    n = np.size(cols["e"])
+    ok = np.asarray(cols["ok"], dtype=bool) if "ok" in cols else np.isfinite(np.asarray(cols["e"], dtype=float))
+    pairs = list(dict.fromkeys(np.asarray(cols["pair"]).tolist())) if "pair" in cols else [None]
+    cols = cols if "pair" in cols else {**cols, "pair": np.full(n, None, dtype=object)}
+    grid = [name for name in (spec.grid if spec is not None else ()) if name != "pair"]
+    twins = {"plate.t": T_OVER_D, T_OVER_D: "plate.t"}  # one derived from the other: the same axis
+    order = [*grid, *(twins[name] for name in grid if name in twins), "v_approach", T_OVER_D, *INPUT_NAMES]
+    axes = []
+    for name in dict.fromkeys(order):
+        if len(axes) < 2 and name in cols and twins.get(name) not in axes and _varies(cols, name, pairs, ok):
+            axes.append(name)
+    if not axes:
+        varied = ", ".join(grid) if grid else "v_approach, t_over_d"
+        raise NoPlot(f"--columns keeps none of the inputs the sweep varies ({varied}); keep one to draw e "
+                     f"against it")
+    return sorted(axes, key=lambda a: a != "v_approach")  # speed along x, as in the COR map
 
 
 def _grid_title(n_cases: int, fixed: str) -> str:
@@ -211,15 +287,16 @@ def _grid_title(n_cases: int, fixed: str) -> str:
     return f"Apparent COR e (Green 2022), {n_cases} cases" + (f"; {fixed}" if fixed else "")
 
 
-def _shared_axis(cols, pairs, ok) -> str | None:
-    """The one input (``v_approach`` or ``t_over_d``) that varies within every pair when there are
-    several pairs and the other input holds one value within each: their curves share one panel."""
+def _shared_axis(cols, pairs, ok, axes) -> str | None:
+    """The one input of ``axes`` (``v_approach`` or ``t_over_d``, or the kept inputs a plot draws along)
+    that varies within every pair when there are several pairs and the other input holds one value within
+    each: their curves share one panel."""
     if len(pairs) < 2:
         return None
     shared = set()
     for pair in pairs:
         sel = (cols["pair"] == pair) & ok
-        varying = {name for name in _MAP_AXES if np.unique(np.asarray(cols[name], dtype=float)[sel]).size > 1}
+        varying = {name for name in axes if np.unique(np.asarray(cols[name], dtype=float)[sel]).size > 1}
         if len(varying) != 1:
             return None
         shared |= varying
@@ -232,7 +309,7 @@ def _pairs_on_one_panel(cols, ok, valid_all, axis, path, title, fixed, dpi) -> P
     fig, ax = plt.subplots(figsize=(6.8, 4.4), constrained_layout=True)
     labels = np.array([pair_label(p) for p in np.asarray(cols["pair"])[ok]], dtype=object)
     _curves(ax, np.asarray(cols[axis], dtype=float)[ok], labels, np.asarray(cols["e"], dtype=float)[ok],
-            valid_all[ok], _MAP_AXES[axis], "{}")
+            valid_all[ok], _map_label(axis), "{}")
     if title is None:
         title = _grid_title(len(ok), fixed)
     fit_title(fig, title, fontsize=10)
@@ -292,7 +369,7 @@ def plot_random(statistics, path, title: str | None = None, dpi: int = 120) -> P
     import matplotlib.pyplot as plt
 
     if "e" not in statistics.names:
-        raise ValueError("the plot of a random sweep needs the column 'e'")
+        raise NoPlot("--columns leaves out e, which the plot of a random sweep draws")
     spec = statistics.spec
     stats, coords = statistics.by_point(["e"])
     e = stats["e"]
@@ -356,4 +433,4 @@ def plot_random(statistics, path, title: str | None = None, dpi: int = 120) -> P
             title += f" ({counts['cases'] - counts['ok']:,} with inputs out of range left out)"
         title += f": {_draws_text(spec)}"
     fit_title(fig, title, fontsize=10)
-    return save_figure(fig, path, dpi)
+    return save_figure(fig, path, dpi, plot_kind(spec)[1])

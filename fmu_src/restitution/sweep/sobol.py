@@ -1,4 +1,4 @@
-"""Sobol' sensitivity indices of a random sweep (``python -m restitution.sweep --sobol``).
+"""Sobol' sensitivity indices of a random sweep (``restitution sweep --sobol``).
 
 The ``--random`` inputs are sampled with Saltelli's scheme on a scrambled Sobol' sequence
 (:func:`SALib.sample.sobol.sample`, first and total order only: ``N (D + 2)`` cases for ``N`` base

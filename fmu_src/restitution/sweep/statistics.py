@@ -21,6 +21,7 @@ import numpy as np
 
 from ..fmu.models.sphere_plate_impact.variables import TABLE
 from ..output_files import write_json
+from ..scene.explain import E_NEGATIVE_MEANING, meaning_lines
 from .order_statistics import Scratch, moments_and_order_statistics, order_statistics
 from .student_t import t975
 from .spec import OUTPUTS, T_OVER_D, pair_label
@@ -185,7 +186,8 @@ class SweepStatistics:
         self.spec = spec
         self.names = [name for name in UNITS if keep is None or name in keep]
         #: first case of a chunk -> (its evaluated values per output, their grid points or None,
-        #: its table_counts, its first out-of-range case numbers)
+        #: its table_counts, its first out-of-range case numbers, its evaluated cases with e < 0 or None
+        #: where it keeps neither e nor e_negative)
         self._chunks = {}
         self._whole = None  # whole()'s result until the next chunk comes
 
@@ -203,7 +205,8 @@ class SweepStatistics:
         else:
             values, evaluated = {name: np.asarray(columns[name], dtype=float)[ok] for name in self.names}, case[ok]
         points = evaluated // self.spec.samples if self.spec.n_grid > 1 else None
-        self._chunks[int(case[0])] = (values, points, table_counts(columns), case[~ok][:LISTED_CASES].tolist())
+        self._chunks[int(case[0])] = (values, points, table_counts(columns), case[~ok][:LISTED_CASES].tolist(),
+                                      _negative(columns, ok))
         self._whole = None
 
     def __call__(self, start: int, stop: int, columns: dict) -> None:
@@ -235,6 +238,11 @@ class SweepStatistics:
             for key, value in chunk[2].items():
                 total[key] = total.get(key, 0) + value
         return total or {"cases": 0, "ok": 0, "inside": 0, **{flag: 0 for flag in VALIDITY}}
+
+    def e_negative(self) -> int | None:
+        """Evaluated cases with e < 0 (``e_negative``); None when the table keeps neither e nor e_negative."""
+        counts = [chunk[4] for chunk in self._chunks.values()]
+        return None if any(n is None for n in counts) else sum(counts)
 
     def out_of_range_cases(self) -> list:
         """The first :data:`LISTED_CASES` case numbers whose inputs left the model's domain."""
@@ -276,6 +284,8 @@ class SweepStatistics:
                                    "meaning": "inputs outside the model's domain (ok = False, outputs NaN); "
                                               f"the first {LISTED_CASES} case numbers are listed"},
                   "outside_validated_ranges": {flag: counts[flag] for flag in VALIDITY},
+                  **({"e_negative": {"n": self.e_negative(), "meaning": f"e < 0: {E_NEGATIVE_MEANING}"}}
+                     if self.e_negative() is not None else {}),
                   "method": {"over": "the evaluated cases (ok = True) with a finite value",
                              "std": "sample standard deviation (n - 1)",
                              "percentiles": "linear interpolation between order statistics (numpy's default, "
@@ -336,6 +346,7 @@ class SweepStatistics:
             cells = [row[0].ljust(widths[0]), row[1].ljust(widths[1])]
             cells += [cell.rjust(w) for cell, w in zip(row[2:-1], widths[2:-1])] + [row[-1]]
             lines.append("  " + "  ".join(cells).rstrip())
+        lines += meaning_lines(self.e_negative(), counts["valid"], counts["ok"], "evaluated cases")
         return "\n".join(lines)
 
     def point_label(self, coords: dict, k: int, skip=()) -> str:
@@ -350,6 +361,15 @@ class SweepStatistics:
                 unit = unit_of(axis)
                 bits.append(f"{axis} = {values[k]:g}{' ' + unit if unit else ''}")
         return ", ".join(bits)
+
+
+def _negative(columns: dict, ok: np.ndarray) -> int | None:
+    """A chunk's evaluated cases with e < 0: its ``e_negative`` flags, else its e; None with neither."""
+    if "e_negative" in columns:
+        return int(np.count_nonzero(ok & np.asarray(columns["e_negative"], dtype=bool)))
+    if "e" in columns:
+        return int(np.count_nonzero(ok & (np.asarray(columns["e"], dtype=float) < 0.0)))
+    return None
 
 
 def write_summary(path, statistics: dict, extra_sections: dict | None = None):

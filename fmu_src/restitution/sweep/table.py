@@ -1,23 +1,52 @@
 """A sweep's table: its columns, the result classes that hold it and write it (CSV or Parquet, under a
-temporary name renamed when whole), and reading a written table back."""
+temporary name renamed when whole), and reading a written table back.
+
+Units: a column that holds a quantity has the SI unit of its FMU variable (``[1]`` for a dimensionless
+one: ``e``, ``t_over_d``, ``sphere.nu``); ``case``, ``pair``, the integer codes and the flags have none
+(:func:`column_unit`). A CSV header names each column with its unit in brackets, ``v_approach [m/s]``,
+``e [1]``, ``valid`` (:func:`csv_header`); a Parquet table keeps the bare names, the unit in each
+field's metadata (``unit``). Floats are written in CSV as Python's ``repr``: the shortest text that reads
+back as the same double. :func:`read_table` reads both headers, with units and without (tables written
+before they had them), and gives the bare names."""
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
+from ..fmu.models.sphere_plate_impact.variables import TABLE
 from ..output_files import atomic_write as write_atomic
 from . import arrow_arrays
 from .spec import (INPUT_NAMES, INTEGER_INPUTS, OUTPUT_NAMES, OUTPUTS as _OUTPUT_TYPES, T_OVER_D, SweepSpec,
                    is_one_value_view)
 
 __all__ = ["COLUMNS", "VALIDITY", "SweepResult", "PackedColumns", "read_table", "table_counts", "assemble",
-           "keep_columns", "TableBuilder", "write_atomic", "write_csv_rows", "chunk_table", "pair_codes"]
+           "keep_columns", "TableBuilder", "write_atomic", "write_csv_rows", "chunk_table", "pair_codes",
+           "column_unit", "csv_header", "UNITS"]
 
 #: Column order of a result table.
 COLUMNS = ("case", "pair", *INPUT_NAMES, T_OVER_D, *OUTPUT_NAMES, "ok")
+
+#: Column -> SI unit of the quantity it holds ("1": dimensionless), for every Real column (the FMU
+#: variables' units, as the interface table gives them) and t_over_d.
+UNITS = {**{v.name: v.unit or "1" for v in (*TABLE.settable, *TABLE.outputs) if v.type == "Real"}, T_OVER_D: "1"}
+#: A CSV header cell: the column's name, then its unit in brackets.
+_HEADER = re.compile(r"(?P<name>.*?) \[(?P<unit>[^\]]*)\]")
+
+
+def column_unit(name: str) -> str | None:
+    """The SI unit of column ``name`` ("1": a dimensionless quantity); None for a column that holds no
+    quantity (``case``, ``pair``, the integer codes, the flags, ``ok``)."""
+    return UNITS.get(name)
+
+
+def csv_header(names) -> str:
+    """The header line of a CSV table of the columns ``names``: each with its unit in brackets
+    (``v_approach [m/s]``, ``e [1]``), bare where it holds no quantity (``case``, ``valid``)."""
+    return ",".join(f"{name} [{column_unit(name)}]" if column_unit(name) else name for name in names) + "\n"
 
 
 #: Validity columns every table keeps, whatever ``columns`` asks for (with ``case``, ``pair`` and ``ok``).
@@ -295,7 +324,7 @@ class SweepResult:
     def to_csv(self, path) -> Path:
         path = Path(path)
         with open(path, "w", encoding="utf-8", newline="") as f:
-            f.write(",".join(self.columns) + "\n")
+            f.write(csv_header(self.columns))
             write_csv_rows(f, self.columns)
         return path
 
@@ -319,7 +348,8 @@ class SweepResult:
         return frame
 
     def plot(self, path, **kwargs) -> Path:
-        """The COR map (see :func:`restitution.sweep.plot.plot_cor_map`)."""
+        """The plot: a grid's COR map, the histogram of e of random draws around one point (see
+        :func:`restitution.sweep.plot.plot_cor_map`)."""
         from .plot import plot_cor_map
 
         return plot_cor_map(self, path, **kwargs)
@@ -342,9 +372,12 @@ def arrow_table(columns: dict):
 
 
 def _schema(names, arrays):
+    """The table's schema: its bare column names, each quantity's unit in its field's metadata."""
     import pyarrow as pa
 
-    return pa.schema([pa.field(name, a.type, nullable=False) for name, a in zip(names, arrays)])
+    return pa.schema([pa.field(name, a.type, nullable=False,
+                               metadata={"unit": column_unit(name)} if column_unit(name) else None)
+                      for name, a in zip(names, arrays)])
 
 
 def _pair_labels(spec: SweepSpec):
@@ -447,7 +480,9 @@ def write_csv_rows(f, columns: dict) -> None:
 
 
 def read_table(path) -> dict:
-    """Columns of a table written by :meth:`SweepResult.write` (CSV or Parquet)."""
+    """Columns of a table written by :meth:`SweepResult.write` (CSV or Parquet), by their bare names: a CSV
+    header's units (``v_approach [m/s]``) are taken off, and a header without them (a table written before
+    they were added) reads the same. :func:`column_unit` gives each column's unit."""
     path = Path(path)
     if path.suffix.lower() == ".parquet":
         import pyarrow.parquet as pq
@@ -467,7 +502,7 @@ def read_table(path) -> dict:
 
     with open(path, encoding="utf-8", newline="") as f:
         rows = list(csv.reader(f))
-    header, body = rows[0], rows[1:]
+    header, body = [_bare(cell) for cell in rows[0]], rows[1:]
     out = {}
     for j, name in enumerate(header):
         values = [r[j] for r in body]
@@ -480,3 +515,9 @@ def read_table(path) -> dict:
         else:
             out[name] = np.array(values, dtype=float)
     return out
+
+
+def _bare(cell: str) -> str:
+    """A CSV header cell's column name: ``v_approach [m/s]`` is ``v_approach``, ``valid`` itself."""
+    match = _HEADER.fullmatch(cell.strip())
+    return match["name"] if match else cell.strip()

@@ -7,6 +7,13 @@ scene's parser (:mod:`restitution.scene.units`: pint, any unit of the right kind
 kind is refused naming the input, the unit given and the kind expected. Dimensionless inputs
 (``sphere.nu``, tolerances, ``t_over_d``) and relative spreads take plain numbers.
 
+Values are the decimals they were given as, where a computation would leave them an ulp away
+(:func:`decimal_like`): a unit's conversion (``4.5mm`` is 0.0045, not 0.0045000000000000005), and the
+points of a ``linspace`` or ``arange`` whose ends and step are short decimals (``linspace:0.1:0.5:5``
+gives 0.3, not numpy's 0.30000000000000004: each point is the double nearest its exact decimal
+value); a ``geomspace`` or ``logspace`` point within two ulps of a decimal of 12 significant digits is
+that decimal's double (``geomspace:2:32:5`` gives 8, not 7.999999999999999).
+
 An explicit value outside the input's declared range (the interface table's interval, the FMUs'
 ``min``/``max``, :data:`restitution.domain.DOMAIN`) is refused by :func:`outside`, with a hint where a
 slipped SI prefix explains it (``plate.E = 114 Pa ... did you mean 114 GPa?``).
@@ -14,6 +21,7 @@ slipped SI prefix explains it (``plate.E = 114 Pa ... did you mean 114 GPa?``).
 from __future__ import annotations
 
 import math
+from decimal import Decimal
 
 import numpy as np
 
@@ -23,7 +31,7 @@ from ..scene.units import EXAMPLES, QUANTITIES, UnitError, convert_quantity, spl
 
 __all__ = ["QuantityError", "quantity", "quantities", "unit_of", "outside", "parse_values", "parse_distribution",
            "axis_size", "axis_form", "range_size", "range_values", "range_ends", "draw_standard", "from_standard", "MAX_AXIS_VALUES",
-           "DISTRIBUTIONS"]
+           "DISTRIBUTIONS", "decimal_like"]
 
 #: FMU name -> row of the interface table, for every input and parameter.
 ROWS = {v.name: v for v in TABLE.settable}
@@ -65,8 +73,8 @@ def _read(name: str, value) -> tuple[float, bool]:
         return number, False
     if si is None:
         raise QuantityError(f"{name} = {value!r}: {name} is dimensionless: give a plain number, no unit", name)
-    try:
-        return convert_quantity(name, value.strip(), number, unit, KINDS[si]), True
+    try:  # the unit's factor may leave the product an ulp off the decimal it is (4.5 x 0.001)
+        return float(decimal_like(convert_quantity(name, value.strip(), number, unit, KINDS[si]))), True
     except UnitError as exc:
         raise QuantityError(f"{name} = {exc}", name) from None
 
@@ -225,27 +233,115 @@ def range_size(name: str, kind: str, args: list) -> int:
     return int(args[2])
 
 
+#: A computed value within SNAP_ULPS ulps of a decimal of SNAP_DIGITS significant digits is that decimal's
+#: double (an ulp taken as 2**-52 of the value: at the foot of a binade, up to twice as many).
+SNAP_DIGITS = 12
+SNAP_ULPS = 2
+_SNAP_REL = SNAP_ULPS * 2.0**-52
+#: 10**k for k = 0 ... 22, each exact as a double.
+_POW10 = np.array([float(10**k) for k in range(23)])
+#: For k = -22 ... 22 (index k + 22), a decimal with k places is digits * _MUL / _DIV, one exact factor 1.
+_MUL = np.concatenate([_POW10[:0:-1], np.ones(23)])
+_DIV = np.concatenate([np.ones(22), _POW10])
+#: Values handled at a time (bounds the temporaries of an axis of 10^8 values, and keeps them in cache).
+_BLOCK = 1 << 16
+
+
+def decimal_like(values) -> np.ndarray:
+    """``values`` with each one that lies within :data:`SNAP_ULPS` ulps of a decimal of
+    :data:`SNAP_DIGITS` significant digits replaced by the double nearest that decimal (the others,
+    zeros and non-finite values as they are): the rounding of a computation, an ulp or two, taken off a
+    value that is a short decimal (7.999999999999999 is 8, 0.0045000000000000005 is 0.0045)."""
+    x = np.array(values, dtype=float, ndmin=1)
+    for lo in range(0, x.size, _BLOCK):
+        block = x[lo:lo + _BLOCK]
+        with np.errstate(all="ignore"):
+            size = np.abs(block)
+            places = (SNAP_DIGITS - 1 + 22) - np.floor(np.log10(size))  # of a SNAP_DIGITS-digit decimal, + 22
+            fine = (places >= 0) & (places <= 44)  # False where NaN: zeros, non-finite values
+            k = np.where(fine, places, 22).astype(np.intp)
+            mul, div = _MUL[k], _DIV[k]
+            digits = np.rint(block * div / mul)  # an integer below 10^13: exact
+            near = digits * mul / div  # one correctly rounded operation (the other is by 1)
+            fine &= np.abs(near - block) <= _SNAP_REL * size
+        np.copyto(block, near, where=fine)
+    return x if np.ndim(values) else x[:1].reshape(())
+
+
+def _scaled(*numbers: float):
+    """(the numbers as integers, k): each number's shortest decimal (its repr) times 10**k, k its most
+    decimal places; None beyond k = 22 (10**k no longer exact as a double)."""
+    decimals = [Decimal(repr(float(x))) for x in numbers]
+    k = max(0, *(-d.as_tuple().exponent for d in decimals))
+    return ([int(d.scaleb(k)) for d in decimals], k) if k <= 22 else None
+
+
+def _decimal_points(start: int, step: int, n: int, k: int) -> np.ndarray | None:
+    """(start + i step) / 10**k for i < n, each the double nearest that decimal (an exact integer over an
+    exact power of ten, one correctly rounded division); None where an integer passes 2**53."""
+    if max(abs(start), abs(start + (n - 1) * step)) >= 2**53:
+        return None
+    out = np.empty(n)
+    for lo in range(0, n, _BLOCK):
+        ints = np.arange(lo, min(n, lo + _BLOCK), dtype=np.int64)
+        out[lo:lo + ints.size] = (ints * step + start).astype(np.float64) / _POW10[k]
+    return out
+
+
+def _decimal_range(kind: str, args: list, n: int) -> np.ndarray | None:
+    """A linspace's or arange's points as the decimals they are (:func:`_decimal_points`) when its ends and
+    step are decimals (a linspace's step: (last - first) / (n - 1) with at most 22 places); else None."""
+    if kind == "linspace":
+        if n == 1:
+            return np.array([float(args[0])])
+        got = _scaled(args[0], args[1])
+        if got is None:
+            return None
+        (first, last), k = got
+        for more in range(23 - k):  # the fewest further places that make the step an integer
+            span = (last - first) * 10**more
+            if span % (n - 1) == 0:
+                return _decimal_points(first * 10**more, span // (n - 1), n, k + more)
+        return None
+    start, _stop, step = (0.0, args[0], 1.0) if len(args) == 1 else (*args, 1.0)[:3]
+    got = _scaled(start, step)
+    return None if got is None else _decimal_points(got[0][0], got[0][1], n, got[1])
+
+
 def range_values(name: str, kind: str, args: list) -> np.ndarray:
-    """The values of a range ``(kind, args)``, at most :data:`MAX_AXIS_VALUES`."""
+    """The values of a range ``(kind, args)``, at most :data:`MAX_AXIS_VALUES`: a linspace's and an
+    arange's points as the decimals they are where its ends and step are decimals, else numpy's points
+    (:func:`decimal_like`, a linspace's and a geomspace's ends exactly as given)."""
     size = range_size(name, kind, args)
     if size > MAX_AXIS_VALUES:
         raise ValueError(f"{name}: {kind} gives {size:,} values; at most {MAX_AXIS_VALUES:,} per axis")
+    if kind in ("linspace", "arange") and size:
+        values = _decimal_range(kind, args, size)
+        if values is not None:
+            return values
     if kind == "arange":
-        return np.arange(*args)
+        return decimal_like(np.arange(*args))
     fn = {"linspace": np.linspace, "geomspace": np.geomspace, "logspace": np.logspace}[kind]
-    return fn(args[0], args[1], int(args[2]))
+    values = decimal_like(fn(args[0], args[1], int(args[2])))
+    if kind != "logspace" and values.size:
+        values[0], values[-1] = args[0], args[1]  # numpy's, exactly
+    return values
 
 
 def range_ends(name: str, kind: str, args: list) -> list:
-    """The first and last values of a range, without building it."""
+    """The first and last values of a range, without building it (those :func:`range_values` gives)."""
     n = range_size(name, kind, args)
     if n == 0:
         return []
     if kind == "arange":
         start, _stop, step = (0.0, args[0], 1.0) if len(args) == 1 else (*args, 1.0)[:3]
-        first, last = start, start + (n - 1) * step
+        got = _scaled(start, step)
+        ends = None if got is None else _decimal_points(got[0][0] + (n - 1) * got[0][1], 0, 1, got[1])
+        first, last = start, float(ends[0] if ends is not None else decimal_like(start + (n - 1) * step))
+    elif kind == "logspace":
+        first, last = (float(decimal_like(10.0 ** a)) for a in args[:2])
     else:
-        first, last = (10.0 ** args[0], 10.0 ** args[1]) if kind == "logspace" else (args[0], args[1])
+        first, last = args[0], args[1]
     return [first] if n == 1 else [first, last]
 
 
