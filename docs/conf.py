@@ -38,10 +38,16 @@ root_doc = "index"
 exclude_patterns = ["_build", "mutation_survivors.txt"]
 # Option names such as --fmu stay as typed: no "--" turned into a dash, no curly quotes.
 smartquotes = False
-html_theme = "alabaster"
+# furo: the content column narrows with the window, and a code block wider than the column scrolls
+# sideways inside it (its pre is overflow: auto) instead of running past the column's edge, as it did
+# with alabaster's fixed 940 px body. tests/tools/test_docs_site.py measures that in a headless
+# chromium at 1280 px.
+html_theme = "furo"
 html_title = f"restitution {release}"
-html_theme_options = {"description": "Apparent coefficient of restitution of a sphere hitting a plate "
-                                     "(Green 2022): numpy package and FMI 2.0/3.0 FMUs"}
+html_short_title = "restitution"
+# _static/code_blocks.css: a long line's scrollbar is drawn always, not only while scrolling
+html_static_path = ["_static"]
+html_css_files = ["code_blocks.css"]
 
 # --- Markdown pages (myst-parser) --------------------------------------------------------------
 # The pages link to sections of each other as GitHub does ("calibration.md#from-python",

@@ -1,6 +1,7 @@
 """A model-exchange drop: BouncingBall.fmu integrated by the master, e(v) from SpherePlateImpact at each contact.
 
     python examples/model_exchange_bounce.py [--fmu-dir dist/fmi2] [--impact me|cs|package] [--show]
+    python examples/model_exchange_bounce.py --sphere chrome_steel --d "4.76 mm" --plate brass_260 --t "3 mm"
 
 The native BouncingBall FMU runs in model exchange (FMI 2.0 from ``DIR``/``DIR/fmi2``, FMI 3.0 from
 ``DIR/fmi3``): the master (:func:`restitution.cosim.bounce_model_exchange`) integrates its states h and v
@@ -11,7 +12,9 @@ ball (d = 6.35 mm) falls from 0.3 m onto an Al 6061 plate with t/d = 1 and bounc
 slower than ``v_min`` (1 cm/s). The same drop through the event-exact co-simulation master
 (:func:`restitution.cosim.bounce`, closed-form flights, e from the package) is the reference: the table
 lists both, and the picture (height against time, the master's accepted points marked) goes to
-examples/output/model_exchange_bounce.png.
+examples/output/model_exchange_bounce.png. ``--sphere``, ``--d``, ``--plate`` and ``--t`` choose another case,
+as ``restitution cor`` reads them: a preset's name (``restitution materials``), a length with any unit (a bare
+number is SI).
 """
 from __future__ import annotations
 
@@ -23,6 +26,7 @@ import numpy as np
 import restitution as r
 from restitution.cosim import (FmuInstance, ModelExchangeInstance, bounce, bounce_model_exchange, build_default_fmu,
                                fmu_rebound, impact_fmu_parameters, model_exchange_rebound, package_rebound)
+from restitution.options import OptionError, input_quantity, material
 from restitution.viz import finish
 
 HERE = Path(__file__).resolve().parent
@@ -30,6 +34,8 @@ OUTPUT = HERE / "output"
 #: --impact's choices and what they mean
 IMPACTS = {"me": "SpherePlateImpact.fmu (model exchange)", "cs": "SpherePlateImpact.fmu (co-simulation)",
            "package": "the package (restitution.impact)"}
+#: The default case: an S2 tool-steel ball, d = 6.35 mm, on an Al 6061 plate with t = d.
+SPHERE, D, PLATE = "s2_tool_steel", 6.35e-3, "al_6061"
 
 
 def native_dir(fmu_dir=None) -> Path:
@@ -48,12 +54,14 @@ def native_dir(fmu_dir=None) -> Path:
 
 
 def drop(fmu_dir=None, impact: str = "me", drop_height: float = 0.3, t_over_d: float = 1.0, v_min: float = 1e-2,
-         event_tol: float = 1e-12, sphere_key: str = "s2_tool_steel", d: float = 6.35e-3, plate_key: str = "al_6061"):
-    """(model-exchange Bounces, co-simulation reference Bounces, the folder of the FMUs used)."""
+         event_tol: float = 1e-12, sphere_key: str = SPHERE, d: float = D, plate_key: str = PLATE, t=None):
+    """(model-exchange Bounces, co-simulation reference Bounces, the folder of the FMUs used): the preset
+    ``sphere_key``, diameter ``d`` [m], on the preset ``plate_key``, thickness ``t`` [m] (None: ``t_over_d`` d)."""
     if impact not in IMPACTS:
         raise ValueError(f"impact = {impact!r} is not one of {', '.join(IMPACTS)}")
     folder = native_dir(fmu_dir)
-    sphere, plate = r.Sphere(r.MATERIALS[sphere_key], d), r.Plate(r.MATERIALS[plate_key], t_over_d * d)
+    sphere = r.Sphere(r.MATERIALS[sphere_key], d)
+    plate = r.Plate(r.MATERIALS[plate_key], t_over_d * d if t is None else t)
     package = package_rebound(**sphere.params(), **plate.params())
     ball, impact_fmu = folder / "BouncingBall.fmu", folder / "SpherePlateImpact.fmu"
     params = impact_fmu_parameters(sphere, plate)
@@ -97,10 +105,13 @@ def plot(me, ref, path: Path, dpi: int = 90, show: bool = False):
 
 
 def run(show_plot: bool = False, fmu_dir=None, impact: str = "me", drop_height: float = 0.3, v_min: float = 1e-2,
-        event_tol: float = 1e-12, out_dir=None, dpi: int = 90, verbose: bool = True) -> dict:
-    """One drop in model exchange and its co-simulation reference; the PNG; {"me", "ref", "markdown", "png",
+        event_tol: float = 1e-12, out_dir=None, dpi: int = 90, verbose: bool = True, sphere: str = SPHERE,
+        d: float = D, plate: str = PLATE, t=None) -> dict:
+    """One drop in model exchange and its co-simulation reference (the preset ``sphere``, diameter ``d`` [m],
+    on the preset ``plate``, thickness ``t`` [m], default ``d``); the PNG; {"me", "ref", "markdown", "png",
     "max_dt", "max_dv"} (the largest differences of the contact instants [s] and impact speeds [m/s])."""
-    me, ref, folder = drop(fmu_dir, impact, drop_height, v_min=v_min, event_tol=event_tol)
+    me, ref, folder = drop(fmu_dir, impact, drop_height, v_min=v_min, event_tol=event_tol, sphere_key=sphere, d=d,
+                           plate_key=plate, t=t)
     n = min(me.n_impacts, ref.n_impacts)
     max_dt = float(np.max(np.abs(me.time[:n] - ref.time[:n])))
     max_dv = float(np.max(np.abs(me.v_approach[:n] - ref.v_approach[:n])))
@@ -120,8 +131,9 @@ def run(show_plot: bool = False, fmu_dir=None, impact: str = "me", drop_height: 
     return {"me": me, "ref": ref, "markdown": md, "png": png, "max_dt": max_dt, "max_dv": max_dv}
 
 
-if __name__ == "__main__":
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+def main(argv=None) -> dict | None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
+                                     epilog="Lengths take a unit (\"6.35 mm\", \"1/4 in\"); a bare number is SI.")
     parser.add_argument("--fmu-dir", type=Path, default=None,
                         help="folder with the native BouncingBall.fmu and SpherePlateImpact.fmu: dist/fmi2 (the "
                              "default, built if missing) or dist/fmi3")
@@ -130,10 +142,24 @@ if __name__ == "__main__":
     parser.add_argument("--drop-height", type=float, default=0.3, help="[m]")
     parser.add_argument("--v-min", type=float, default=1e-2, help="rest below this rebound speed [m/s]")
     parser.add_argument("--event-tol", type=float, default=1e-12, help="contact location tolerance [s]")
+    parser.add_argument("--sphere", default=SPHERE, metavar="KEY",
+                        help=f"sphere material (restitution materials; default {SPHERE})")
+    parser.add_argument("--d", default=f"{D * 1e3:g} mm", metavar="LEN", help=f"sphere diameter (default {D * 1e3:g} mm)")
+    parser.add_argument("--plate", default=PLATE, metavar="KEY", help=f"plate material (default {PLATE})")
+    parser.add_argument("--t", default=None, metavar="LEN", help="plate thickness (default: the sphere's diameter)")
+    parser.add_argument("--out-dir", type=Path, default=None, help=f"folder of the PNG (default {OUTPUT})")
     parser.add_argument("--show", action="store_true", help="show the plot window")
-    args = parser.parse_args()
+    args = parser.parse_args(argv)
     try:
-        run(show_plot=args.show, fmu_dir=args.fmu_dir, impact=args.impact, drop_height=args.drop_height,
-            v_min=args.v_min, event_tol=args.event_tol)
-    except ValueError as exc:
+        material("sphere", args.sphere), material("plate", args.plate)
+        d = input_quantity("d", "sphere.d", args.d)
+        t = None if args.t is None else input_quantity("t", "plate.t", args.t)
+        return run(show_plot=args.show, fmu_dir=args.fmu_dir, impact=args.impact, drop_height=args.drop_height,
+                   v_min=args.v_min, event_tol=args.event_tol, out_dir=args.out_dir, sphere=args.sphere, d=d,
+                   plate=args.plate, t=t)
+    except (OptionError, ValueError) as exc:  # a refused option, no native FMU with model exchange
         parser.exit(2, f"model_exchange_bounce.py: error: {exc}\n")
+
+
+if __name__ == "__main__":
+    main()

@@ -8,6 +8,7 @@ writes its pages into the source folder; the checkout stays untouched), the way 
 """
 import dataclasses
 import html
+import json
 import os
 import re
 import shutil
@@ -154,3 +155,108 @@ def test_fmu_recipes_print_the_cor_of_the_package(site):
     for recipe in ("fmi2_fmu_in_fmpy", "fmi3_fmu_in_fmpy"):
         lines = [line for line in _text(site / "gallery" / f"{recipe}.html").splitlines() if "v = 2.3 m/s" in line]
         assert lines and expected in lines[0], f"{recipe}: {lines}"
+
+
+# --- the layout: code blocks stay inside the content column (a headless chromium at 1280 px) ------------
+CHROMIUM = Path("/usr/bin/chromium")
+WINDOW = (1280, 900)
+#: Run at the page's load: every code block's box, its scrolling and the content column's box, written into
+#: the DOM as JSON (chromium --dump-dom prints the DOM after the scripts ran).
+LAYOUT_PROBE = """
+window.addEventListener("load", function () {
+  var main = document.querySelector("article[role=main]") || document.querySelector("div.body") || document.body;
+  var col = main.getBoundingClientRect();
+  function scroller(el) {  // el or its nearest ancestor inside the column that scrolls sideways
+    for (var e = el; e && e !== main.parentElement; e = e.parentElement) {
+      var x = getComputedStyle(e).overflowX;
+      if (x === "auto" || x === "scroll") return e;
+    }
+    return null;
+  }
+  var blocks = Array.prototype.map.call(main.querySelectorAll("pre"), function (pre) {
+    var r = pre.getBoundingClientRect(), s = getComputedStyle(pre), sc = scroller(pre);
+    var q = sc ? sc.getBoundingClientRect() : null;
+    return {line: pre.textContent.split("\\n")[0].slice(0, 100), left: r.left, right: r.right, width: r.width,
+            scrollWidth: pre.scrollWidth, clientWidth: pre.clientWidth, whiteSpace: s.whiteSpace,
+            bar: pre.offsetHeight - pre.clientHeight - parseFloat(s.borderTopWidth) - parseFloat(s.borderBottomWidth),
+            scroller: sc ? sc.tagName.toLowerCase() : null, scrollerRight: q ? q.right : null,
+            scrollerScrollWidth: sc ? sc.scrollWidth : null, scrollerClientWidth: sc ? sc.clientWidth : null};
+  });
+  var out = document.createElement("script");
+  out.type = "application/json";
+  out.id = "layout-report";
+  out.textContent = JSON.stringify({innerWidth: window.innerWidth, pageScrollWidth: document.documentElement.scrollWidth,
+    column: {left: col.left, right: col.right}, blocks: blocks}).replace(/</g, "\\\\u003c");
+  document.body.appendChild(out);
+});
+"""
+
+
+def _long_code_pages(limit: int = 80) -> list[str]:
+    """The pages of docs/ with a code line longer than ``limit`` characters, getting started first."""
+    pages = []
+    for page in [DOCS / "getting_started.md", DOCS / "hosts.md"] + sorted(DOCS.glob("*.md")):
+        blocks = re.findall(r"(?ms)^```[^\n{]*\n(.*?)^```", page.read_text(encoding="utf-8"))
+        if page.stem not in pages and any(len(line) > limit for block in blocks for line in block.splitlines()):
+            pages.append(page.stem)
+    return pages
+
+
+def _chromium(args: list[str], cwd: Path) -> subprocess.CompletedProcess:
+    profile = cwd / "chromium-profile"
+    return subprocess.run([str(CHROMIUM), "--headless", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage",
+                           f"--user-data-dir={profile}",
+                           f"--window-size={WINDOW[0]},{WINDOW[1]}", "--run-all-compositor-stages-before-draw",
+                           "--virtual-time-budget=10000", *args], capture_output=True, text=True, timeout=120, cwd=cwd)
+
+
+def _layout(site: Path, page: str, work: Path) -> dict:
+    """What LAYOUT_PROBE measured on ``page`` (a copy beside it, so that its stylesheets load)."""
+    source = (site / f"{page}.html").read_text(encoding="utf-8")
+    probe = site / f"{page}.layout-probe.html"
+    probe.write_text(source.replace("</body>", f"<script>{LAYOUT_PROBE}</script></body>"), encoding="utf-8")
+    proc = _chromium(["--dump-dom", probe.as_uri()], work)
+    found = re.search(r'<script type="application/json" id="layout-report">(.*?)</script>', proc.stdout, re.S)
+    assert found, f"chromium measured nothing on {page} (exit {proc.returncode}):\n{proc.stderr[-2000:]}"
+    return json.loads(found.group(1))
+
+
+@pytest.mark.skipif(not CHROMIUM.is_file(), reason="no /usr/bin/chromium (Debian's chromium; "
+                                                   "build_scripts/system_packages.sh installs it)")
+def test_code_blocks_stay_inside_the_column(site, tmp_path):
+    """At 1280 px, on every page with a code line longer than 80 characters: no code block runs past the
+    content column's right edge, nor the window's; a block whose lines are wider than it scrolls sideways
+    inside the column, with a scrollbar drawn (it takes height: not an overlay that shows only while
+    scrolling), or wraps. A screenshot of the getting-started page is kept beside the test's files."""
+    pages = _long_code_pages()
+    assert "getting_started" in pages and len(pages) >= 3, pages
+    overflowing, problems = 0, []
+    for page in pages:
+        report = _layout(site, page, tmp_path)
+        assert report["innerWidth"] == WINDOW[0], report["innerWidth"]
+        right = report["column"]["right"]
+        if report["pageScrollWidth"] > WINDOW[0] + 1:
+            problems.append(f"{page}: the page is {report['pageScrollWidth']} px wide in a {WINDOW[0]} px window")
+        if right > WINDOW[0] + 1:
+            problems.append(f"{page}: the content column ends at {right} px, past the window")
+        assert report["blocks"], f"{page}: no code block measured"
+        for block in report["blocks"]:
+            if block["width"] == 0:  # not displayed (a collapsed section): nothing to see
+                continue
+            where = f"{page}: the code block {block['line']!r}"
+            wider = block["scrollWidth"] > block["clientWidth"] + 1
+            if block["right"] > right + 1 and (block["scrollerRight"] is None or block["scrollerRight"] > right + 1):
+                problems.append(f"{where} ends at {block['right']:.0f} px, past the column's {right:.0f} px")
+            if wider:
+                overflowing += 1
+                if block["scroller"] is None and "wrap" not in block["whiteSpace"]:
+                    problems.append(f"{where} is {block['scrollWidth']} px wide in {block['clientWidth']} px and "
+                                    "neither scrolls nor wraps: its end is cut off")
+                elif block["scroller"] == "pre" and block["bar"] <= 0:
+                    problems.append(f"{where} scrolls with no scrollbar drawn: its end looks cut off")
+    assert not problems, "\n".join(problems)
+    assert overflowing >= 3, "no page measured has a code line wider than its column: the test tests nothing"
+    shot = tmp_path / "getting_started.png"
+    proc = _chromium([f"--screenshot={shot}", (site / "getting_started.html").as_uri()], tmp_path)
+    assert shot.is_file() and shot.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n", proc.stderr[-2000:]
+    assert int.from_bytes(shot.read_bytes()[16:20], "big") == WINDOW[0]  # the PNG's width

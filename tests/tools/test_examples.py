@@ -89,6 +89,64 @@ def test_bouncing_ball_table_matches_the_package(bouncing):
     assert bouncing["png"].stat().st_size > 10_000
 
 
+CHROME_ON_BRASS = ["--sphere", "chrome_steel", "--d", "4.76 mm", "--plate", "brass_260"]
+
+
+def test_bouncing_ball_defaults_are_todays_case(bouncing, fmu_dir, tmp_path, capsys):
+    """Without --sphere/--d/--plate/--t the command line drops today's ball on today's plates."""
+    result = _load("bouncing_ball").main(["--fmu", str(fmu_dir / "SpherePlateImpact.fmu"), "--out-dir", str(tmp_path)])
+    out = capsys.readouterr().out
+    assert out.startswith("S2 tool-steel ball, d = 6.35 mm, dropped from 0.3 m on Al 6061 (first 5 bounces)\n")
+    assert result["markdown"] == bouncing["markdown"] and result["markdown"] in out
+
+
+def test_bouncing_ball_takes_the_users_case(fmu_dir, tmp_path, capsys):
+    """--sphere, --d, --plate and --t (with units, repeatable) choose the drop, and the printout shows it."""
+    result = _load("bouncing_ball").main(["--fmu", str(fmu_dir / "SpherePlateImpact.fmu"), *CHROME_ON_BRASS,
+                                          "--t", "3 mm", "--t", "0.006", "--out-dir", str(tmp_path)])
+    out = capsys.readouterr().out
+    assert out.startswith("Chrome steel (AISI 52100) ball, d = 4.76 mm, dropped from 0.3 m on Brass alloy 260 ")
+    assert list(result["cases"]) == ["t/d = 0.63", "t/d = 1.26", "half-space"]
+    sphere = r.Sphere(r.MATERIALS["chrome_steel"], 4.76e-3)
+    for label, t in (("t/d = 0.63", 3e-3), ("t/d = 1.26", 6e-3)):
+        first = result["cases"][label]
+        ref = r.impact_between(sphere, r.Plate(r.MATERIALS["brass_260"], t), v=first.v_approach[0])
+        assert first.e[0] == pytest.approx(ref.e, abs=1e-9)
+        (row,) = [line for line in out.splitlines() if line.startswith(f"| {label} | 1 |")]
+        assert f" {ref.e:.3f} | {ref.e_ep:.3f} | {ref.e_ze:.3f} |" in row
+    assert (tmp_path / "bouncing_ball.png").stat().st_size > 10_000
+
+
+def test_bouncing_ball_refuses_a_slip_in_one_line(fmu_dir, capsys):
+    with pytest.raises(SystemExit) as exit_:
+        _load("bouncing_ball").main(["--fmu", str(fmu_dir / "SpherePlateImpact.fmu"), "--t", "3 km"])
+    assert exit_.value.code == 2
+    assert capsys.readouterr().err == "bouncing_ball.py: error: --t: plate.t = 3000 m is outside 1e-07 <= value " \
+                                      "<= 100 m: did you mean 3000 mm?\n"
+
+
+def test_model_exchange_bounce_takes_the_users_case(fmu_dir, tmp_path, capsys):
+    """examples/model_exchange_bounce.py with another ball and plate: the e of every contact is the package's
+    for that case (and not the default case's), and the printed table shows it."""
+    native = fmu_dir if fmu_dir.name in ("fmi2", "fmi3") else fmu_dir / "fmi2"  # the example's choice
+    if not (native / "BouncingBall.fmu").is_file():
+        pytest.skip("no native FMUs with model exchange built here (needs gcc)")
+    result = _load("model_exchange_bounce").main(["--fmu-dir", str(fmu_dir), *CHROME_ON_BRASS, "--t", "2 mm",
+                                                  "--out-dir", str(tmp_path)])
+    out = capsys.readouterr().out
+    me = result["me"]
+    assert me.n_impacts > 3
+    sphere, plate = r.Sphere(r.MATERIALS["chrome_steel"], 4.76e-3), r.Plate(r.MATERIALS["brass_260"], 2e-3)
+    for k in range(3):
+        ref = r.impact_between(sphere, plate, v=me.v_approach[k])
+        assert me.e[k] == pytest.approx(ref.e, abs=1e-9)
+        (row,) = [line for line in out.splitlines() if line.startswith(f"| {k + 1} |")]
+        assert f" {ref.e:.6f} | {ref.e:.6f} |" in row  # model exchange and the co-simulation reference
+    default = r.impact_between(r.Sphere(r.MATERIALS["s2_tool_steel"], 6.35e-3), r.Plate(r.MATERIALS["al_6061"], 6.35e-3),
+                               v=me.v_approach[0])
+    assert abs(default.e - me.e[0]) > 0.05
+
+
 # --- 2. two FMUs under three masters ---------------------------------------------------------
 STEPS = (1e-2, 1e-3)
 
@@ -298,11 +356,12 @@ def test_readme_is_a_users_page():
 
 
 def test_the_demo_reuses_up_to_date_fmus_and_rebuilds_stale_ones(built_fmus, tmp_path, monkeypatch, capsys):
-    """The Quickstart demo runs the example without --fmu: FMUs built from the current sources are
-    used as they are (no build), a stale one (another recorded source hash) is rebuilt."""
+    """The Quickstart demo runs the example without --fmu: a full set of FMUs built from the current
+    sources is used as it is (no build), a stale SpherePlateImpact.fmu (another recorded source hash) is
+    rebuilt, and that one alone: the demo never builds the other FMUs nor another platform."""
     import shutil
 
-    from restitution.fmu.build import products as fmu_build
+    from restitution.fmu.build import plan, products as fmu_build
 
     script = (ROOT / "build_scripts" / "quickstart.sh").read_text()
     demo = script[script.index("demo)"):script.index(";;", script.index("demo)"))]
@@ -311,10 +370,10 @@ def test_the_demo_reuses_up_to_date_fmus_and_rebuilds_stale_ones(built_fmus, tmp
     shutil.copytree(built_fmus, dist)
     builds = []
     monkeypatch.setattr(fmu_build, "default_fmu_dir", lambda: dist)
-    monkeypatch.setattr(fmu_build, "build_all", lambda out, **kw: builds.append(out) or [])
+    monkeypatch.setattr(fmu_build, "run", lambda todo, out, **kw: builds.append((todo, out)) or [])
     bounces = _load("quickstart_bounce").run()
     assert builds == [] and bounces.n_impacts > 3
     assert f"FMU: {dist / 'SpherePlateImpact.fmu'}" in capsys.readouterr().out
-    monkeypatch.setattr(fmu_build, "source_hash", lambda model: "another")
+    monkeypatch.setattr(plan, "source_hash", lambda model: "another")
     _load("quickstart_bounce").run()
-    assert builds == [dist]
+    assert builds == [(plan.model_plan("SpherePlateImpact"), dist)]
