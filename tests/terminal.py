@@ -30,3 +30,13 @@ def with_terminal_stderr(cmd, env, cwd=None, timeout: float = 300):
     proc.wait(timeout=timeout)
     os.close(master)
     return proc.returncode, out, b"".join(chunks).decode("utf-8", "replace")
+
+
+def takes_ctrl_c() -> None:
+    """``preexec_fn`` of a child that a test interrupts as a terminal's Ctrl-C would: SIGINT back to its
+    default action. A shell starts a background job (``cmd &``, a CI step run that way) with SIGINT
+    ignored, and an ignored signal stays ignored across exec: the child would then never see the test's
+    SIGINT and run to its end."""
+    import signal
+
+    signal.signal(signal.SIGINT, signal.SIG_DFL)

@@ -17,7 +17,7 @@ import pytest
 from restitution.scene import SceneError, parse_scene, run_scene
 from restitution.scene.__main__ import main
 from restitution.scene.loader import MAX_BOUNCES
-from terminal import with_terminal_stderr
+from terminal import takes_ctrl_c, with_terminal_stderr
 
 PYTHON = sys.executable
 ENV = {**os.environ, "PYTHONUNBUFFERED": "1"}
@@ -196,7 +196,7 @@ def test_sigint_keeps_every_finished_drop(tmp_path, impact_fmu):
     out = tmp_path / "out"
     proc = subprocess.Popen([PYTHON, "-m", "restitution.scene", "run", str(scene), "--fmu", str(impact_fmu),
                              "--out", str(out), "--no-plot"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            text=True, env=ENV, start_new_session=True)
+                            text=True, env=ENV, start_new_session=True, preexec_fn=takes_ctrl_c)
     table = out / "slow.csv"
 
     def finished_drops():

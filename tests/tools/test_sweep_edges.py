@@ -16,6 +16,7 @@ from restitution.sweep.cluster import CASE_SECONDS, CLUSTER_SECONDS, serial_reas
 from restitution.sweep.run import SweepInterrupted
 
 from interrupting_backend import InterruptingBackend
+from terminal import takes_ctrl_c
 
 PYTHON = sys.executable
 ENV = {**os.environ, "PYTHONUNBUFFERED": "1"}
@@ -112,7 +113,7 @@ def _ctrl_c(tmp_path, sweep, when):
     out = tmp_path / "s.csv"
     proc = subprocess.Popen([PYTHON, "-m", "restitution.sweep", *sweep, "--scheduler", "local", "--workers", "2",
                              "--no-plot", "--out", str(out)], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            text=True, cwd=tmp_path, env=ENV, start_new_session=True)
+                            text=True, cwd=tmp_path, env=ENV, start_new_session=True, preexec_fn=takes_ctrl_c)
     parts = tmp_path / "s.csv.parts" / ("fmu" if "fmu" in sweep else "package")
     if when == "start":
         assert proc.stdout.readline().startswith("sweep:")

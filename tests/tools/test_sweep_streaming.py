@@ -23,7 +23,7 @@ from restitution.sweep.run import SweepInterrupted
 from restitution.sweep.size import check_memory, plan_size, table_bytes
 from restitution.sweep.spec import SizeError
 
-from terminal import with_terminal_stderr
+from terminal import takes_ctrl_c, with_terminal_stderr
 
 PYTHON = sys.executable
 ENV = {**os.environ, "PYTHONUNBUFFERED": "1"}
@@ -319,7 +319,8 @@ def _interrupt_after_chunks(args, parts: Path, n_chunks: int, cwd):
     """Run the CLI in a process group of its own and send SIGINT to the whole group once ``n_chunks``
     chunks are on disk: what Ctrl-C in a terminal does (the Dask workers get it too)."""
     proc = subprocess.Popen([PYTHON, "-m", "restitution.sweep", *args], stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True, cwd=cwd, env=ENV, start_new_session=True)
+                            stderr=subprocess.PIPE, text=True, cwd=cwd, env=ENV, start_new_session=True,
+                            preexec_fn=takes_ctrl_c)
     deadline = time.monotonic() + 120
     while time.monotonic() < deadline and proc.poll() is None:
         if len(list(parts.glob("chunk-*.parquet"))) >= n_chunks:
