@@ -1,7 +1,9 @@
-"""Materials, spheres and plates, with the material presets of I. Green, Nonlinear Dyn (2022).
+"""Materials, spheres and plates, with the material presets of I. Green, Nonlinear Dyn (2022) and common
+engineering materials from handbooks (appended after the paper's; their notes say where the model is not validated).
 
 Units: E [Pa], nu [1], Sy [Pa], rho [kg/m^3], d and t [m]; each also accepts a pint Quantity of any
-compatible unit (:mod:`restitution.quantities`), stored in SI.
+compatible unit (:mod:`restitution.quantities`) or a string with its unit, as the command lines read it
+(``Plate(m, t="2 mm")``, ``Material("Cu", "115 GPa", 0.31, "69 MPa", "8960 kg/m3")``), stored in SI.
 
 Brittle materials carry Sy = 1e12 Pa "to ward off yielding", as the paper does
 (Table 1 footnote). Tables 1 and 2 give no elastic moduli: E is taken from
@@ -32,10 +34,11 @@ class Material:
     Sy: float  #: yield strength [Pa] (BRITTLE_SY for brittle materials)
     rho: float  #: density [kg/m^3]
     source: str = ""  #: where each value comes from
+    note: str = ""  #: where the model is not validated for the material ("" for the paper's own)
 
     def __post_init__(self):
         for field, unit in (("E", "Pa"), ("nu", "dimensionless"), ("Sy", "Pa"), ("rho", "kg/m**3")):
-            object.__setattr__(self, field, to_si(f"{self.name}.{field}", getattr(self, field), unit))
+            object.__setattr__(self, field, _si(f"{self.name}.{field}", getattr(self, field), unit))
         for field, unit in (("E", "Pa"), ("Sy", "Pa"), ("rho", "kg/m3")):  # a sphere's and a plate's domain alike
             label = f"{self.name}.{field}"
             check_in_domain(label, f"sphere_{field}", check_positive(label, getattr(self, field), unit), unit)
@@ -62,7 +65,7 @@ class Sphere:
 
     def __post_init__(self):
         object.__setattr__(self, "material", _material(self.material, "sphere"))
-        object.__setattr__(self, "d", to_si("sphere.d", self.d, "m"))
+        object.__setattr__(self, "d", _si("sphere.d", self.d, "m"))
         check_in_domain("sphere.d", "sphere_d", check_positive("sphere.d", self.d, "m"), "m")
 
     def params(self) -> dict:
@@ -79,7 +82,7 @@ class Plate:
 
     def __post_init__(self):
         object.__setattr__(self, "material", _material(self.material, "plate"))
-        object.__setattr__(self, "t", to_si("plate.t", self.t, "m"))
+        object.__setattr__(self, "t", _si("plate.t", self.t, "m"))
         check_in_domain("plate.t", "plate_t", check_positive("plate.t", self.t, "m"), "m")
 
     def params(self) -> dict:
@@ -88,6 +91,16 @@ class Plate:
 
     def with_thickness(self, t: float) -> "Plate":
         return replace(self, t=t)
+
+
+def _si(name: str, value, unit: str):
+    """``value`` in SI: a pint Quantity converted, a string with its unit read as the command lines read
+    it (``"2 mm"``, ``"115 GPa"``; :func:`restitution.options.python_quantity`), a number as it is."""
+    if isinstance(value, str):
+        from .options import python_quantity  # host side only: the FMUs never pass text
+
+        return python_quantity(name, value, unit)
+    return to_si(name, value, unit)
 
 
 def _material(material, role: str) -> Material:
@@ -105,6 +118,13 @@ _T1 = "Green (2022) Table 1"
 _T2 = "Green (2022) Table 2"
 _T3 = "Green (2022) Table 3"
 _HB = "handbook value, not from the paper"
+_CAL = "Callister & Rethwisch, Materials Science and Engineering, App. B"
+_ASM = "ASM Aerospace Specification Metals data sheet (MatWeb)"
+#: What the presets from handbooks say about where Green's model is not validated for them.
+_POLYMER = ("polymer: viscoelastic and strain-rate dependent, so Sy and E at impact rates differ from the "
+            "quasi-static values; Green's elastic-perfectly plastic JGM model is not validated for polymers")
+_WORK_HARDENING = ("strongly work-hardening (tensile strength 2.3-3.2 times Sy): the elastic-perfectly plastic "
+                   "JGM model uses Sy alone")
 
 class MaterialTable(dict):
     """The presets by short name; an unknown name raises a KeyError that lists the known names
@@ -135,7 +155,8 @@ def suggest_material(name, materials) -> str:
     return " (did you mean " + " or ".join(repr(c) for c in close) + "?)"
 
 
-#: Every material of the paper's Tables 1-3, keyed by a short name.
+#: Every material of the paper's Tables 1-3, then common engineering materials from handbooks,
+#: keyed by a short name.
 MATERIALS: dict[str, Material] = MaterialTable({
     # Table 3 (Patil & Higgs 2018): complete property sets.
     "brass_260": Material("Brass alloy 260", 103e9, 0.35, 0.393e9, 8525, _T3),
@@ -158,6 +179,39 @@ MATERIALS: dict[str, Material] = MaterialTable({
                               f"{_T2}; E = 207 GPa is a {_HB} (AISI S7)"),
     "stainless_440c": Material("Stainless steel 440C", 200e9, 0.30, 0.448e9, 7750,
                                f"{_T2}; E = 200 GPa is a {_HB} (AISI 440C)"),
+    # Handbook presets, not from the paper: appended, so that the paper's keep their FMU codes 1-12.
+    "copper_c110_annealed": Material("Copper C11000 (ETP), annealed", 115e9, 0.31, 69e6, 8890,
+                                     f"{_CAL} (C11000: E 115 GPa, nu 0.31, 8.89 g/cm3); Sy 69 MPa: ASM Handbook "
+                                     f"Vol. 2, C11000 annealed (O60) flat products", _WORK_HARDENING),
+    "copper_c110_h02": Material("Copper C11000 (ETP), half hard H02", 115e9, 0.31, 250e6, 8890,
+                                f"E, nu, rho as copper_c110_annealed ({_CAL}); Sy 250 MPa: ASM Handbook Vol. 2 / "
+                                f"Copper Development Association, C11000 H02 flat products, typical"),
+    "ti_6al_4v": Material("Titanium Ti-6Al-4V (Grade 5), annealed", 113.8e9, 0.342, 880e6, 4430,
+                          f"{_ASM}, Ti-6Al-4V Grade 5 annealed, typical (not MMPDS design values); {_CAL}: "
+                          f"E 114 GPa, Sy 830 MPa (min.), 4.43 g/cm3"),
+    "stainless_304": Material("Stainless steel 304, annealed", 193e9, 0.29, 215e6, 8000,
+                              f"{_ASM}, AISI 304 annealed, typical; {_CAL}: E 193 GPa, 8.00 g/cm3, "
+                              f"Sy 205 MPa (min.)", _WORK_HARDENING),
+    "stainless_316": Material("Stainless steel 316, annealed", 193e9, 0.30, 205e6, 8000,
+                              f"{_CAL}: E 193 GPa, 8.00 g/cm3, Sy 205 MPa (hot finished and annealed, min.; "
+                              f"the ASTM A240 minimum); nu 0.30 typical (ASM Handbook Vol. 1); typical annealed "
+                              f"bar: Sy 240 MPa ({_ASM})", _WORK_HARDENING),
+    "gray_cast_iron_30": Material("Gray (grey) cast iron, ASTM A48 class 30", 100e9, 0.26, BRITTLE_SY, 7200,
+                                  f"ASM Handbook Vol. 1 / {_CAL} (class 30 = grade G3000): E 90-113 GPa in "
+                                  f"tension, 100 GPa taken (66-157 GPa over classes 20-60), nu 0.26, tensile "
+                                  f"strength 214 MPa typical and no yield point; rho 7.15-7.30 g/cm3 in handbook "
+                                  f"tables, 7200 taken; Sy N/A (brittle), set to 1e12 Pa as in Table 1",
+                                  "brittle: no yield point, so Sy = 1e12 Pa as the paper does for its brittle "
+                                  "materials and the model sees a purely elastic body; Green's model is not "
+                                  "validated for cast iron, which may crack or crush under the contact"),
+    "al_7075_t6": Material("Aluminum 7075-T6", 71.7e9, 0.33, 503e6, 2810,
+                           f"{_ASM}, 7075-T6, typical; {_CAL}: E 71 GPa, Sy 505 MPa, 2.80 g/cm3"),
+    "pmma": Material("PMMA (acrylic)", 2.7e9, 0.35, 70e6, 1190,
+                     f"E 2.7 GPa, nu 0.35: Dowling, Mechanical Behavior of Materials, Table 5.2; Sy 70 MPa within "
+                     f"{_CAL}'s yield strength 53.8-73.1 MPa (E 2.24-3.24 GPa); 1.19 g/cm3 ({_CAL})", _POLYMER),
+    "polycarbonate": Material("Polycarbonate (PC)", 2.38e9, 0.36, 62.1e6, 1200,
+                              f"{_CAL}: E 2.38 GPa, nu 0.36, Sy 62.1 MPa, 1.20 g/cm3 (Dowling, Table 5.2: "
+                              f"2.4 GPa, 0.38)", _POLYMER),
 })
 #: Other keys for a preset: alias -> (preset key, why the alias exists).
 ALIASES = {

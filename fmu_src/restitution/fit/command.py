@@ -1,6 +1,7 @@
 """``restitution fit``: calibrate the model's parameters from a drop test.
 
     restitution fit DATA --sphere KEY --d LEN --plate KEY --t LEN --fit NAME [--fit NAME ...]
+                    [--sphere-material FILE | --sphere-E ... --plate-material FILE | --plate-E ...]
                     [--g ACC] [--h0 LEN] [--json FILE] [--plot FILE] [--times FILE] [--bayes] [--seed N] [--strict]
 
 DATA: a CSV of rebound pairs (``v_in,v_out[,sigma]`` [m/s]) or of one drop's impact times (``t_impact``
@@ -14,7 +15,8 @@ import argparse
 import sys
 from pathlib import Path
 
-from ..options import ArgumentParser, OptionError, input_quantity, material, positive_quantity
+from ..options import (BARE_NUMBER_RULE, ArgumentParser, OptionError, add_material_options, check_plausible_lengths,
+                       input_reading, material_from_args, positive_quantity)
 from ..output_files import (EXIT_IO_ERROR, EXIT_REFUSED, OutputPathError, check_output, check_outputs,
                             finish_stdout)
 
@@ -39,15 +41,16 @@ def _needs(module: str, extra: str, option: str) -> None:
 def _parser() -> argparse.ArgumentParser:
     parser = ArgumentParser(prog=PROG, description=__doc__.split("\n\n")[0],
                             formatter_class=argparse.RawDescriptionHelpFormatter,
-                            epilog="Lengths take a unit (\"6.35 mm\"); a bare number is SI.\n\n"
+                            epilog="Lengths take a unit (\"6.35 mm\"). " + BARE_NUMBER_RULE + "\n\n"
                                    "exit status: 0 done (also when lack of fit is detected, unless --strict); "
                                    "2 bad input;\n3 lack of fit detected with --strict; 74 an output "
                                    "could not be written.")
     parser.add_argument("data", help="rebound pairs or impact times (.csv), or a recording (.wav)")
-    parser.add_argument("--sphere", required=True, metavar="KEY", help="sphere material (restitution materials)")
-    parser.add_argument("--d", required=True, metavar="LEN", help="sphere diameter, e.g. \"6.35 mm\"")
-    parser.add_argument("--plate", required=True, metavar="KEY", help="plate material")
-    parser.add_argument("--t", required=True, metavar="LEN", help="plate thickness")
+    parser.add_argument("--d", required=True, metavar="LEN", help="sphere diameter, e.g. \"6.35 mm\" (a bare "
+                                                                  "number is metres)")
+    parser.add_argument("--t", required=True, metavar="LEN", help="plate thickness (a bare number is metres)")
+    parser.add_argument("--allow-implausible", action="store_true",
+                        help="accept a bare-number length that looks like a slip (a 10 m sphere)")
     parser.add_argument("--fit", required=True, action="append", metavar="NAME", dest="names",
                         help="a parameter to fit: plate.Sy, plate.E, sphere.Sy, sphere.E, plate.t, ... (repeatable)")
     parser.add_argument("--g", default="9.80665 m/s2", metavar="ACC", help="gravity of a drop (default 9.80665 m/s2)")
@@ -60,6 +63,8 @@ def _parser() -> argparse.ArgumentParser:
     parser.add_argument("--seed", type=int, default=None, help="seed of the posterior's draws")
     parser.add_argument("--strict", action="store_true", help="exit with status 3 when the lack-of-fit checks "
                                                               "find that the model does not describe the data")
+    add_material_options(parser, "sphere")
+    add_material_options(parser, "plate")
     return parser
 
 
@@ -87,8 +92,10 @@ def _prepare(args):
         names = check_names(args.names)
     except ValueError as exc:
         raise OptionError(f"--fit: {exc}") from None
-    sphere = Sphere(material("sphere", args.sphere), input_quantity("d", "sphere.d", args.d))
-    plate = Plate(material("plate", args.plate), input_quantity("t", "plate.t", args.t))
+    d, t = input_reading("d", "sphere.d", args.d), input_reading("t", "plate.t", args.t)
+    check_plausible_lengths((f"--d {args.d}", *d), (f"--t {args.t}", *t), allow=args.allow_implausible)
+    sphere = Sphere(material_from_args(args, "sphere")[0], d[0])
+    plate = Plate(material_from_args(args, "plate")[0], t[0])
     g = positive_quantity("g", args.g, "m/s2", "acceleration")
     h0 = positive_quantity("h0", args.h0, "m", "length") if args.h0 else None
     check_drop(g, h0)

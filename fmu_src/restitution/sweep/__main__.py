@@ -11,6 +11,7 @@ from pathlib import Path
 
 from ..extras import MissingExtra, require
 from ..materials_table import text as materials_text
+from ..options import BARE_NUMBER_RULE, OptionError, add_material_options
 from ..output_files import (EXIT_IO_ERROR, EXIT_REFUSED, OutputPathError, OutputWriteError,
                             check_output, check_outputs, describe_os_error)
 from .sobol import SOBOL_OUTPUTS, SobolCollector, SobolError, SobolSpec
@@ -88,6 +89,8 @@ EXAMPLES = """examples:
       --backend fmu --out mc.csv
 
   # values with their units (a bare number is SI)
+  restitution sweep --sphere chrome_steel --plate-material copper.toml --set sphere.d=6.35mm \\
+      --set plate.t=3mm --grid v_approach=geomspace:0.1:10:40 --out cu.csv
   restitution sweep --set sphere.d="1/4 in" --set plate.E=114GPa --grid plate.t=linspace:1mm:5mm:9 \\
       --grid v_approach=geomspace:10cm/s:10m/s:40 --out t.csv
 
@@ -146,6 +149,15 @@ def build_spec(args) -> tuple[SweepSpec, dict]:
                         del data[other][k]
             data.setdefault(section, {})[key] = value
             given.add((section, key))
+    for key, value in _material_values(args).items():  # --sphere/--plate and their properties: fixed values
+        if any((section, key) in given for section in ("grid", "fixed")):
+            raise OptionError(f"{key} is given by --set/--grid and by the {key.split('.')[0]} material options: "
+                             f"give it once")
+        for other in ("grid", "fixed"):  # they replace the spec file's values (a relative draw scatters them)
+            for k in [k for k in data.get(other, {}) if canonical_name(k) == key]:
+                del data[other][k]
+        data.setdefault("fixed", {})[key] = value
+        given.add(("fixed", key))
     if args.samples is not None:
         data["samples"] = args.samples
     if args.seed is not None:
@@ -155,7 +167,42 @@ def build_spec(args) -> tuple[SweepSpec, dict]:
         spec.check_domain()  # explicit values inside the inputs' declared ranges, before any work
     except QuantityError as exc:
         raise QuantityError(_value_error(exc, given, args.spec), exc.name) from None
+    _check_set_lengths(args)
     return spec, run
+
+
+def _material_values(args) -> dict:
+    """The fixed values (SI, by FMU name) of --sphere/--plate, --ROLE-material and --ROLE-E ...: a
+    material's four properties; refused with --pair, which names both materials."""
+    from ..options import MATERIAL_PROPERTIES, material_from_args
+
+    out = {}
+    for role in ("sphere", "plate"):
+        options = [getattr(args, role), getattr(args, f"{role}_material"),
+                   *(getattr(args, f"{role}_{key}") for key in MATERIAL_PROPERTIES)]
+        if all(option is None for option in options):
+            continue
+        if args.pair:
+            raise OptionError(f"--{role} and its properties set the {role}'s material: not with --pair, "
+                             f"which names both materials (give --sphere and --plate instead)")
+        body = material_from_args(args, role)[0]
+        out.update({f"{role}.{key}": float(getattr(body, key)) for key in MATERIAL_PROPERTIES})
+    return out
+
+
+def _check_set_lengths(args) -> None:
+    """A bare-number sphere.d or plate.t of --set that is a likely slip refused
+    (:func:`restitution.options.check_plausible_lengths`) unless --allow-implausible."""
+    from ..options import check_plausible_lengths, input_reading
+
+    readings = {}
+    for item in args.set or []:
+        name, _, text = item.partition("=")
+        key = canonical_name(name)
+        if key in ("sphere.d", "plate.t"):
+            readings[key] = (f"--set {name.strip()}={text.strip()}",
+                             *input_reading(f"set {key}", key, text.strip()))
+    check_plausible_lengths(readings.get("sphere.d"), readings.get("plate.t"), allow=args.allow_implausible)
 
 
 #: The option that gives the values of each section of a spec.
@@ -176,7 +223,7 @@ def main(argv=None) -> int:
         prog=PROG, formatter_class=argparse.RawDescriptionHelpFormatter,
         description="Sweep the apparent COR (Green 2022) over material pairs, FMU parameters and the "
                     "approach speed, on Dask; write a table (CSV headers with units) and a plot: a grid's "
-                    "COR map, or the histogram of e of random draws.", epilog=EXAMPLES)
+                    "COR map, or the histogram of e of random draws.", epilog=EXAMPLES + "\n" + BARE_NUMBER_RULE)
     parser.add_argument("spec", nargs="?", help="TOML or JSON spec file (pairs, [grid], [random], [fixed], "
                                                 "samples, seed, [run]); options below add to or override it")
     parser.add_argument("--pair", action="append", metavar="SPHERE/PLATE",
@@ -189,6 +236,10 @@ def main(argv=None) -> int:
                              "normal_rel:sd, uniform_rel:h, choice:a,b (repeat)")
     parser.add_argument("--set", action="append", metavar="NAME=VALUE",
                         help="fixed value, with a unit or SI: plate.t=3mm, plate.E=114GPa, sphere.d='1/4 in' (repeat)")
+    parser.add_argument("--allow-implausible", action="store_true",
+                        help="accept a bare-number --set sphere.d or plate.t that looks like a slip (a 10 m sphere)")
+    add_material_options(parser, "sphere", "; they set the four properties as --set values (not with --pair)")
+    add_material_options(parser, "plate", "; as for the sphere")
     parser.add_argument("--samples", type=_int_in(1, MAX_SAMPLES),
                         help="random cases per grid point (--sobol: N base samples, a power of 2)")
     parser.add_argument("--sobol", action="store_true",
@@ -269,7 +320,7 @@ def _main(parser, args) -> int:
         spec, run = build_spec(args)
         run_ints = {key: _int_in(low, high)(str(run[key])) for key, low, high in (
             ("workers", 1, MAX_WORKERS), ("chunk_size", 1, MAX_CHUNK)) if run.get(key) is not None}
-    except (QuantityError, SobolError) as exc:  # a value, or a sweep --sobol cannot take: one line, no usage
+    except (QuantityError, SobolError, OptionError) as exc:  # a value, or a sweep --sobol cannot take: one line, no usage
         return _error(str(exc), EXIT_REFUSED)
     except (ValueError, argparse.ArgumentTypeError) as exc:
         parser.error(str(exc))

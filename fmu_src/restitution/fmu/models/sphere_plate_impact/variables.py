@@ -48,7 +48,8 @@ def _material(body, default_text):
         f"{body}.used.* show the values used. Codes: {codes}",
         vtype="Integer", choices=MATERIAL_CHOICES, first_code=0, enumeration="Material",
         item_descriptions=("the body's own numeric parameters",
-                           *(f"{MATERIALS[k].name} ({MATERIALS[k].source})" for k in PRESETS)))
+                           *(f"{MATERIALS[k].name} ({MATERIALS[k].source})"
+                             + (f". Note: {MATERIALS[k].note}" if MATERIALS[k].note else "") for k in PRESETS)))
 
 
 def _used(body):
