@@ -13,7 +13,17 @@ from __future__ import annotations
 
 import warnings
 
-__all__ = ["CONDITIONS", "departures", "AssumptionWarning", "warn_departures"]
+__all__ = ["CONDITIONS", "departures", "AssumptionWarning", "warn_departures", "E_NEGATIVE_MEANING",
+           "VALID_MEANING"]
+
+#: What e < 0 means (the flag ``e_negative``), in the words every report showing e < 0 gives beside it
+#: (``restitution cor``, the fit report, a sweep's statistics, a scene's summary; docs/assumptions.md).
+E_NEGATIVE_MEANING = ("the sphere keeps moving with the plate after the impact instead of bouncing back: Eq. (20) "
+                      "gives e < 0 where e_ep or e_ze is near 0 (a thin plate, a hard impact); a result of the "
+                      "model, not an error, and it does not make valid false")
+#: What ``valid`` means, where it is shown beside one impact (docs/assumptions.md, "Validated ranges").
+VALID_MEANING = ("inside the models' validated ranges, lambda <= 1.5 and V* <= 1000 (outside them e is an "
+                 "extrapolation); it does not cover e < 0 (e_negative)")
 
 
 class AssumptionWarning(UserWarning):

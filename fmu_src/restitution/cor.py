@@ -15,9 +15,11 @@ import json
 import math
 import sys
 
+from .assumptions import E_NEGATIVE_MEANING, VALID_MEANING
 from .model import ZENER_METHODS, impact, published
 from .zener import WAVE_DELAY_LIMIT
-from .options import ArgumentParser, OptionError, input_quantity, material
+from .options import (BARE_NUMBER_RULE, ArgumentParser, OptionError, add_material_options, check_plausible_lengths,
+                      input_reading, material, material_from_args)
 from .output_files import (EXIT_IO_ERROR, EXIT_REFUSED, OutputPathError, atomic_write, check_output,
                            finish_stdout)
 
@@ -32,18 +34,27 @@ UNITS = {"e": "1", "e_ep": "1", "e_ze": "1", "v_rebound": "m/s", "V_c": "m/s", "
          "v_plate": "m/s", "wave_delay": "1", "edge_echo": "1"}
 
 
-def evaluate(sphere: str, d, plate: str, t, v, zener_method: str = "exact", edge=None) -> tuple[dict, dict]:
-    """(inputs in SI, the published result as a dict) for the named materials, the diameter ``d``, the
-    thickness ``t``, the approach speed ``v`` and the edge distance ``edge`` (each a number in SI or a text
-    with its unit; ``edge`` None or 0: an unbounded plate).
+def evaluate(sphere, d, plate, t, v, zener_method: str = "exact", edge=None,
+             allow_implausible: bool = True) -> tuple[dict, dict]:
+    """(inputs in SI, the published result as a dict) for the materials ``sphere`` and ``plate`` (a
+    preset's name or a :class:`~restitution.Material`), the diameter ``d``, the thickness ``t``, the
+    approach speed ``v`` and the edge distance ``edge`` (each a number in SI or a text with its unit;
+    ``edge`` None or 0: an unbounded plate). Without ``allow_implausible`` a bare-number length that is
+    a likely slip is refused (:func:`~restitution.options.check_plausible_lengths`).
     :class:`~restitution.options.OptionError` (one line) for an unknown material or a value outside the domain."""
-    bodies = {"sphere": material("sphere", sphere), "plate": material("plate", plate)}
-    values = {option: input_quantity(option, QUANTITIES[option][0], str(text))
-              for option, text in (("d", d), ("t", t), ("v", v), ("edge", edge)) if text is not None}
+    bodies = {role: (material(role, body) if isinstance(body, str) else body)
+              for role, body in (("sphere", sphere), ("plate", plate))}
+    readings = {option: input_reading(option, QUANTITIES[option][0], str(text))
+                for option, text in (("d", d), ("t", t), ("v", v), ("edge", edge)) if text is not None}
+    check_plausible_lengths(*((f"--{option} {text}", *readings[option]) for option, text in (("d", d), ("t", t))),
+                            allow=allow_implausible)
+    values = {option: value for option, (value, _) in readings.items()}
     params = {**bodies["sphere"].params("sphere"), **bodies["plate"].params("plate"),
               "sphere_d": values["d"], "plate_t": values["t"], "plate_edge_distance": values.get("edge", 0.0)}
     result = published(impact(values["v"], **params, zener_method=zener_method).as_dict())
-    inputs = {"sphere": sphere, "plate": plate, "v": values["v"], **params, "zener_method": zener_method}
+    inputs = {"sphere": sphere if isinstance(sphere, str) else sphere.name,
+              "plate": plate if isinstance(plate, str) else plate.name,
+              "v": values["v"], **params, "zener_method": zener_method}
     return inputs, {key: (bool(value) if isinstance(value, bool) or key not in UNITS else float(value))
                     for key, value in result.items()}
 
@@ -54,19 +65,23 @@ def _line(name: str, value: float, what: str) -> str:
 
 
 def report(inputs: dict, r: dict) -> str:
-    """What the command prints: e first, then its parts, the rebound and the validity."""
+    """What the command prints: e first, then its parts, the rebound and the validity, with what ``valid``
+    means and, where e < 0, what that means (``e_negative``; the words of :mod:`restitution.assumptions`)."""
     yes = {True: "yes", False: "no"}
     return "\n".join([
         f"e = {r['e']:.4f}  apparent COR of {inputs['sphere']} (d = {inputs['sphere_d'] * 1e3:.6g} mm) on "
         f"{inputs['plate']} (t = {inputs['plate_t'] * 1e3:.6g} mm) at {inputs['v']:.6g} m/s (Eq. 20)",
         _line("e_ep", r["e_ep"], "elastoplastic COR, JGM (Eq. 7/8)"),
         _line("e_ze", r["e_ze"], "plate-wave COR, Zener (Eqs. 9-13a)"),
-        _line("v_rebound", r["v_rebound"], "rebound speed, e v"),
+        _line("v_rebound", r["v_rebound"], "rebound speed, e v" + (" (below 0: e < 0, see e_negative)"
+                                                                   if r["e_negative"] else "")),
         _line("V_star", r["V_star"], f"impact speed over the critical speed V_c = {r['V_c']:.4g} m/s (Eq. 6)"),
         _line("lam", r["lam"], "Zener's inelasticity parameter lambda (Eq. 12)"),
         _line("t_contact", r["t_contact"], "contact duration"),
         f"  valid = {yes[r['valid']]}  (lambda <= 1.5: {yes[r['lambda_in_range']]}, V* <= 1000: "
         f"{yes[r['vstar_in_range']]}, e < 0: {yes[r['e_negative']]})",
+        f"    valid: {VALID_MEANING}",
+        *([f"  e_negative = yes  e < 0: {E_NEGATIVE_MEANING}"] if r["e_negative"] else []),
         f"  wave_delay = {r['wave_delay']:.6g}  contact time over its half-space value, tau0(lambda)/tau0(0); "
         f"concurrent (<= {WAVE_DELAY_LIMIT}): {yes[r['concurrent']]}",
         (f"  edge_echo = {r['edge_echo']:.6g}  first edge echo (2 a/c_L, a = {inputs['plate_edge_distance'] * 1e3:.6g} "
@@ -78,23 +93,30 @@ def report(inputs: dict, r: dict) -> str:
 
 def main(argv=None) -> int:
     parser = ArgumentParser(prog="restitution cor", description=__doc__.split("\n\n")[0],
-                            epilog="Lengths and speeds take a unit (\"6.35 mm\", \"1/4 in\", \"2 m/s\"); "
-                                   "a bare number is SI.")
-    parser.add_argument("--sphere", required=True, metavar="KEY", help="sphere material (restitution materials)")
-    parser.add_argument("--d", required=True, metavar="LEN", help="sphere diameter, e.g. \"6.35 mm\"")
-    parser.add_argument("--plate", required=True, metavar="KEY", help="plate material")
-    parser.add_argument("--t", required=True, metavar="LEN", help="plate thickness, e.g. \"3 mm\"")
+                            epilog="Lengths and speeds take a unit (\"6.35 mm\", \"1/4 in\", \"2 m/s\"). "
+                                   + BARE_NUMBER_RULE)
+    parser.add_argument("--d", required=True, metavar="LEN", help="sphere diameter, e.g. \"6.35 mm\" (a bare "
+                                                                  "number is metres)")
+    parser.add_argument("--t", required=True, metavar="LEN", help="plate thickness, e.g. \"3 mm\" (a bare number "
+                                                                  "is metres)")
     parser.add_argument("--v", required=True, metavar="SPEED", help="approach speed, e.g. \"2 m/s\"")
     parser.add_argument("--edge", metavar="LEN", help="distance from the impact point to the plate's nearest "
                                                       "edge, e.g. \"76 mm\" (default: an unbounded plate)")
+    parser.add_argument("--allow-implausible", action="store_true",
+                        help="accept a bare-number length that looks like a slip (a 10 m sphere)")
     parser.add_argument("--zener-method", default="exact", choices=ZENER_METHODS,
                         help="Zener's COR and contact time (default: exact)")
     parser.add_argument("--json", metavar="FILE", help="write the inputs and every field of the result (SI)")
+    add_material_options(parser, "sphere")
+    add_material_options(parser, "plate")
     args = parser.parse_args(argv)
     try:
         if args.json:
             check_output(args.json, "--json")
-        inputs, result = evaluate(args.sphere, args.d, args.plate, args.t, args.v, args.zener_method, args.edge)
+        (sphere, sphere_label), (plate, plate_label) = (material_from_args(args, role) for role in ("sphere", "plate"))
+        inputs, result = evaluate(sphere, args.d, plate, args.t, args.v, args.zener_method, args.edge,
+                                  allow_implausible=args.allow_implausible)
+        inputs.update(sphere=sphere_label, plate=plate_label)
     except (OptionError, OutputPathError) as exc:
         print(f"restitution cor: error: {exc}", file=sys.stderr)
         return EXIT_REFUSED

@@ -355,6 +355,30 @@ def test_readme_is_a_users_page():
         assert (ROOT / link).is_file(), link
 
 
+def test_quickstart_takes_the_users_case(impact_fmu, capsys):
+    """--sphere/--d/--plate/--t choose the case (units as restitution cor reads them): the header names the
+    materials and sizes, and the first bounce's e is the package's for that ball and plate at its speed."""
+    bounces = _load("quickstart_bounce").main(["--fmu", str(impact_fmu), "--sphere", "chrome_steel", "--d", "4.76 mm",
+                                               "--plate", "brass_260", "--t", "3 mm", "--height", "0.2"])
+    out = capsys.readouterr().out
+    names = r.MATERIALS["chrome_steel"].name, r.MATERIALS["brass_260"].name
+    assert out.startswith(f"{names[0]} ball (d = 4.76 mm) dropped from 0.2 m on {names[1]}, t = 3.00 mm"), out
+    want = r.impact(bounces.v_approach[0], **r.MATERIALS["chrome_steel"].params("sphere"),
+                    **r.MATERIALS["brass_260"].params("plate"), sphere_d=4.76e-3, plate_t=3e-3)
+    first = out.splitlines()[2].split()
+    assert first[0] == "1" and float(first[3]) == pytest.approx(float(want.e), abs=6e-5), (first, want.e)
+    default = r.impact(bounces.v_approach[0], **r.MATERIALS["s2_tool_steel"].params("sphere"),
+                       **r.MATERIALS["al_6061"].params("plate"), sphere_d=6.35e-3, plate_t=6.35e-3)
+    assert abs(float(want.e) - float(default.e)) > 0.01  # another case than the default's
+
+
+def test_quickstart_refuses_a_bad_case_in_one_line(capsys):
+    with pytest.raises(SystemExit) as stop:
+        _load("quickstart_bounce").main(["--fmu", "x.fmu", "--plate", "al_6016", "--t", "3 mm"])
+    err = capsys.readouterr().err
+    assert stop.value.code == 2 and err.startswith("quickstart_bounce.py: error: --plate 'al_6016': unknown material")
+
+
 def test_the_demo_reuses_up_to_date_fmus_and_rebuilds_stale_ones(built_fmus, tmp_path, monkeypatch, capsys):
     """The Quickstart demo runs the example without --fmu: a full set of FMUs built from the current
     sources is used as it is (no build), a stale SpherePlateImpact.fmu (another recorded source hash) is

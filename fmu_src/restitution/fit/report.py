@@ -7,6 +7,7 @@ import math
 
 import numpy as np
 
+from ..assumptions import E_NEGATIVE_MEANING
 from .datasets import ImpactTimes, Recording, ReboundPairs
 from .forward import KEYS, bounce_train, restitution_at
 
@@ -63,6 +64,9 @@ def table(calibration) -> str:
     if result.out_of_range:
         lines.append(f"  {result.out_of_range} of {result.n} points outside the model's validated range "
                      "(lambda > 1.5, V* > 1000 or e < 0): kept, marked in the plot and the JSON")
+    negative = int(np.count_nonzero(result.flags.get("e_negative", ()))) if result.flags else 0
+    if negative:
+        lines.append(f"  e < 0 (e_negative) at {negative} of {result.n} points: {E_NEGATIVE_MEANING}")
     return "\n".join(lines)
 
 

@@ -5,13 +5,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..assumptions import E_NEGATIVE_MEANING
 from ..model import ZENER_SLOPE_BOUND, impact
 from .loader import Drop
 
-#: What e < 0 means (the flag ``e_negative``), where a count of such cases is shown (docs/assumptions.md).
-E_NEGATIVE_MEANING = ("the sphere keeps moving with the plate after the impact instead of bouncing back: Eq. (20) "
-                      "gives e < 0 where e_ep or e_ze is near 0 (a thin plate, a hard impact); a result of the "
-                      "model, not an error, and it does not make valid false")
+
 
 
 def meaning_lines(n_negative: int | None, n_invalid: int, of: int, what: str = "impacts",

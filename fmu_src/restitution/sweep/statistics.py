@@ -19,9 +19,10 @@ import math
 
 import numpy as np
 
+from ..assumptions import E_NEGATIVE_MEANING
 from ..fmu.models.sphere_plate_impact.variables import TABLE
 from ..output_files import write_json
-from ..scene.explain import E_NEGATIVE_MEANING, meaning_lines
+from ..scene.explain import meaning_lines
 from .order_statistics import Scratch, moments_and_order_statistics, order_statistics
 from .student_t import t975
 from .spec import OUTPUTS, T_OVER_D, pair_label
