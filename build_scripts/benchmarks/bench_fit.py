@@ -26,7 +26,7 @@ this thread, ``time.thread_time``, so other jobs on a shared machine do not infl
 often the 95 % intervals contain the true plate.Sy; ``--coverage-bayes M`` does the same for M
 posteriors of pairs (and, for the same data sets, the profile-likelihood intervals again).
 ``--drag`` fits noise-free drops computed with quadratic air drag, which the model leaves out, and
-prints the bias it makes. ``--write`` puts the printed block into docs/calibration.md between its
+prints the bias it makes. ``--write`` puts the printed block into docs/performance.md between its
 ``bench_fit`` markers. The run the page shows (``--coverage 2000 --coverage-bayes 400 --drag``)
 takes about 6 minutes on a shared 2-core machine; the costs alone, about 15 s.
 """
@@ -53,7 +53,7 @@ from restitution.fit.datasets import ImpactTimes, ReboundPairs  # noqa: E402
 from restitution.fit.estimate import base_of, fit_parameters  # noqa: E402
 from restitution.fit.posterior import sample_posterior  # noqa: E402
 
-DOC = ROOT / "docs" / "calibration.md"
+DOC = ROOT / "docs" / "performance.md"
 BEGIN, END = "<!-- bench_fit:begin -->", "<!-- bench_fit:end -->"
 
 G = 9.80665

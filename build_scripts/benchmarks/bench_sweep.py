@@ -1,4 +1,4 @@
-"""Measure design-space sweep throughput and write the table in docs/sweeps.md.
+"""Measure design-space sweep throughput and write the table in docs/performance.md.
 
     .venv/bin/python build_scripts/benchmarks/bench_sweep.py [--no-write] [--fmu-cases N] [--package-cases N]
 
@@ -37,7 +37,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "build_scripts" / "benchmarks"))
-DOC = ROOT / "docs" / "sweeps.md"
+DOC = ROOT / "docs" / "performance.md"
 BEGIN, END = "<!-- bench_sweep:begin -->", "<!-- bench_sweep:end -->"
 
 
@@ -131,7 +131,7 @@ def timed(fn, repeats):
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--no-write", action="store_true", help="print the table, leave docs/sweeps.md alone")
+    parser.add_argument("--no-write", action="store_true", help="print the table, leave docs/performance.md alone")
     parser.add_argument("--fmu-cases", type=int, default=24_000, help="cases of the FMU sweeps (default 24000)")
     parser.add_argument("--package-cases", type=int, default=4_800_000,
                         help="cases of the package sweeps (default 4800000)")

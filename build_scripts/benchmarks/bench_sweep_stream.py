@@ -1,5 +1,5 @@
 """What a sweep costs beside the model it evaluates: the sweep command against ``impact`` alone, as
-whole processes, and ``run_sweep`` against ``impact`` in one process; writes its block in docs/sweeps.md.
+whole processes, and ``run_sweep`` against ``impact`` in one process; writes its block in docs/performance.md.
 
     .venv/bin/python build_scripts/benchmarks/bench_sweep_stream.py [--cases N] [--runs R] [--no-write] [--quick]
 
@@ -34,7 +34,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "build_scripts" / "benchmarks"))
-DOC = ROOT / "docs" / "sweeps.md"
+DOC = ROOT / "docs" / "performance.md"
 BEGIN, END = "<!-- bench_sweep_stream:begin -->", "<!-- bench_sweep_stream:end -->"
 PAIR = "s2_tool_steel/al_6061"
 PAIRS = (PAIR, "brass_260/borosilicate_glass")
@@ -178,7 +178,7 @@ def main(argv=None) -> int:
     parser.add_argument("--in-process-cases", type=int, default=1_000_000,
                         help="cases of the in-process sweeps (default 10^6)")
     parser.add_argument("--repeats", type=int, default=5, help="runs of each in-process measurement (default 5)")
-    parser.add_argument("--no-write", action="store_true", help="print, leave docs/sweeps.md alone")
+    parser.add_argument("--no-write", action="store_true", help="print, leave docs/performance.md alone")
     parser.add_argument("--quick", action="store_true", help="a small run that checks the benchmark works (no docs)")
     args = parser.parse_args(argv)
     if args.quick:
