@@ -38,8 +38,7 @@ def _usage() -> str:
     return "\n".join(lines)
 
 
-def main(argv=None) -> int:
-    argv = list(sys.argv[1:] if argv is None else argv)
+def _run(argv: list[str]) -> int:
     if not argv or argv[0] in ("-h", "--help"):
         print(_usage())
         return 0 if argv else 2
@@ -52,19 +51,38 @@ def main(argv=None) -> int:
     if name not in SUBCOMMANDS:
         import difflib
 
-        close = difflib.get_close_matches(name, list(SUBCOMMANDS), n=1)
+        from .options import echo
+
+        close = difflib.get_close_matches(name, list(SUBCOMMANDS), n=1) if len(name) <= 40 else []
         hint = f" (did you mean {close[0]}?)" if close else ""
-        print(f"restitution: error: unknown command {name!r}{hint}; commands: {', '.join(SUBCOMMANDS)}",
+        print(f"restitution: error: unknown command '{echo(name)}'{hint}; commands: {', '.join(SUBCOMMANDS)}",
               file=sys.stderr)
         return 2
     module = importlib.import_module(SUBCOMMANDS[name][0])
-    try:
-        return module.main(rest)
-    except BrokenPipeError:  # the reader went away (`restitution cor ... | head -1`): no traceback
-        import os
+    return module.main(rest)
 
-        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+
+def main(argv=None) -> int:
+    """Run ``restitution COMMAND ...``; its exit status. What a command printed is flushed here, inside the
+    command's lifetime: standard output that cannot be written (a full disk, a closed pipe) is one line and
+    exit 74, or a quiet 141 where the reader went away, never a traceback or an exit 0 with the output lost
+    (argparse's --help, and print() in the tools, leave the flush to the interpreter's exit)."""
+    from .output_files import EXIT_IO_ERROR, finish_stdout, os_reason, silence_stdout
+
+    argv = list(sys.argv[1:] if argv is None else argv)
+    prog = f"restitution {argv[0]}" if argv and argv[0] in SUBCOMMANDS else "restitution"
+    try:
+        status = _run(argv)
+    except SystemExit as exc:  # argparse: --help (0), a refused option (2, its message already on stderr)
+        status = exc.code
+    except BrokenPipeError:  # the reader went away (`restitution cor ... | head -1`): no traceback
+        silence_stdout()
         return 141
+    except OSError as exc:  # writing the output failed where the tool did not catch it
+        silence_stdout()
+        print(f"{prog}: error: cannot write: {os_reason(exc)}", file=sys.stderr, flush=True)
+        return EXIT_IO_ERROR
+    return finish_stdout(prog) or status
 
 
 if __name__ == "__main__":

@@ -9,7 +9,6 @@ The same rows feed both, so docs/materials.md is this command's output (a test k
 """
 from __future__ import annotations
 
-import argparse
 import sys
 
 from .materials import ALIASES, BRITTLE_SY, MATERIALS, TABLE4_CASES, Material, table4_case
@@ -119,7 +118,9 @@ def text() -> str:
 
 
 def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(prog="restitution-materials", description=__doc__.split("\n\n")[0])
+    from .options import ArgumentParser
+
+    parser = ArgumentParser(prog="restitution materials", description=__doc__.split("\n\n")[0])
     parser.add_argument("--markdown", action="store_true", help="the Markdown of docs/materials.md")
     args = parser.parse_args(argv)
     sys.stdout.write(markdown() if args.markdown else text() + "\n")

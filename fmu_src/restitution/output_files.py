@@ -34,8 +34,9 @@ import sys
 import tempfile
 from pathlib import Path
 
-__all__ = ["EXIT_REFUSED", "EXIT_IO_ERROR", "EXIT_BROKEN_PIPE", "OutputPathError", "OutputWriteError", "os_reason", "describe_os_error",
-           "file_kind", "check_output", "check_outputs", "check_output_dir", "finish_stdout", "atomic_write", "json_ready", "write_json", "GrowingOutput"]
+__all__ = ["EXIT_REFUSED", "EXIT_IO_ERROR", "EXIT_BROKEN_PIPE", "OutputPathError", "OutputWriteError", "os_reason",
+           "describe_os_error", "file_kind", "silence_stdout", "check_output", "check_outputs", "check_output_dir",
+           "finish_stdout", "atomic_write", "json_ready", "write_json", "GrowingOutput"]
 
 #: Exit status of an output path refused before any work (a user mistake, as the other ones).
 EXIT_REFUSED = 2
@@ -170,7 +171,7 @@ def check_outputs(outputs: dict, inputs: dict | None = None) -> None:
         seen.append((option, path, here, False))
 
 
-def _silence_stdout() -> None:
+def silence_stdout() -> None:
     """Point file descriptor 1 at the null device: what is left in sys.stdout's buffer goes nowhere
     at exit instead of failing again ("Exception ignored ...")."""
     with contextlib.suppress(OSError, ValueError, AttributeError):
@@ -189,10 +190,10 @@ def finish_stdout(prog: str, text: str | None = None) -> int:
             print(text)
         sys.stdout.flush()
     except BrokenPipeError:
-        _silence_stdout()
+        silence_stdout()
         return EXIT_BROKEN_PIPE
     except OSError as exc:
-        _silence_stdout()
+        silence_stdout()
         with contextlib.suppress(OSError, ValueError):
             print(f"{prog}: error: cannot write standard output: {os_reason(exc)}", file=sys.stderr, flush=True)
         return EXIT_IO_ERROR

@@ -4,10 +4,10 @@ with a line per product and platform on stderr as it goes (zig's first use fills
 minutes), then a line per FMU built on stdout."""
 from __future__ import annotations
 
-import argparse
 import sys
 from pathlib import Path
 
+from ..options import ArgumentParser
 from .build import FMUS, BuildError, build_all, default_fmu_dir
 from .build.progress import stderr_line
 
@@ -16,7 +16,7 @@ PROG = "restitution fmu"
 
 
 def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(prog=PROG,
+    parser = ArgumentParser(prog=PROG,
                                      description="Build and validate the project's FMUs.")
     commands = parser.add_subparsers(dest="command", required=True)
     build = commands.add_parser("build", help=f"build {', '.join(f'{m}.fmu' for m in FMUS)} (pythonfmu) and their "

@@ -17,6 +17,7 @@ from pathlib import Path
 
 from ..extras import MissingExtra, require
 from ..fmu.build import BuildError
+from ..options import ArgumentParser
 from ..output_files import (EXIT_IO_ERROR, EXIT_REFUSED, OutputPathError, check_output, check_output_dir,
                             check_outputs, describe_os_error)
 from .loader import SceneError, load_scene
@@ -144,7 +145,7 @@ def _repeat(text: str) -> int:
 
 
 def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(prog=PROG, description=(
+    parser = ArgumentParser(prog=PROG, description=(
         "Drop scenes: balls dropped on plates, described in TOML files and simulated through the FMU."))
     sub = parser.add_subparsers(dest="command", required=True)
 

@@ -11,7 +11,7 @@ from pathlib import Path
 
 from ..extras import MissingExtra, require
 from ..materials_table import text as materials_text
-from ..options import BARE_NUMBER_RULE, OptionError, add_material_options
+from ..options import BARE_NUMBER_RULE, ArgumentParser, OptionError, add_material_options
 from ..output_files import (EXIT_IO_ERROR, EXIT_REFUSED, OutputPathError, OutputWriteError,
                             check_output, check_outputs, describe_os_error)
 from .sobol import SOBOL_OUTPUTS, SobolCollector, SobolError, SobolSpec
@@ -219,7 +219,7 @@ def _value_error(exc: QuantityError, given: set, spec_file) -> str:
 
 
 def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(
+    parser = ArgumentParser(
         prog=PROG, formatter_class=argparse.RawDescriptionHelpFormatter,
         description="Sweep the apparent COR (Green 2022) over material pairs, FMU parameters and the "
                     "approach speed, on Dask; write a table (CSV headers with units) and a plot: a grid's "
