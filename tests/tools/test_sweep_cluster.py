@@ -22,8 +22,10 @@ def test_closing_a_local_cluster_silences_its_workers_and_restores_this_process(
     with cluster._quiet_shutdown() as quiet:
         from distributed import Client, LocalCluster
 
-        with LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None,
-                          silence_logs=logging.ERROR) as local, Client(local) as client:
+        with cluster._without_fmu_resources_on_sys_path():  # as open_client starts its workers: with this
+            local = LocalCluster(n_workers=1, threads_per_worker=1, processes=True,  # process's restitution
+                                 dashboard_address=None, silence_logs=logging.ERROR)
+        with local, Client(local) as client:
             assert all(state[0] < logging.CRITICAL for state in client.run(_worker_logging_state).values())
             quiet(client)
             states = client.run(_worker_logging_state)
