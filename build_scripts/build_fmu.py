@@ -1,5 +1,5 @@
 """Build the project's FMUs into dist/ (or --out DIR): a thin entry point to
-``python -m restitution.fmu build`` (see :mod:`restitution.fmu.build`)."""
+``python -m restitution.fmu build`` (see :mod:`restitution.fmu.builders`)."""
 import sys
 from pathlib import Path
 

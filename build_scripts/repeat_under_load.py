@@ -11,7 +11,7 @@ sweep says after Ctrl-C: anything after it, a worker's traceback or a distribute
     .venv/bin/python build_scripts/repeat_under_load.py NODE [-n 20] [-k 2] [--max-minutes 15] [--show-stderr]
 
 NODE is a pytest node id, e.g.
-``"tests/tools/test_sweep_streaming.py::test_cli_ctrl_c_writes_what_is_done_and_resume_completes[localcluster2-fmu]"``
+``"tests/sweep/test_sweep_streaming.py::test_cli_ctrl_c_writes_what_is_done_and_resume_completes[localcluster2-fmu]"``
 (quote it: the brackets). K defaults to the number of cores. The runs stop at the first one that starts
 after ``--max-minutes`` (the runs done are reported; the busy loops are always ended). Exit status 0 when
 every run that ran passed and none was left out, 1 otherwise.

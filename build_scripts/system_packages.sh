@@ -6,7 +6,7 @@
 #   libc6-arm64-cross     the aarch64 C library qemu-user loads them with
 #   libtbb12              the ecos engine of the ecospy wheel (tests/hosts/test_native_hosts.py)
 #   cmake                 fmpy's rebuild of a native FMU from its sources/ (tests/fmu/test_native_fmu.py)
-#   chromium              a headless browser measuring the documentation site's layout (tests/tools/test_docs_site.py)
+#   chromium              a headless browser measuring the documentation site's layout (tests/docs/test_docs_site.py)
 #
 #   bash build_scripts/system_packages.sh
 #
@@ -22,7 +22,7 @@ declare -A SKIPS=(
     [libc6-arm64-cross]="the aarch64-linux runs of tests/fmu/test_cross_binaries.py skip (no aarch64 C library for qemu)"
     [libtbb12]="the ecos tests of tests/hosts/test_native_hosts.py skip (ecos needs libtbb.so.12)"
     [cmake]="tests/fmu/test_native_fmu.py::test_rebuilt_from_sources_by_fmpy skips (fmpy's rebuild uses cmake)"
-    [chromium]="tests/tools/test_docs_site.py::test_code_blocks_stay_inside_the_column skips (no headless browser to measure the site's code blocks in)"
+    [chromium]="tests/docs/test_docs_site.py::test_code_blocks_stay_inside_the_column skips (no headless browser to measure the site's code blocks in)"
 )
 ORDER=(gcc-mingw-w64-x86-64 wine64 qemu-user libc6-arm64-cross libtbb12 cmake chromium)
 

@@ -40,7 +40,7 @@ exclude_patterns = ["_build", "mutation_survivors.txt"]
 smartquotes = False
 # furo: the content column narrows with the window, and a code block wider than the column scrolls
 # sideways inside it (its pre is overflow: auto) instead of running past the column's edge, as it did
-# with alabaster's fixed 940 px body. tests/tools/test_docs_site.py measures that in a headless
+# with alabaster's fixed 940 px body. tests/docs/test_docs_site.py measures that in a headless
 # chromium at 1280 px.
 html_theme = "furo"
 html_title = f"restitution {release}"

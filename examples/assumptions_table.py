@@ -10,7 +10,7 @@ how far each impact sits from the model's assumptions (``wave_delay``, ``edge_ec
 apparent COR it predicts.
 
 The output goes verbatim between the marker comments of docs/assumptions.md;
-tests/tools/test_assumptions_page.py fails when the two differ. It carries no date or machine line
+tests/docs/test_assumptions_page.py fails when the two differ. It carries no date or machine line
 (unlike docs/accuracy.md): the numbers are deterministic physics, so a rerun on any machine must
 reproduce the page byte for byte.
 """

@@ -1,8 +1,9 @@
 """Shared fixtures: the FMU is built once per test session from the working tree.
 
 The tests mirror the package: physics/ (the equations and the model), fmu/ (the FMUs: both
-implementations, the C front, the guard, the build), hosts/ (FMI hosts and co-simulation masters),
-tools/ (scenes, sweeps, examples, benchmarks). What several of them share lives here, in tests/:
+implementations, the C front, the guard, the builders), hosts/ (FMI hosts and co-simulation masters),
+fit/, sweep/, scene/ (one folder per tool wing), cli/ (the restitution command: options, materials, output
+files), docs/ (the pages, the site and the examples they show), benchmarks/ (the benchmarks' quick runs). What several of them share lives here, in tests/:
 cases.py (case sets), agree.py (comparing within conditioning), independent.py (the references from
 outside the code), fmi_child.py (hostile FMI calls in a child process), toy_fmu.py and toys/, c_host/
 (C hosts and drivers), data/."""
@@ -26,7 +27,7 @@ def built_fmus(tmp_path_factory) -> Path:
     """Every FMU of the project built from the current sources (and validated) into one temp dir:
     SpherePlateImpact.fmu and BouncingBall.fmu (pythonfmu, behind the C guard), and their native
     twins, FMI 2.0 in fmi2/ and FMI 3.0 in fmi3/, where a C compiler is available."""
-    from restitution.fmu.build import build_all
+    from restitution.fmu.builders import build_all
 
     out = tmp_path_factory.mktemp("fmu")
     build_all(out)

@@ -32,7 +32,7 @@ FMI3_SYSTEMS = {"darwin": ".dylib", "linux": ".so", "windows": ".dll"}
 #: linux64, win64 and darwin64 of them (darwin64: one universal file for both macOS architectures).
 NATIVE_FOLDERS = {"2.0": ("darwin64", "linux64", "win64"),
                   "3.0": ("aarch64-darwin", "aarch64-linux", "x86_64-darwin", "x86_64-linux", "x86_64-windows")}
-#: How to get the compiler of each platform the native build targets (restitution.fmu.build.toolchains).
+#: How to get the compiler of each platform the native build targets (restitution.fmu.builders.toolchains).
 INSTALL = {"x86_64-linux": "apt-get install gcc",
            "x86_64-windows": "apt-get install gcc-mingw-w64-x86-64, or pip install ziglang",
            "aarch64-linux": "pip install ziglang", "x86_64-darwin": "pip install ziglang",
@@ -136,8 +136,8 @@ def skip_unless_built(fmu: Path, platform: str = "win64") -> str:
     """The binaries/ folder of ``platform`` (a binaries/ folder of either FMI version: win64 or
     x86_64-windows, darwin64, aarch64-linux, ...) in ``fmu``, which the build produced; skips, naming the
     compiler, where the archive has no binary there because that compiler is not installed (see
-    restitution.fmu.build.toolchains); fails where the compiler is there and the binary is still missing."""
-    from restitution.fmu.build import toolchains
+    restitution.fmu.builders.toolchains); fails where the compiler is there and the binary is still missing."""
+    from restitution.fmu.builders import toolchains
 
     version = fmi_version(fmu)
     folders = toolchains.folders(version)

@@ -25,7 +25,7 @@ KINDS = {"Real": "real", "Integer": "integer", "Float64": "real", "Int32": "inte
 
 def build_host(exe: Path, fmi_version: int = 2, cc="gcc", flags=()) -> Path:
     """Compile the host for ``fmi_version`` (2 or 3) with ``cc`` (gcc, or mingw-w64 for win64; or a
-    restitution.fmu.build.toolchains.Compiler, e.g. zig for win64) into ``exe``; a failed build raises with the
+    restitution.fmu.builders.toolchains.Compiler, e.g. zig for win64) into ``exe``; a failed build raises with the
     compiler's messages."""
     command, env = ([cc], None) if isinstance(cc, str) else (list(cc.command), cc.env)
     cmd = [*command, *WARNINGS, *flags, f"-DFMI_VERSION={fmi_version}", "-o", str(exe), str(HOST_SOURCE)]

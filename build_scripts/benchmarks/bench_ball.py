@@ -72,7 +72,7 @@ def build_ours(work: Path) -> dict:
     """Our BouncingBall's linux64 binaries, FMI 2.0 and FMI 3.0, by the package's native build; label ->
     (FMI version, binary, resource, token)."""
     from restitution.about import VERSION
-    from restitution.fmu.build import native
+    from restitution.fmu.builders import native
     from restitution.fmu.describe.c_header import model_info_header
     from restitution.fmu.models import table
 
@@ -222,7 +222,7 @@ def main(argv=None) -> int:
     source, why_not = reference_dir(args.reference_fmus)
     if source is None:
         print(why_not)
-    from restitution.fmu.build.native import fmi_include_dir
+    from restitution.fmu.builders.native import fmi_include_dir
 
     with tempfile.TemporaryDirectory(prefix="bench-ball-") as tmp:
         work = Path(tmp)

@@ -29,8 +29,8 @@ ROOT = HERE.parents[1]
 sys.path.insert(0, str(ROOT / "fmu_src"))
 
 from bench_native_build import compile_host  # noqa: E402
-from restitution.fmu.build import build_all  # noqa: E402
-from restitution.fmu.build.native import fmi_include_dir  # noqa: E402
+from restitution.fmu.builders import build_all  # noqa: E402
+from restitution.fmu.builders.native import fmi_include_dir  # noqa: E402
 
 HOST = HERE / "bench_c" / "exchange_timing.c"
 VERSIONS = {"2.0": ("fmi2", "linux64", 2), "3.0": ("fmi3", "x86_64-linux", 3)}

@@ -20,7 +20,7 @@ terms computed once, no FMI), then measures, every ratio in this one run:
 4. the C physics (``rst_impact``) against the package's scalar ``restitution.impact``.
 
 Prints the headline next to the goals and writes DIR/native_cost.md (DIR defaults to docs/).
-``--quick`` (used by tests/tools/test_bench_native.py) measures 3 short repeats; the full run takes about a
+``--quick`` (used by tests/benchmarks/test_bench_native.py) measures 3 short repeats; the full run takes about a
 minute. Split by job: bench_native_build.py (the FMUs and C programs), bench_native_timing.py
 (interleaved batches), bench_native_page.py (the page).
 """

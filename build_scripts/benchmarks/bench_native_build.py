@@ -110,7 +110,7 @@ def build_floor(work: Path, model_description: str) -> Path:
     """The floor FMU, unzipped in ``work/floor``: the C front, the generated interface table and
     model info, ``bench_c/floor_fmu.c``, compiled by ``build_native.compile_binary`` (gcc, the native FMU's
     flags); its modelDescription is the native FMU's."""
-    from restitution.fmu.build import native as bn
+    from restitution.fmu.builders import native as bn
     from restitution.fmu.describe import fmi2
     from restitution.fmu.describe.c_header import c_header, model_info, model_info_header
 
@@ -133,7 +133,7 @@ def build_floor(work: Path, model_description: str) -> Path:
 def compile_host(out: Path, sources: list[Path], includes: list[Path], libs: list[str], defines=()) -> Path:
     """gcc with the native build's flags (C99, -Wall -Wextra -Werror -pedantic, -O2, no FMA contraction);
     ``defines``: ``NAME=VALUE`` texts for -D."""
-    from restitution.fmu.build.compile import CFLAGS
+    from restitution.fmu.builders.compile import CFLAGS
 
     cmd = ["gcc", *CFLAGS, *(f"-D{d}" for d in defines), *(f"-I{p}" for p in includes), "-o", str(out),
            *map(str, sources), *libs]
@@ -145,9 +145,9 @@ def compile_host(out: Path, sources: list[Path], includes: list[Path], libs: lis
 
 def build_all(work: Path, log=None) -> Built:
     """Build everything the benchmark times into ``work`` (an empty scratch directory)."""
-    from restitution.fmu.build import build_one
-    from restitution.fmu.build.native import build_native_one, fmi_include_dir, write_backend
-    from restitution.fmu.build.compile import prepare_sources
+    from restitution.fmu.builders import build_one
+    from restitution.fmu.builders.native import build_native_one, fmi_include_dir, write_backend
+    from restitution.fmu.builders.compile import prepare_sources
 
     log = log or (lambda message: None)
     if shutil.which("gcc") is None:

@@ -5,7 +5,7 @@
 
 Builds, in a scratch directory (``--work``, default a temporary one):
 
-* the product: ``SpherePlateImpact.fmu`` by :func:`restitution.fmu.build.build_one`, exactly as the
+* the product: ``SpherePlateImpact.fmu`` by :func:`restitution.fmu.builders.build_one`, exactly as the
   project builds it (pythonfmu, the package, the C guard in front of pythonfmu's binary);
 * the *plain twin*: a pythonfmu FMU built by pythonfmu alone (no guard, no package) whose slave
   registers the same variables (names, types, causalities, variabilities, start values, hence the same
@@ -137,7 +137,7 @@ def _without_physics(product: Path, directory: Path) -> Path:
 def build(work: Path) -> dict:
     """{"product", "no_physics", "twin": unzipped dir} built into ``work``."""
     from pythonfmu.builder import FmuBuilder
-    from restitution.fmu.build import build_one
+    from restitution.fmu.builders import build_one
 
     product = build_one(MODEL, work / "fmus", log=lambda message: print(message, file=sys.stderr))
     source = work / "twin_src"

@@ -146,7 +146,7 @@ def main(argv=None) -> int:
     import dask
     import fmpy
     import numpy as np
-    from restitution.fmu.build import build_one
+    from restitution.fmu.builders import build_one
     from restitution.sweep import machine_workers, open_client, release_fmus, run_sweep
 
     t_all = time.perf_counter()

@@ -28,7 +28,7 @@ workdir = tempfile.TemporaryDirectory(prefix="restitution-gallery-")
 if os.environ.get("RESTITUTION_GALLERY_FMUS"):
     path = Path(os.environ["RESTITUTION_GALLERY_FMUS"]) / "SpherePlateImpact.fmu"
 else:
-    from restitution.fmu.build.products import build_one
+    from restitution.fmu.builders.products import build_one
 
     path = build_one("SpherePlateImpact", Path(workdir.name))
 print(path.name, f"{path.stat().st_size / 1e3:.0f} kB")

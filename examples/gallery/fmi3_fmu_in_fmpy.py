@@ -27,7 +27,7 @@ workdir = tempfile.TemporaryDirectory(prefix="restitution-gallery-")
 if os.environ.get("RESTITUTION_GALLERY_FMUS"):
     path = Path(os.environ["RESTITUTION_GALLERY_FMUS"]) / "fmi3" / "SpherePlateImpact.fmu"
 else:
-    from restitution.fmu.build.native import build_native_one
+    from restitution.fmu.builders.native import build_native_one
 
     path = build_native_one("SpherePlateImpact", Path(workdir.name), fmi_version="3.0")
 print(path.parent.name + "/" + path.name, f"{path.stat().st_size / 1e3:.0f} kB")

@@ -27,7 +27,7 @@ workdir = tempfile.TemporaryDirectory(prefix="restitution-gallery-")
 if os.environ.get("RESTITUTION_GALLERY_FMUS"):
     ball_fmu = Path(os.environ["RESTITUTION_GALLERY_FMUS"]) / "fmi3" / "BouncingBall.fmu"
 else:
-    from restitution.fmu.build.native import build_native_one
+    from restitution.fmu.builders.native import build_native_one
 
     ball_fmu = build_native_one("BouncingBall", Path(workdir.name), fmi_version="3.0")
 

@@ -1,4 +1,4 @@
-"""restitution.fmu.build.plan and .progress: what a build makes and what it says as it goes.
+"""restitution.fmu.builders.plan and .progress: what a build makes and what it says as it goes.
 
 * The plans: the Quickstart demo's is its one FMU (pythonfmu, the host's guard, no zig); ``restitution fmu
   build`` and the default FMUs' are every FMU, the native ones for every platform.
@@ -17,8 +17,8 @@ from pathlib import Path
 
 import pytest
 
-from restitution.fmu.build import plan, products, toolchains
-from restitution.fmu.build.progress import Progress
+from restitution.fmu.builders import plan, products, toolchains
+from restitution.fmu.builders.progress import Progress
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -117,7 +117,7 @@ def test_a_dist_the_demo_filled_is_not_the_full_set(demo_dist, monkeypatch):
 def test_a_native_fmu_lacking_a_platform_is_not_the_full_set(tmp_path):
     """fmi3/BouncingBall.fmu built for x86_64-linux alone (gcc: cheap) is up to date for a plan of that
     platform; for the full plan it lacks every platform zig builds here (none without zig)."""
-    from restitution.fmu.build.native import build_native_one
+    from restitution.fmu.builders.native import build_native_one
 
     if shutil.which("gcc") is None:
         pytest.skip("gcc not found: no native FMU is built here")

@@ -40,7 +40,7 @@ import pytest
 
 import restitution as r
 from restitution.agreement import disagreements, tolerances
-from restitution.fmu.build.compile import CFLAGS
+from restitution.fmu.builders.compile import CFLAGS
 
 from binary_formats import read_images
 from cases import FMU_REALS, params_for
@@ -73,7 +73,7 @@ WINE = shutil.which("wine64") or shutil.which("wine") or (
 def fmi_functions(version: str) -> frozenset:
     """The FMI functions of ``version`` ("2.0" or "3.0"): every ``FMIn_Export fmiNxTYPE fmiNx;`` of the
     fmiNFunctions.h fmpy ships."""
-    from restitution.fmu.build.native import NativeBuildSkipped, fmi_include_dir
+    from restitution.fmu.builders.native import NativeBuildSkipped, fmi_include_dir
 
     n = version[0]
     try:
@@ -141,7 +141,7 @@ def test_the_reader_finds_exactly_what_the_compiler_was_told_to_export(tmp_path)
     """tests/c_host/export_probe.c (one exported, one internal function, as the FMUs build them) built for
     every platform of the native FMUs with zig, read back: its platform's format and architecture, and the
     exported function only (beside the Mach-O linker's own)."""
-    from restitution.fmu.build import toolchains
+    from restitution.fmu.builders import toolchains
 
     if toolchains.zig_command() is None:
         pytest.skip(f"zig not found ({toolchains.ZIG_INSTALL})")
@@ -215,8 +215,8 @@ def probe_hosts(tmp_path_factory):
     """build(target, version) -> tests/c_host/fmi_probe_host.c built for ``target`` (x86_64-linux with gcc,
     aarch64-linux with zig, x86_64-windows with mingw-w64 or zig: toolchains' choice) and FMI ``version``,
     once per module; skips naming the missing compiler."""
-    from restitution.fmu.build import toolchains
-    from restitution.fmu.build.native import fmi_include_dir
+    from restitution.fmu.builders import toolchains
+    from restitution.fmu.builders.native import fmi_include_dir
 
     out, built = tmp_path_factory.mktemp("probe_hosts"), {}
 
@@ -331,8 +331,8 @@ def test_zig_windows_dll_from_the_fmus_sources_runs_under_wine(built_fmus, which
                                                                tmp_path):
     """The Windows DLL zig builds from the FMU's sources/ (what the build writes where mingw-w64 is missing;
     built here whatever built the FMU's own) in the probe host under Wine: the package's values, as above."""
-    from restitution.fmu.build import toolchains
-    from restitution.fmu.build.native import fmi_include_dir
+    from restitution.fmu.builders import toolchains
+    from restitution.fmu.builders.native import fmi_include_dir
 
     fmu_path = _implementation(built_fmus, model, which)
     runner = _runner("x86_64-windows")

@@ -242,7 +242,7 @@ def test_fmi3_source_fmus_link_into_one_library_with_prefixes(fmi3_impact_fmu, f
     import shutil
     import subprocess
 
-    from restitution.fmu.build.native import fmi_include_dir
+    from restitution.fmu.builders.native import fmi_include_dir
 
     if shutil.which("gcc") is None or shutil.which("nm") is None:
         pytest.skip("gcc and nm are needed")

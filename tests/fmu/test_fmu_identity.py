@@ -157,7 +157,7 @@ def test_the_generation_date_is_source_date_epoch_or_none():
 
 
 def test_a_malformed_source_date_epoch_stops_the_build_before_it_starts(tmp_path, monkeypatch):
-    from restitution.fmu.build import BuildError, build_one
+    from restitution.fmu.builders import BuildError, build_one
 
     monkeypatch.setenv("SOURCE_DATE_EPOCH", "tomorrow")
     with pytest.raises(BuildError, match="SOURCE_DATE_EPOCH"):
@@ -203,7 +203,7 @@ def builds(built_fmus, tmp_path_factory):
     session = os.environ.get("SOURCE_DATE_EPOCH", "").strip()
     if session in ("", EPOCH):
         out["set" if session else "unset"].append(built_fmus)
-    from restitution.fmu.build import build_all
+    from restitution.fmu.builders import build_all
 
     with pytest.MonkeyPatch.context() as patch:
         for which, value in (("unset", None), ("set", EPOCH)):

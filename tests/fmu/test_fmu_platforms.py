@@ -123,7 +123,7 @@ def test_native_platforms_without_mingw_are_the_built_ones(ball_fmu, fmi_version
     has): with zig, the FMU has every platform, the Windows one built by zig; without zig too (hidden), it
     has the Linux x86-64 binary only. build_info.json declares what was built, and the build says which
     compiler was missing for each platform it skipped and how to install it."""
-    from restitution.fmu.build import native as build_native, toolchains
+    from restitution.fmu.builders import native as build_native, toolchains
 
     if shutil.which("gcc") is None:
         pytest.skip("gcc not found: no native FMU is built here")

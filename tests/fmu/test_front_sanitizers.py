@@ -39,7 +39,7 @@ pytestmark = [
 
 
 def _fmi_headers(version: int):
-    from restitution.fmu.build.native import fmi_include_dir
+    from restitution.fmu.builders.native import fmi_include_dir
 
     return fmi_include_dir(f"{version}.0")
 
@@ -79,7 +79,7 @@ def _sanitized_native(fmu, model, dest):
 def _sanitized_guard(fmu, model, dest):
     """The pythonfmu FMU unpacked, its guard rebuilt with the sanitizers."""
     from restitution.fmu.describe.c_header import c_header
-    from restitution.fmu.build import guard as ms
+    from restitution.fmu.builders import guard as ms
 
     unpacked = _unpack(fmu, dest)
     real = unpacked / "binaries" / "linux64" / f"{model}{ms.REAL_SUFFIX}.so"

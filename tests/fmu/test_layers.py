@@ -15,7 +15,7 @@ import pytest
 PACKAGE = Path(__file__).resolve().parents[2] / "fmu_src" / "restitution"
 FMU = PACKAGE / "fmu"
 #: The layer of each part of restitution.fmu (a subpackage, or a module at its top); higher imports lower.
-LAYERS = {"table": 0, "physics_c": 1, "pythonfmu_guard": 1, "models": 1, "describe": 2, "build": 3, "__init__": 4, "__main__": 4}
+LAYERS = {"table": 0, "physics_c": 1, "pythonfmu_guard": 1, "models": 1, "describe": 2, "builders": 3, "__init__": 4, "__main__": 4}
 
 
 def _imports(path: Path, package: str) -> set[str]:
@@ -70,7 +70,7 @@ def test_the_models_never_reach_the_describers_or_builders():
     """What a pythonfmu FMU bundles (the tables) and the models' own code import nothing of the build."""
     for path in (FMU / "models").rglob("*.py"):
         names = _imports(path, _module_package(path))
-        assert not {n for n in names if _part(n) in ("describe", "build")}, path
+        assert not {n for n in names if _part(n) in ("describe", "builders")}, path
 
 
 @pytest.mark.parametrize("tool, forbidden", [("cosim", ("sweep", "scene")), ("scene", ("sweep",))])

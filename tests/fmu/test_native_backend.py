@@ -21,8 +21,8 @@ import restitution as r
 from restitution.agreement import disagreements, tolerances
 from restitution.fmu.describe.c_header import variables
 from restitution.model import published
-from restitution.fmu.build.native import write_backend
-from restitution.fmu.build.compile import CFLAGS, prepare_sources
+from restitution.fmu.builders.native import write_backend
+from restitution.fmu.builders.compile import CFLAGS, prepare_sources
 
 from cases import FMU_FLAGS, FMU_REALS, NAMES, random_cases
 

@@ -22,8 +22,8 @@ from fmpy import extract
 from fmi_child import run_child
 from independent import INDICATOR_EXTREME, INDICATOR_IN_FLIGHT, assert_indicator
 from restitution.fmu.describe.c_header import variables
-from restitution.fmu.build.native import write_backend
-from restitution.fmu.build.compile import CFLAGS
+from restitution.fmu.builders.native import write_backend
+from restitution.fmu.builders.compile import CFLAGS
 
 pytestmark = pytest.mark.skipif(shutil.which("gcc") is None, reason="gcc is needed to compile the native backend")
 

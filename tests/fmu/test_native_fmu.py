@@ -21,7 +21,7 @@ from hypothesis import strategies as st
 import restitution as r
 from restitution.agreement import disagreements, tolerances
 from restitution.model import published
-from restitution.fmu.build.native import NativeBuildSkipped, front_files
+from restitution.fmu.builders.native import NativeBuildSkipped, front_files
 from restitution.fmu.describe import fmi2
 from restitution.fmu.models import table
 

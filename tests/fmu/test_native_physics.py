@@ -27,7 +27,7 @@ import pytest
 
 import restitution as r
 from restitution.agreement import FLAGS, REALS, disagreements, tolerances
-from restitution.fmu.build.compile import CFLAGS, compile_shared, prepare_sources
+from restitution.fmu.builders.compile import CFLAGS, compile_shared, prepare_sources
 from physics_ctypes import METHOD_CODE, MODE_CODE, MODEL_CODE, UNSUPPORTED, Inputs, NativePhysics, Result
 
 from cases import NAMES, PAIRS, SPEEDS, T_OVER_D, params_for, random_cases

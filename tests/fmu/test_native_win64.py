@@ -38,8 +38,8 @@ import pytest
 
 import restitution as r
 from restitution.agreement import disagreements, tolerances
-from restitution.fmu.build import toolchains
-from restitution.fmu.build.compile import CFLAGS, prepare_sources
+from restitution.fmu.builders import toolchains
+from restitution.fmu.builders.compile import CFLAGS, prepare_sources
 
 from cases import FMU_FLAGS, FMU_REALS, NAMES, params_for, random_cases
 from script_host import ball_me_script, ball_run, build_host, check_ball_run, interface

@@ -14,7 +14,7 @@ from pathlib import Path
 import pytest
 
 import restitution as r
-from restitution.fmu.build import products as fmu_build
+from restitution.fmu.builders import products as fmu_build
 
 ROOT = Path(__file__).resolve().parents[2]
 LOCK = ROOT / "requirements" / "dev.lock"
@@ -86,7 +86,7 @@ def test_a_failed_build_leaves_the_previous_fmu_untouched(built, monkeypatch):
 
 
 def test_staleness_is_decided_by_the_recorded_source_hash(built, monkeypatch):
-    from restitution.fmu.build import plan
+    from restitution.fmu.builders import plan
 
     out, fmu = built
     builds = []
@@ -115,7 +115,7 @@ def test_no_fmu_and_none_buildable_is_one_line_naming_fmu_path(tmp_path):
     (blocker / "pythonfmu.py").write_text("raise ImportError('pythonfmu hidden by the test')\n")
     scene = ROOT / "examples" / "scenes" / "steel_ball_thin_aluminium.toml"
     env = dict(os.environ, PYTHONPATH=str(blocker), XDG_CACHE_HOME=str(tmp_path / "cache"))
-    code = ("import sys, restitution.fmu.build.products as b; b._checkout_dist = lambda: None; "
+    code = ("import sys, restitution.fmu.builders.products as b; b._checkout_dist = lambda: None; "
             "from restitution.scene.__main__ import main; sys.exit(main(sys.argv[1:]))")
     proc = subprocess.run([sys.executable, "-c", code, "run", str(scene), "--out", str(tmp_path / "o")],
                           capture_output=True, text=True, env=env)
@@ -179,7 +179,7 @@ def test_the_build_refuses_a_slave_that_registers_unlike_the_table(built):
     """pythonfmu's binary numbers variables in the order the slave registers them, and the build replaces
     pythonfmu's modelDescription with the table's: a slave registering two variables the other way round
     (as pythonfmu would then describe them) stops the build, naming the first difference."""
-    from restitution.fmu.build import python_fmu
+    from restitution.fmu.builders import python_fmu
 
     _out, fmu = built
     with zipfile.ZipFile(fmu) as z:

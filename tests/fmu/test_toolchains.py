@@ -1,4 +1,4 @@
-"""restitution.fmu.build.toolchains: the platforms of the native FMUs and the compiler of each.
+"""restitution.fmu.builders.toolchains: the platforms of the native FMUs and the compiler of each.
 
 * The table: FMI 3.0 gives each of the five platforms its folder; FMI 2.0 names linux64, win64 and
   darwin64 (both macOS architectures in one file) and no aarch64 Linux folder.
@@ -18,7 +18,7 @@ import zipfile
 
 import pytest
 
-from restitution.fmu.build import toolchains
+from restitution.fmu.builders import toolchains
 
 from binary_formats import read_images
 
@@ -95,7 +95,7 @@ def test_universal_binary(tmp_path):
 def test_builds_are_reproducible(fmi3_ball_fmu, tmp_path):
     """BouncingBall's FMI 3.0 sources compiled twice, from two folders, by every compiler of every platform
     there is here (gcc, mingw-w64, zig): the same bytes."""
-    from restitution.fmu.build.native import fmi_include_dir
+    from restitution.fmu.builders.native import fmi_include_dir
 
     compared = []
     for target in toolchains.PLATFORMS:

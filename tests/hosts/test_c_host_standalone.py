@@ -1,4 +1,4 @@
-"""A pythonfmu FMU post-processed by restitution/fmu/build/guard.py
+"""A pythonfmu FMU post-processed by restitution/fmu/builders/guard.py
 must run in a plain C FMI host (no LD_PRELOAD, no PYTHONPATH/PYTHONHOME, no
 venv, PATH=/usr/bin:/bin), must keep running in Python hosts (fmpy), and must
 fail cleanly (log message + NULL instance) when its interpreter is missing.
@@ -33,7 +33,7 @@ CLEAN_ENV = {"PATH": "/usr/bin:/bin"}
 
 
 def _load_make_standalone():
-    from restitution.fmu.build import guard
+    from restitution.fmu.builders import guard
 
     return guard
 

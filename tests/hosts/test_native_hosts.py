@@ -3,7 +3,7 @@ with the reason where its tool is missing. (The win64 DLL under Wine: tests/fmu/
 
 1. OSP libcosim (libcosimpy): BouncingBall + SpherePlateImpact from the OspSystemStructure.xml that
    examples/two_fmu_cosim.py writes and runs (its ``run_libcosim``), native pair and pythonfmu pair,
-   each in a child process. Checked as tests/tools/test_examples.py checks the pythonfmu pair: five bounces,
+   each in a child process. Checked as tests/docs/test_examples.py checks the pythonfmu pair: five bounces,
    bounce times within 5 steps of the event-exact master (restitution.cosim.bounce on the package),
    the one-step lag visible in the apex, apex heights within what the step allows; and, for every one
    of the five rebounds, the COR applied is the package's for the ball's speed at the last communication
@@ -59,7 +59,7 @@ G = 9.80665
 DROP = 0.3  # [m]
 T_END = 1.0  # [s]
 N_BOUNCES = 5
-STEPS = (1e-2, 1e-3)  # [s] communication steps, as tests/tools/test_examples.py
+STEPS = (1e-2, 1e-3)  # [s] communication steps, as tests/docs/test_examples.py
 #: The ball's parameters in the SSP (ecos): contact_mode 1 waits at the plate for the COR; v_min is not its
 #: default (0.1 m/s), to show that the SSP's parameter set reaches the FMU.
 BALL = {"h0": DROP, "g": G, "contact_mode": 1, "v_min": 0.05}
@@ -114,7 +114,7 @@ def _speeds_before_contacts(time, bounces, n):
 
 
 def _assert_coupled_like_the_reference(result, system, h, resolution=0.0):
-    """The assertions of tests/tools/test_examples.py for libcosim's fixedStep, and the lag for every rebound.
+    """The assertions of tests/docs/test_examples.py for libcosim's fixedStep, and the lag for every rebound.
 
     ``resolution``: how finely the host wrote its values (ecos's CSV: 6 decimals, so 5e-7)."""
     cmp = system["example"].compare(result, system["exact"], N_BOUNCES)

@@ -232,7 +232,7 @@ print("REPORT " + json.dumps(found))
 def native_library(tmp_path_factory):
     if shutil.which("gcc") is None:
         pytest.skip("gcc is needed to compile the native physics")
-    from restitution.fmu.build.compile import compile_shared
+    from restitution.fmu.builders.compile import compile_shared
 
     return compile_shared(tmp_path_factory.mktemp("monitors_native"))
 

@@ -14,7 +14,7 @@ import restitution as r
 from independent import TABLES, printed_equations, table_material, table_rows
 
 #: The paper's presets (Tables 1-3); those from handbooks, appended after them, are checked against their
-#: references in tests/tools/test_handbook_presets.py.
+#: references in tests/cli/test_handbook_presets.py.
 M = {key: m for key, m in r.MATERIALS.items() if m.source.startswith("Green (2022)")}
 
 

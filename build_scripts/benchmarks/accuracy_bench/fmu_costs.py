@@ -60,9 +60,9 @@ FLOOR_FAST_ACCESSORS = '''
 def build_fmus(work: Path) -> dict:
     """Build SpherePlateImpact, BouncingBall and the two trivial FMUs from the working tree."""
     from pythonfmu.builder import FmuBuilder
-    from restitution.fmu.build import FMUS, build_one
+    from restitution.fmu.builders import FMUS, build_one
     from restitution.fmu.models import table
-    from restitution.fmu.build.guard import make_standalone
+    from restitution.fmu.builders.guard import make_standalone
 
     out = {"SpherePlateImpact": build_one("SpherePlateImpact", work)}
     if "BouncingBall" in FMUS:

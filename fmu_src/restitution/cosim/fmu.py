@@ -21,7 +21,7 @@ def build_default_fmu(out_dir: str | Path | None = None, model: str = "SpherePla
                       rebuild: bool = False, log=None, scope: str = "all") -> Path:
     """Path of ``<model>.fmu``, built when missing or stale: :func:`restitution.fmu.default_fmu` (``scope``
     "all": with every other FMU, every platform; "model": that one alone, the pythonfmu FMU)."""
-    from ..fmu.build import default_fmu
+    from ..fmu.builders import default_fmu
 
     return default_fmu(out_dir, model=model, rebuild=rebuild, log=log, scope=scope)
 

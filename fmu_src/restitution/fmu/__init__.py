@@ -9,7 +9,7 @@ same FMUs as a source checkout:
   implementations); ``physics_c/``: the physics in C99; ``pythonfmu_guard/``: the guard's backend that
   forwards checked calls to pythonfmu, and its Python loader for plain C hosts;
 * ``describe/``: every description, header and page written from the tables (pure text);
-* ``build/``: the builders, one per product (pythonfmu, native, the guard), and the entry points.
+* ``builders/``: the builders, one per product (pythonfmu, native, the guard), and the entry points.
 
 The build is imported on first use: the pythonfmu FMUs bundle the interface tables, never the build.
 """
@@ -18,6 +18,6 @@ __all__ = ["FMUS", "BuildError", "build_all", "build_one", "default_fmu", "defau
 
 def __getattr__(name):
     if name in __all__:
-        from . import build
-        return getattr(build, name)
+        from . import builders
+        return getattr(builders, name)
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

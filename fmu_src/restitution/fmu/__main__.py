@@ -8,8 +8,8 @@ import sys
 from pathlib import Path
 
 from ..options import ArgumentParser
-from .build import FMUS, BuildError, build_all, default_fmu_dir
-from .build.progress import stderr_line
+from .builders import FMUS, BuildError, build_all, default_fmu_dir
+from .builders.progress import stderr_line
 
 #: The command's name in its usage line and its errors, however it was started.
 PROG = "restitution fmu"

@@ -409,7 +409,7 @@ def _main(parser, args) -> int:
         parser.error(str(exc))
 
     if backend in ("fmu", "both") and fmu is None:
-        from ..fmu.build import BuildError, default_fmu
+        from ..fmu.builders import BuildError, default_fmu
         try:
             fmu = default_fmu(log=print)
         except BuildError as exc:

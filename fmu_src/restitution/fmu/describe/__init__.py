@@ -9,6 +9,6 @@ alone: no compiler, no pythonfmu, no zip, nothing read from another build.
 * :mod:`.documentation`: ``documentation/index.html``;
 * :mod:`.common`: what they share (generation date and tools, log categories, numbers, units).
 
-The build (:mod:`restitution.fmu.build`) writes these files into the FMUs; two builds of the same
+The build (:mod:`restitution.fmu.builders`) writes these files into the FMUs; two builds of the same
 sources write the same text.
 """

@@ -14,7 +14,7 @@
   the same file.
 
 The license files beside it (``documentation/licenses/``) are the build's
-(:mod:`restitution.fmu.build.licenses`). Pure data in, text out.
+(:mod:`restitution.fmu.builders.licenses`). Pure data in, text out.
 """
 from __future__ import annotations
 

@@ -6,5 +6,5 @@ package (the package is authoritative; tests/fmu/test_native_*.py keep the two t
 * :mod:`.zener_table_header`: writes the C header with the ``exact`` method's Hermite pieces, generated
   at build time from ``restitution/data/zener_table.npz`` (never edited by hand, never committed).
 
-:mod:`restitution.fmu.build.compile` compiles it; the tests call it through ctypes (tests/physics_ctypes.py).
+:mod:`restitution.fmu.builders.compile` compiles it; the tests call it through ctypes (tests/physics_ctypes.py).
 """

@@ -2,7 +2,7 @@
 directory lacks or holds stale; and building a plan, a line per product and platform as it goes.
 
 * :func:`full_plan`: every FMU of the project, the native ones for every platform (what ``python -m
-  restitution.fmu build`` builds, and what :func:`~restitution.fmu.build.products.default_fmu` keeps
+  restitution.fmu build`` builds, and what :func:`~restitution.fmu.builders.products.default_fmu` keeps
   complete by default);
 * :func:`model_plan`: one model's pythonfmu FMU, ``<model>.fmu``: what the Quickstart demo runs, built in
   seconds with no zig (its guard is gcc's, for x86_64-linux, the host);
@@ -174,7 +174,7 @@ def run(plan, out_dir, standalone: bool = True, log=None, progress: Progress | N
     """Build every product of ``plan`` into ``out_dir``, in order; returns the FMUs built. ``log``: every
     line (the progress and the warnings; default stderr, flushed). A native FMU that cannot be built here
     is skipped with a warning (the pythonfmu ones stay usable); a pythonfmu one that cannot be built
-    raises :class:`~restitution.fmu.build.files.BuildError`."""
+    raises :class:`~restitution.fmu.builders.files.BuildError`."""
     from .compile import NativeBuildSkipped
     from .native import build_native_one
 

@@ -167,7 +167,7 @@ def test_cli_user_mistakes_are_one_line_errors(tmp_path, args, words, bouncing_b
 @pytest.fixture(scope="module")
 def bouncing_ball_fmu(tmp_path_factory):
     """An FMU that is not a SpherePlateImpact FMU."""
-    from restitution.fmu.build import build_one
+    from restitution.fmu.builders import build_one
 
     return build_one("BouncingBall", tmp_path_factory.mktemp("ball"), standalone=False)
 

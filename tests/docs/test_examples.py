@@ -385,7 +385,7 @@ def test_the_demo_reuses_up_to_date_fmus_and_rebuilds_stale_ones(built_fmus, tmp
     rebuilt, and that one alone: the demo never builds the other FMUs nor another platform."""
     import shutil
 
-    from restitution.fmu.build import plan, products as fmu_build
+    from restitution.fmu.builders import plan, products as fmu_build
 
     script = (ROOT / "build_scripts" / "quickstart.sh").read_text()
     demo = script[script.index("demo)"):script.index(";;", script.index("demo)"))]

@@ -245,7 +245,7 @@ def test_the_fmu_backend_gives_the_statistics_of_the_package(tmp_path, impact_fm
     for name in ("e", "jgm.e", "zener.e", "v_rebound", "zener.t_contact"):
         for key in ("mean", "std", "p2.5", "p50", "p97.5"):
             # the same cases, which the FMU evaluates with the package bundled in it (the two agree
-            # within 1e-12 case by case, tests/tools/test_sweep.py)
+            # within 1e-12 case by case, tests/sweep/test_sweep.py)
             assert fmu["outputs"][name][key] == pytest.approx(package["outputs"][name][key], rel=1e-9), (name, key)
 
 

@@ -27,7 +27,7 @@ SCOPES = ("all", "model")
 
 def build_all(out_dir: Path, standalone: bool = True, log=None) -> list[Path]:
     """Build every FMU of the project into ``out_dir``: the pythonfmu ones, then the native ones into
-    ``out_dir/fmi2`` and ``out_dir/fmi3``, every platform (:func:`~restitution.fmu.build.plan.full_plan`).
+    ``out_dir/fmi2`` and ``out_dir/fmi3``, every platform (:func:`~restitution.fmu.builders.plan.full_plan`).
     ``log``: the build's lines and warnings (default stderr)."""
     return run(full_plan(), out_dir, standalone=standalone, log=log)
 

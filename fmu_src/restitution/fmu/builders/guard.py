@@ -20,10 +20,10 @@ FMU rebuilds the guard and the configuration file.
 
 Usage::
 
-    from restitution.fmu.build.guard import make_standalone
+    from restitution.fmu.builders.guard import make_standalone
     make_standalone(Path("build/Model.fmu"))            # this interpreter / venv
 
-    python -m restitution.fmu.build.guard build/Model.fmu \
+    python -m restitution.fmu.builders.guard build/Model.fmu \
         [--python /path/to/venv/bin/python] [--require numpy --require scipy]
 """
 from __future__ import annotations
@@ -158,7 +158,7 @@ def _detect_requirements(entries: dict[str, bytes]) -> set[str]:
 
 def _config_text(info: dict, requires: Sequence[str]) -> str:
     lines = [
-        "# Written by restitution.fmu.build.guard.",
+        "# Written by restitution.fmu.builders.guard.",
         "# Read by the FMU's binaries/linux64 guard when the host process has no Python",
         "# (plain C/C++ FMI hosts). Edit the paths to move the FMU to another Python",
         f"# {'.'.join(info['version'].split('.')[:2])} installation; ignored inside Python hosts (fmpy, libcosimpy).",

@@ -11,7 +11,7 @@ sources declared, so a host on another platform can compile ``sources/`` (FMI 3.
 ``sources/buildDescription.xml``); its identity is the table's instantiation token, which the
 pythonfmu FMU of the same interface carries too.
 
-Binaries: every platform of :mod:`restitution.fmu.build.toolchains` (FMI 2.0: linux64, win64, darwin64;
+Binaries: every platform of :mod:`restitution.fmu.builders.toolchains` (FMI 2.0: linux64, win64, darwin64;
 FMI 3.0: x86_64-linux, aarch64-linux, x86_64-windows, x86_64-darwin, aarch64-darwin), Linux x86-64 with
 gcc, Windows with mingw-w64 where installed, the others with zig (the ``ziglang`` package from PyPI). A
 missing compiler skips that binary with a message; with none, no native FMU is written (and the build
@@ -105,7 +105,7 @@ def build_native_one(model: str, out_dir: Path, log=None, fmi_version: str = "2.
     from the package alone; its GUID (FMI 3.0: instantiation token) is the model's
     :meth:`~restitution.fmu.table.Table.instantiation_token`. ``folders``: the binaries/ folders to build
     (default every one of :func:`toolchains.folders`); ``log``: warnings (default stderr); ``progress``: a
-    :class:`~restitution.fmu.build.progress.Progress` told each platform's compilation (default: none)."""
+    :class:`~restitution.fmu.builders.progress.Progress` told each platform's compilation (default: none)."""
     from fmpy.validation import validate_fmu
 
     from .progress import quiet

@@ -10,9 +10,9 @@ the installed ``restitution`` package (the same source ``pip install`` installs)
   registered are the table's, in its order (pythonfmu's binary numbers them by registration; it never
   reads the XML nor compares GUIDs: the guard does, against this one);
 * ``resources/build_info.json`` records a hash of the sources it was built from, which
-  :func:`restitution.fmu.build.products.default_fmu` compares to decide whether an FMU is stale;
+  :func:`restitution.fmu.builders.products.default_fmu` compares to decide whether an FMU is stale;
   ``documentation/`` gets the index page and the licenses;
-* the guard goes in front of pythonfmu's Linux binary (:func:`restitution.fmu.build.guard.make_standalone`:
+* the guard goes in front of pythonfmu's Linux binary (:func:`restitution.fmu.builders.guard.make_standalone`:
   the C FMI front checks every call against the FMI 2.0 state machine and the model's interface table,
   and the binary also loads in plain C hosts; needs gcc, without it the FMU is built for Python hosts
   only, unguarded, and the build says so);
@@ -99,7 +99,7 @@ def build_one(model: str, out_dir: Path, standalone: bool = True, log=None, prog
 
     The FMU is built and validated in a temporary directory inside ``out_dir`` and moved into
     place only then, readable as the umask allows (0644 typically). ``log(message)`` receives
-    warnings (default: stderr); ``progress`` (a :class:`~restitution.fmu.build.progress.Progress`),
+    warnings (default: stderr); ``progress`` (a :class:`~restitution.fmu.builders.progress.Progress`),
     a start and an end line (default: none).
     """
     from .progress import quiet

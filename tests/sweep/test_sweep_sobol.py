@@ -181,7 +181,7 @@ def run_cli(tmp_path, capsys, *extra, name="sobol"):
 @pytest.fixture(scope="module")
 def fmu(tmp_path_factory):
     """The pythonfmu SpherePlateImpact.fmu alone, built from the working tree (seconds)."""
-    from restitution.fmu.build import build_one
+    from restitution.fmu.builders import build_one
 
     return build_one("SpherePlateImpact", tmp_path_factory.mktemp("fmu"))
 

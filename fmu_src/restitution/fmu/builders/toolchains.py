@@ -19,7 +19,7 @@ every platform builds on a machine with only Python and gcc. Where a platform's 
 :func:`compiler` raises :class:`ToolchainMissing` with a one-line reason naming what to install, and the
 build skips that platform.
 
-Every build compiles with the project's flags (:data:`restitution.fmu.build.compile.CFLAGS`: C99, ``-Wall
+Every build compiles with the project's flags (:data:`restitution.fmu.builders.compile.CFLAGS`: C99, ``-Wall
 -Wextra -Werror -pedantic``, no FMA contraction) and includes the FMI headers as system headers
 (``-isystem``: they are the standard's, and clang warns about two unprototyped callback types in the
 FMI 3.0 ones). Only the FMI functions are exported (hidden visibility on ELF and Mach-O; on Windows the

@@ -2,8 +2,8 @@
 s / sqrt(n), Student's t at n - 1 degrees of freedom. The reference is scipy.stats.t.ppf(0.975, n - 1) and
 numpy's std(ddof=1), computed here, at n = 2, 3, 5, 10, where the degrees of freedom matter most: t at n
 instead of n - 1 is 66 % too narrow at n = 2, 26 % at 3, 7 % at 5, 1.5 % at 10 (and 0.2 % at n = 25, 8e-8 at
-4000, the sizes tests/tools/test_sweep_statistics.py looks at). Tolerance 1e-9 relative: rounding only (the
-quantile is computed to ~1e-13, tests/tools/test_sweep_student_t.py; the mean and std by other sums).
+4000, the sizes tests/sweep/test_sweep_statistics.py looks at). Tolerance 1e-9 relative: rounding only (the
+quantile is computed to ~1e-13, tests/sweep/test_sweep_student_t.py; the mean and std by other sums).
 
 Every way the statistics are computed is covered: describe() of one group and of many groups at once (the
 per-grid-point statistics), and a real sweep's summary (mean_ci95 of the whole sweep and of each grid point)."""
