@@ -1,4 +1,4 @@
-"""Run one of build_scripts/benchmarks/ in a process of its own, as a user would: the package from this
+"""Run one of benchmarks/ in a process of its own, as a user would: the package from this
 checkout's fmu_src/ first on PYTHONPATH. What the benchmark tests share; they assert what it prints, never
 its timings."""
 from __future__ import annotations
@@ -9,11 +9,11 @@ import sys
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-BENCHMARKS = ROOT / "build_scripts" / "benchmarks"
+BENCHMARKS = ROOT / "benchmarks"
 
 
 def run_benchmark(name: str, *args: str, cwd: Path, timeout: float, env: dict | None = None):
-    """``python build_scripts/benchmarks/<name> *args`` in ``cwd``, with ``env`` (default: this process's
+    """``python benchmarks/<name> *args`` in ``cwd``, with ``env`` (default: this process's
     environment) and fmu_src/ ahead of its PYTHONPATH: the finished process, output captured as text."""
     env = dict(os.environ if env is None else env)
     env["PYTHONPATH"] = os.pathsep.join(p for p in (str(ROOT / "fmu_src"), env.get("PYTHONPATH")) if p)

@@ -14,7 +14,7 @@ import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "build_scripts"))
-sys.path.insert(0, str(ROOT / "build_scripts" / "benchmarks"))
+sys.path.insert(0, str(ROOT / "benchmarks"))
 sys.path.insert(0, str(ROOT / "tests"))  # the shared helpers, from every folder
 # the slave modules (sphere_plate_impact_slave, ...) and what they share import by name, as in the FMUs
 MODELS = ROOT / "fmu_src" / "restitution" / "fmu" / "models"

@@ -78,7 +78,7 @@ declares (lambda from 0 to ~6e18, tolerance 1e-14 ... 1e-2):
   domain it never fires: the most measured is ~18 000 evaluations (LSODA in
   its Adams mode near lambda = 100, rtol ~ 3e-11; ~0.35 s), ~14 000 for
   DOP853 (lambda = 10, rtol <= 2.2e-14; ~0.2 s); see
-  build_scripts/benchmarks/bench_ode_cost.py and docs/ode_cost.md.
+  benchmarks/bench_ode_cost.py and docs/ode_cost.md.
 * For large lambda the final values are tiny (e_ze ~ 0.679 lambda^-5), so
   the default absolute tolerance scales with that size.
 """

@@ -1,4 +1,4 @@
-"""build_scripts/benchmarks/bench_accuracy.py --quick: it runs, writes its page and plot, and the accuracy
+"""benchmarks/bench_accuracy.py --quick: it runs, writes its page and plot, and the accuracy
 claims it prints hold. Timing is not asserted (machines are noisy): the benchmark's printed
 ratios show the speed goals."""
 import math
@@ -6,7 +6,7 @@ import math
 import numpy as np
 import pytest
 
-import bench_accuracy as bench  # build_scripts/benchmarks/ is on sys.path (conftest.py)
+import bench_accuracy as bench  # benchmarks/ is on sys.path (conftest.py)
 from accuracy_bench.reference import lambda_points, reference_solve
 from restitution.zener import zener_restitution
 from restitution.zener_exact import zener_exact

@@ -1,4 +1,4 @@
-"""build_scripts/benchmarks/bench_ball.py --quick without the Reference FMUs' source: it builds our native
+"""benchmarks/bench_ball.py --quick without the Reference FMUs' source: it builds our native
 BouncingBall (FMI 2.0 and FMI 3.0) and its timing host, runs, says in one line that the Reference ratios are
 skipped, and prints our own figures and the FMI 3.0 / FMI 2.0 ratios beside their goals. Timing is not
 asserted (machines are noisy and shared)."""

@@ -1,4 +1,4 @@
-"""build_scripts/benchmarks/bench_impact.py --quick runs in a process of its own and prints both sides of the
+"""benchmarks/bench_impact.py --quick runs in a process of its own and prints both sides of the
 measurement and their ratio beside the goal; its numpy expression computes what impact() computes (the
 benchmark stops otherwise). No timing is asserted (machines are noisy): the ratio is the benchmark's to print."""
 import re

@@ -1,4 +1,4 @@
-"""build_scripts/benchmarks/bench_native.py --quick: it builds what it times (the floor FMU and the C hosts among
+"""benchmarks/bench_native.py --quick: it builds what it times (the floor FMU and the C hosts among
 them), runs, and writes docs/native_cost.md's page with every row. Timing is not asserted (machines
 are noisy and shared): the page and the printed headline show the measured ratios against the goals."""
 import math
@@ -15,7 +15,7 @@ pytestmark = [
 
 @pytest.fixture(scope="module")
 def quick(tmp_path_factory):
-    import bench_native  # build_scripts/benchmarks/ is on sys.path (conftest.py)
+    import bench_native  # benchmarks/ is on sys.path (conftest.py)
 
     out = tmp_path_factory.mktemp("bench_native")
     return bench_native.run(quick=True, out_dir=out, verbose=False), out

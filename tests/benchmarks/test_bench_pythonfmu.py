@@ -1,4 +1,4 @@
-"""build_scripts/benchmarks/bench_pythonfmu.py --quick, in a child process (it loads a plain pythonfmu FMU, whose
+"""benchmarks/bench_pythonfmu.py --quick, in a child process (it loads a plain pythonfmu FMU, whose
 binary can crash a process at exit): it builds the product FMU and its plain twin, times them and prints
 the ratio beside its goal. Timing is not asserted (machines are noisy and shared): the printed ratio is
 what the benchmark reports."""

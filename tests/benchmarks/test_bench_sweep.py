@@ -1,4 +1,4 @@
-"""The sweep benchmark's goal measurements (build_scripts/benchmarks/sweep_goals.py) on a small sweep:
+"""The sweep benchmark's goal measurements (benchmarks/sweep_goals.py) on a small sweep:
 they run, and the gather they time rebuilds exactly the table the sweep returned. No timing is
 asserted (shared machines are noisy); the ratios are printed by the benchmark."""
 import math

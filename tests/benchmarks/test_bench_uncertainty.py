@@ -1,4 +1,4 @@
-"""build_scripts/benchmarks/bench_uncertainty.py --quick runs in a process of its own and prints every line:
+"""benchmarks/bench_uncertainty.py --quick runs in a process of its own and prints every line:
 both sides of each measurement and their ratio beside the goal, and the two sides of the Monte Carlo
 computed the same statistics of e. No timing is asserted (machines are noisy): the ratios are the
 benchmark's to print."""

@@ -12,7 +12,7 @@ outside restitution.zener_ode:
   [0, 100] and the declared tolerances 1e-14 ... 1e-2, and zero above lambda = 100;
 * the tolerance floor, the work guard and continuity/monotonicity at the switch lambda = 100.
 
-No wall-clock time is asserted anywhere (build_scripts/benchmarks/bench_ode_cost.py measures time).
+No wall-clock time is asserted anywhere (benchmarks/bench_ode_cost.py measures time).
 """
 import math
 import warnings

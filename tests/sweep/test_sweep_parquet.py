@@ -157,7 +157,7 @@ def test_a_killed_run_keeps_its_finished_chunks_and_resume_completes_it(tmp_path
 
 def test_stream_benchmark_runs_quick():
     """bench_sweep_stream.py --quick, in a child process: it prints each goal beside its measurement."""
-    done = subprocess.run([sys.executable, str(ROOT / "build_scripts" / "benchmarks" / "bench_sweep_stream.py"),
+    done = subprocess.run([sys.executable, str(ROOT / "benchmarks" / "bench_sweep_stream.py"),
                            "--quick"], env=ENV, capture_output=True, text=True, timeout=600)
     assert done.returncode == 0, done.stderr
     for goal in ("sweep command / `impact` alone, whole processes, CPU", "the same, wall time",

@@ -2,7 +2,7 @@
 """What model exchange costs a host: the native BouncingBall driven as an integrator drives it, in a plain
 C host (``bench_c/exchange_timing.c``), FMI 2.0 and FMI 3.0 in one run; writes docs/model_exchange_cost.md.
 
-    .venv/bin/python build_scripts/benchmarks/bench_model_exchange.py [--fmu-dir DIR] [--seconds S]
+    .venv/bin/python benchmarks/bench_model_exchange.py [--fmu-dir DIR] [--seconds S]
 
 Per operation, in CPU time of the timing thread (medians of 7 batches of ``--seconds`` each after a
 warm-up): a right-hand-side evaluation (set time, set h and v, get der(h) and der(v)), the event
@@ -14,8 +14,6 @@ built from the working tree into a temporary directory).
 from __future__ import annotations
 
 import argparse
-import os
-import platform
 import subprocess
 import sys
 import tempfile
@@ -25,10 +23,11 @@ from pathlib import Path
 from xml.etree import ElementTree as ET
 
 HERE = Path(__file__).resolve().parent
-ROOT = HERE.parents[1]
+ROOT = HERE.parent
 sys.path.insert(0, str(ROOT / "fmu_src"))
 
 from bench_native_build import compile_host  # noqa: E402
+from harness import machine_line  # noqa: E402
 from restitution.fmu.builders import build_all  # noqa: E402
 from restitution.fmu.builders.native import fmi_include_dir  # noqa: E402
 
@@ -64,8 +63,8 @@ def page(results: dict, seconds: float) -> str:
     lines = [
         "# What model exchange costs (native BouncingBall)",
         "",
-        f"Written by `build_scripts/benchmarks/bench_model_exchange.py` on {date.today().isoformat()} "
-        f"({platform.machine()}, {os.cpu_count()} CPUs; batches of {seconds:g} s of CPU time, medians of 7). "
+        f"Written by `benchmarks/bench_model_exchange.py` on {date.today().isoformat()} "
+        f"({machine_line()}; batches of {seconds:g} s of CPU time, medians of 7). "
         "A plain C host (`bench_c/exchange_timing.c`) loads the native FMU's Linux binary and drives it as an "
         "integrator does; FMI 2.0 and FMI 3.0 in the same run.",
         "",

@@ -1,7 +1,7 @@
 """What a sweep costs beside the model it evaluates: the sweep command against ``impact`` alone, as
 whole processes, and ``run_sweep`` against ``impact`` in one process; writes its block in docs/performance.md.
 
-    .venv/bin/python build_scripts/benchmarks/bench_sweep_stream.py [--cases N] [--runs R] [--no-write] [--quick]
+    .venv/bin/python benchmarks/bench_sweep_stream.py [--cases N] [--runs R] [--no-write] [--quick]
 
 * Command line, whole processes, taken in turn (A B A B ...): ``python -m restitution.sweep`` over
   ``--cases`` cases (one material pair, approach speed x t/d, serially, the table written as Parquet
@@ -12,7 +12,7 @@ whole processes, and ``run_sweep`` against ``impact`` in one process; writes its
   their median quoted. Goal: <= 2.5x.
 * In one process, CPU time of this thread: ``run_sweep`` (serial, the whole table gathered in memory)
   against ``impact`` on the arrays the sweep hands it, on one material pair and on two, in turn, the
-  least of each (build_scripts/benchmarks/sweep_goals.py, ``sweep_over_model``), and on one pair over
+  least of each (benchmarks/sweep_goals.py, ``sweep_over_model``), and on one pair over
   ten times the cases (chunks copied into the table). Goal: <= 2x.
 
 Ratios are what counts on a shared machine: both sides of each are measured in the same run.
@@ -32,8 +32,8 @@ import tempfile
 import time
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT / "build_scripts" / "benchmarks"))
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "benchmarks"))
 DOC = ROOT / "docs" / "performance.md"
 BEGIN, END = "<!-- bench_sweep_stream:begin -->", "<!-- bench_sweep_stream:end -->"
 PAIR = "s2_tool_steel/al_6061"
@@ -46,6 +46,7 @@ IMPACT_ALONE = """
 import json, sys
 import numpy as np
 import restitution
+from harness import cpu_name
 grid = json.load(open(sys.argv[1]))
 v = np.repeat(np.geomspace(*grid["v"][:2], int(grid["v"][2])), int(grid["t_over_d"][2]))
 t_over_d = np.tile(np.geomspace(*grid["t_over_d"][:2], int(grid["t_over_d"][2])), int(grid["v"][2]))
@@ -136,8 +137,8 @@ def lines(cli: dict, inproc: dict, load: tuple) -> list[str]:
         return "yes" if value <= goal else "**no**"
 
     out = [
-        f"Measured {time.strftime('%Y-%m-%d')} by `build_scripts/benchmarks/bench_sweep_stream.py` on {os.cpu_count()} "
-        f"cores ({platform.processor() or platform.machine()}), Python {platform.python_version()}, numpy "
+        f"Measured {time.strftime('%Y-%m-%d')} by `benchmarks/bench_sweep_stream.py` on {os.cpu_count()} "
+        f"cores ({cpu_name()}), Python {platform.python_version()}, numpy "
         f"{np.__version__}, pyarrow {pyarrow.__version__}; load average (1 min) before / after {load[0]:.2f} / "
         f"{load[1]:.2f} (a shared machine: ratios, both sides measured in this run, are what counts).",
         "",

@@ -1,7 +1,7 @@
 #!/usr/bin/env python
 """What a calibration from a drop test costs (restitution.fit), and optionally how often its intervals hold the truth.
 
-    .venv/bin/python build_scripts/benchmarks/bench_fit.py [--reps N] [--seed N] [--coverage N]
+    .venv/bin/python benchmarks/bench_fit.py [--reps N] [--seed N] [--coverage N]
         [--coverage-bayes M] [--drag] [--write]
 
 The data are made here, with a fixed seed, from known parameters: a chrome-steel ball (d = 6.35 mm)
@@ -12,7 +12,7 @@ every fit starts). The plate yields first, so plate.Sy is the parameter fitted:
 * one drop from h0 = 0.3 m: the impacts while the interval between them is 5 ms or more (17), each
   time with 30 us of Gaussian jitter.
 
-Measured, in one run, the variants interleaved batch by batch (accuracy_bench.timing: CPU time of
+Measured, in one run, the variants interleaved batch by batch (harness.py: CPU time of
 this thread, ``time.thread_time``, so other jobs on a shared machine do not inflate it; medians over
 ``--reps`` batches):
 
@@ -42,16 +42,17 @@ from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parents[2]
-for _p in (ROOT / "fmu_src", ROOT / "build_scripts" / "benchmarks"):
+ROOT = Path(__file__).resolve().parents[1]
+for _p in (ROOT / "fmu_src", ROOT / "benchmarks"):
     if str(_p) not in sys.path:
         sys.path.insert(0, str(_p))
 
 import restitution as r  # noqa: E402
-from accuracy_bench.timing import interleaved, median, median_ratio, settle_allocator  # noqa: E402
+from harness import interleaved, median, median_ratio, settle_allocator  # noqa: E402
 from restitution.fit.datasets import ImpactTimes, ReboundPairs  # noqa: E402
 from restitution.fit.estimate import base_of, fit_parameters  # noqa: E402
 from restitution.fit.posterior import sample_posterior  # noqa: E402
+from harness import cpu_name  # noqa: E402
 
 DOC = ROOT / "docs" / "performance.md"
 BEGIN, END = "<!-- bench_fit:begin -->", "<!-- bench_fit:end -->"
@@ -195,7 +196,7 @@ def report(c: dict, cov: dict | None, drag: list | None, args, n_pairs: int, n_t
     ms = 1e3
     ev = c["evaluations"]
     lines = [
-        f"bench_fit.py on {time.strftime('%Y-%m-%d')}: {platform.processor() or platform.machine()}, "
+        f"bench_fit.py on {time.strftime('%Y-%m-%d')}: {cpu_name()}, "
         f"{os.cpu_count()} cores (shared), Python {platform.python_version()}, numpy {np.__version__}, "
         f"load average {os.getloadavg()[0]:.1f}; CPU time of this thread, medians of {args.reps} interleaved "
         f"batches; seed {args.seed}; {wall:.0f} s",

@@ -1,7 +1,7 @@
 #!/usr/bin/env python
 """What accuracy costs in time: measure every accuracy choice and write docs/accuracy.md.
 
-    .venv/bin/python build_scripts/benchmarks/bench_accuracy.py [--quick] [--out DIR] [--jobs N]
+    .venv/bin/python benchmarks/bench_accuracy.py [--quick] [--out DIR] [--jobs N]
 
 writes DIR/accuracy.md (Markdown tables) and DIR/img/accuracy_cost.png (error against cost,
 log-log); DIR defaults to docs/. ``--quick`` (a minute or so, used by the tests) measures
@@ -45,8 +45,8 @@ from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parents[2]
-for _p in (ROOT / "fmu_src", ROOT / "build_scripts" / "benchmarks"):
+ROOT = Path(__file__).resolve().parents[1]
+for _p in (ROOT / "fmu_src", ROOT / "benchmarks"):
     if str(_p) not in sys.path:
         sys.path.insert(0, str(_p))
 
@@ -55,10 +55,10 @@ from accuracy_bench.config import FULL, QUICK, RANGES, TARGETS  # noqa: E402
 from accuracy_bench.fmu_costs import build_fmus, fmu_costs  # noqa: E402
 from accuracy_bench.jgm_fits import jgm_fits  # noqa: E402
 from accuracy_bench.model_costs import model_costs  # noqa: E402
-from accuracy_bench.page import headline, machine_info, markdown  # noqa: E402
+from accuracy_bench.page import headline, markdown  # noqa: E402
+from harness import machine, settle_allocator  # noqa: E402
 from accuracy_bench.plot import plot  # noqa: E402
 from accuracy_bench.reference import lambda_points, reference_many  # noqa: E402
-from accuracy_bench.timing import settle_allocator  # noqa: E402
 from accuracy_bench.zener_costs import method_list, zener_accuracy, zener_scalar_costs, zener_vector_costs  # noqa: E402
 
 
@@ -74,7 +74,7 @@ def run(quick: bool = False, out_dir: Path | None = None, jobs: int | None = Non
             print(f"[{time.perf_counter() - start:6.1f} s] {msg}", flush=True)
 
     settle_allocator()
-    res = {"machine": machine_info(), "methods": method_list(cfg), "n_vector": cfg.n_vector,
+    res = {"machine": machine(), "methods": method_list(cfg), "n_vector": cfg.n_vector,
            "n_vector_ode": cfg.n_vector_ode}
     lams = lambda_points(cfg)
     say(f"reference: Radau rtol 1e-13 at {sum(len(x) for x in lams.values())} lambdas on {jobs} processes")

@@ -1,7 +1,7 @@
 #!/usr/bin/env python
 """What our native BouncingBall's FMI front costs, beside the Modelica Reference FMUs' BouncingBall.
 
-    .venv/bin/python build_scripts/benchmarks/bench_ball.py [--reference-fmus DIR] [--quick] [--page]
+    .venv/bin/python benchmarks/bench_ball.py [--reference-fmus DIR] [--quick] [--page]
 
 Times, interleaved in one plain C host (``bench_c/ball_timing.c``, CPU time of its thread), one co-simulation
 step (DoStep over 1 ms, the Reference ball's internal solver step, then Get of h and v) and one
@@ -23,7 +23,6 @@ from __future__ import annotations
 
 import argparse
 import os
-import platform
 import re
 import shutil
 import statistics
@@ -34,13 +33,14 @@ from datetime import datetime, timezone
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
-ROOT = HERE.parents[1]
+ROOT = HERE.parent
 if str(ROOT / "fmu_src") not in sys.path:
     sys.path.insert(0, str(ROOT / "fmu_src"))
 if str(HERE) not in sys.path:
     sys.path.insert(0, str(HERE))
 
 from bench_native_build import compile_host  # noqa: E402
+from harness import machine_line  # noqa: E402
 
 MODEL = "BouncingBall"
 HOST = HERE / "bench_c" / "ball_timing.c"
@@ -127,17 +127,6 @@ def reference_commit(source: Path) -> str:
     return done.stdout.strip() if done.returncode == 0 else "not a git checkout: commit unknown"
 
 
-def machine() -> str:
-    """The machine as the page names it: architecture, CPU model (Linux), CPU count."""
-    model = ""
-    try:
-        model = next((line.split(":", 1)[1].strip() for line in Path("/proc/cpuinfo").read_text().splitlines()
-                      if line.startswith("model name")), "")
-    except OSError:
-        pass
-    return ", ".join(x for x in (platform.machine(), model or platform.processor(), f"{os.cpu_count()} CPUs") if x)
-
-
 def run_host(host: Path, fmus: dict, settings: dict, hv: dict, seconds: float, reps: int) -> dict:
     """(label, operation) -> [seconds per operation, one per repetition]."""
     cmd = [str(host), repr(seconds), str(reps)]
@@ -187,9 +176,9 @@ def page(lines: list[str], seconds: float, reps: int, command: str, reference: s
     return "\n".join([
         "# What the C front costs a BouncingBall",
         "",
-        f"Written by `build_scripts/benchmarks/bench_ball.py` on {when} ({machine()}, shared with other work: "
+        f"Written by `benchmarks/bench_ball.py` on {when} ({machine_line()}, shared with other work: "
         f"only the ratios, measured interleaved in one run, count; {reps} repetitions of {seconds:g} s batches "
-        f"of thread CPU time), with `{command}`. The host (`build_scripts/benchmarks/bench_c/ball_timing.c`) "
+        f"of thread CPU time), with `{command}`. The host (`benchmarks/bench_c/ball_timing.c`) "
         "loads each binary with dlopen and makes the same calls with the same arguments on each; see the "
         f"script's docstring. Reference FMUs: {reference}.",
         "",

@@ -1,4 +1,4 @@
-/* The C wrapper floor (build_scripts/benchmarks/bench_native_build.py): the project's C front with a backend
+/* The C wrapper floor (benchmarks/bench_native_build.py): the project's C front with a backend
  * that does nothing. Same hooks as the native glue; outputs are constants. */
 #include "rst_front.h"
 

@@ -1,4 +1,4 @@
-"""What build_scripts/benchmarks/bench_native.py times, built into a scratch directory.
+"""What benchmarks/bench_native.py times, built into a scratch directory.
 
 * the pythonfmu ``SpherePlateImpact.fmu`` (behind the project's C guard), the native one
   (``fmi2/SpherePlateImpact.fmu``, FMI 2.0) and the native FMI 3.0 one (``fmi3/SpherePlateImpact.fmu``: the
@@ -25,7 +25,7 @@ import zipfile
 from dataclasses import dataclass
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = Path(__file__).resolve().parents[1]
 if str(ROOT / "fmu_src") not in sys.path:
     sys.path.insert(0, str(ROOT / "fmu_src"))
 

@@ -1,7 +1,7 @@
 #!/usr/bin/env python
 """What one impact costs in the native SpherePlateImpact FMU: write docs/native_cost.md.
 
-    .venv/bin/python build_scripts/benchmarks/bench_native.py [--quick] [--out DIR]
+    .venv/bin/python benchmarks/bench_native.py [--quick] [--out DIR]
 
 builds, in a scratch directory, the pythonfmu FMU (behind the C guard), the native FMU, a *floor*
 FMU (the same C front and generated interface table with a backend that does nothing) and two C
@@ -29,50 +29,24 @@ from __future__ import annotations
 import argparse
 import datetime
 import os
-import platform
 import statistics
-import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[2]
-for _p in (ROOT / "fmu_src", ROOT / "build_scripts" / "benchmarks"):
+ROOT = Path(__file__).resolve().parents[1]
+for _p in (ROOT / "fmu_src", ROOT / "benchmarks"):
     if str(_p) not in sys.path:
         sys.path.insert(0, str(_p))
 
 import bench_native_build as build  # noqa: E402
 import bench_native_page as page  # noqa: E402
 import bench_native_timing as timing  # noqa: E402
+from harness import machine  # noqa: E402
 
 #: name -> (repeats, CPU seconds per batch)
 CONFIGS = {"full": (11, 0.2), "quick": (3, 0.02)}
-
-
-def machine() -> dict:
-    cpu = platform.processor() or platform.machine()
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    versions = [f"Python {platform.python_version()}"]
-    try:
-        import fmpy
-
-        versions.append(f"fmpy {fmpy.__version__}")
-    except ImportError:
-        pass
-    try:
-        gcc = subprocess.run(["gcc", "-dumpfullversion"], capture_output=True, text=True).stdout.strip()
-        versions.append(f"gcc {gcc}")
-    except OSError:
-        pass
-    return {"cpu": cpu, "cores": os.cpu_count(), "versions": ", ".join(versions), "platform": platform.platform(),
-            "load_start": os.getloadavg()[0]}
 
 
 def run(quick: bool = False, out_dir: Path | None = None, verbose: bool = True) -> dict:

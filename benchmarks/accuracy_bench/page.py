@@ -2,34 +2,11 @@
 from __future__ import annotations
 
 import math
-import os
-import platform
-import time
 
 from restitution.fmu.models import table
 from restitution.zener import TAU0_HERTZ
 
 from .config import RANGES, TARGETS
-
-
-def machine_info() -> dict:
-    cpu = platform.processor() or platform.machine()
-    try:
-        with open("/proc/cpuinfo") as f:
-            for line in f:
-                if line.lower().startswith("model name"):
-                    cpu = line.split(":", 1)[1].strip()
-                    break
-    except OSError:
-        pass
-    versions = {}
-    for mod in ("numpy", "scipy", "fmpy", "pythonfmu"):
-        try:
-            versions[mod] = __import__(mod).__version__
-        except Exception:  # noqa: BLE001 - reporting only
-            versions[mod] = "?"
-    return {"cpu": cpu, "cores": os.cpu_count(), "python": platform.python_version(),
-            "platform": platform.platform(), **versions, "date": time.strftime("%Y-%m-%d")}
 
 
 def _f(x, digits=1) -> str:
@@ -86,11 +63,11 @@ def markdown(res: dict, cfg_name: str, elapsed: float) -> str:
     lines = [
         "# What accuracy costs in time",
         "",
-        "Measured by `build_scripts/benchmarks/bench_accuracy.py`" + (" `--quick`" if cfg_name == "quick" else "")
+        "Measured by `benchmarks/bench_accuracy.py`" + (" `--quick`" if cfg_name == "quick" else "")
         + f" on {m['date']} ({elapsed / 60:.1f} min). Rerun it to measure your machine:",
         "",
         "```sh",
-        ".venv/bin/python build_scripts/benchmarks/bench_accuracy.py   # writes docs/accuracy.md and docs/img/accuracy_cost.png",
+        ".venv/bin/python benchmarks/bench_accuracy.py   # writes docs/accuracy.md and docs/img/accuracy_cost.png",
         "```",
         "",
         f"Machine: {m['cpu']}, {m['cores']} cores; Python {m['python']}, numpy {m['numpy']}, scipy {m['scipy']}, "
@@ -271,7 +248,7 @@ def markdown(res: dict, cfg_name: str, elapsed: float) -> str:
         "and falls when the scalar path gets faster. Vectorized cost per case grows a little with lambda's "
         "spread (lambda up to 100 in random order reads the `exact` table from more of memory). The timings "
         "start once glibc's allocator is in the state of a long-running process "
-        "(`accuracy_bench.timing.settle_allocator`).",
+        "(`harness.settle_allocator`).",
     ]
     for k in missed:
         if k == "fmu_over_floor":

@@ -1,6 +1,6 @@
 """Measure design-space sweep throughput and write the table in docs/performance.md.
 
-    .venv/bin/python build_scripts/benchmarks/bench_sweep.py [--no-write] [--fmu-cases N] [--package-cases N]
+    .venv/bin/python benchmarks/bench_sweep.py [--no-write] [--fmu-cases N] [--package-cases N]
 
 Builds SpherePlateImpact.fmu from the working tree into a temporary directory, then measures
 
@@ -12,7 +12,7 @@ Builds SpherePlateImpact.fmu from the working tree into a temporary directory, t
   37 columns (all inputs and outputs) and gathers them to this process, as ``run_sweep`` does by
   default. Worker start-up and the first FMU load are done before timing (reported apart).
 
-Then the goals (build_scripts/benchmarks/sweep_goals.py): sweep / model per case, serially and per
+Then the goals (benchmarks/sweep_goals.py): sweep / model per case, serially and per
 Dask worker, and Parquet write / gather of the table.
 
 Scaling efficiency = rate(2 workers) / (2 x rate(1 worker)). Cost per case: wall time per case
@@ -34,9 +34,10 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+from harness import cpu_name
 
-ROOT = Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT / "build_scripts" / "benchmarks"))
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "benchmarks"))
 DOC = ROOT / "docs" / "performance.md"
 BEGIN, END = "<!-- bench_sweep:begin -->", "<!-- bench_sweep:end -->"
 
@@ -230,8 +231,8 @@ def main(argv=None) -> int:
     cpu = {(r["path"], r["where"], r["workers"]): r["total_cpu"] for r in rows}
     cpu_eff = {p: cpu[(p, "Dask LocalCluster", 1)] / cpu[(p, "Dask LocalCluster", 2)] for p in ("package", "fmu")}
     lines = [
-        f"Measured {time.strftime('%Y-%m-%d')} by `build_scripts/benchmarks/bench_sweep.py` on {machine_workers()} cores "
-        f"({platform.processor() or platform.machine()}), Python {platform.python_version()}, numpy {np.__version__}, "
+        f"Measured {time.strftime('%Y-%m-%d')} by `benchmarks/bench_sweep.py` on {machine_workers()} cores "
+        f"({cpu_name()}), Python {platform.python_version()}, numpy {np.__version__}, "
         f"dask {dask.__version__}, fmpy {fmpy.__version__}. Sweep: 2 material pairs x approach speed x t/d "
         f"(40 values); the full 37-column table is gathered. Load average (1 min) before / after: "
         f"{load_before:.2f} / {load_after:.2f}.",

@@ -1,4 +1,4 @@
-"""The timings of build_scripts/benchmarks/bench_native.py: interleaved batches, medians, ratios.
+"""The timings of benchmarks/bench_native.py: interleaved batches, medians, ratios.
 
 Every comparison runs its variants in turn, batch by batch (the first variant rotating from one
 repeat to the next), so that a ratio compares batches run close together in time; a ratio is the

@@ -1,7 +1,7 @@
 #!/usr/bin/env python
 """What the uncertainty tools of a sweep cost: a Monte Carlo with ``--summary``, and ``--sobol``.
 
-    .venv/bin/python build_scripts/benchmarks/bench_uncertainty.py [--samples N] [--reps N] [--runs N]
+    .venv/bin/python benchmarks/bench_uncertainty.py [--samples N] [--reps N] [--runs N]
         [--sobol-n N] [--quick]
 
 Measured in one run, each ratio's two sides interleaved (A B A B ...), medians:
@@ -48,8 +48,8 @@ import tempfile
 import time
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[2]
-for _p in (ROOT / "fmu_src", ROOT / "build_scripts" / "benchmarks"):
+ROOT = Path(__file__).resolve().parents[1]
+for _p in (ROOT / "fmu_src", ROOT / "benchmarks"):
     if str(_p) not in sys.path:
         sys.path.insert(0, str(_p))
 
@@ -65,6 +65,7 @@ PLAIN = """\
 import json, sys
 import numpy as np
 import restitution
+from harness import cpu_name
 N, SEED, BLOCK, DISTS, BASE, FIXED = {n}, {seed}, {block}, {dists!r}, {base!r}, {fixed!r}
 draws = {{k: np.empty(N) for k in DISTS}}
 for b in range(-(-N // BLOCK)):
@@ -120,7 +121,7 @@ def _median(xs) -> float:
 def mc_in_process(samples: int, reps: int) -> dict:
     import numpy as np
     import restitution
-    from accuracy_bench.timing import settle_allocator
+    from harness import settle_allocator
     from restitution.sweep import run_sweep
     from restitution.sweep.statistics import SweepStatistics
 
@@ -301,7 +302,7 @@ def main(argv=None) -> int:
 
     t_all = time.perf_counter()
     load = os.getloadavg()[0]
-    print(f"bench_uncertainty.py on {time.strftime('%Y-%m-%d')}: {platform.processor() or platform.machine()}, "
+    print(f"bench_uncertainty.py on {time.strftime('%Y-%m-%d')}: {cpu_name()}, "
           f"{os.cpu_count()} cores (shared), Python {platform.python_version()}, numpy {np.__version__}, "
           f"load average {load:.1f}{' (--quick: small sizes, not the figures to quote)' if args.quick else ''}")
     n = args.samples

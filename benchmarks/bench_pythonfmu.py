@@ -1,7 +1,7 @@
 #!/usr/bin/env python
 """What the pythonfmu SpherePlateImpact FMU costs per step beyond a plain pythonfmu FMU.
 
-    .venv/bin/python build_scripts/benchmarks/bench_pythonfmu.py [--quick] [--work DIR]
+    .venv/bin/python benchmarks/bench_pythonfmu.py [--quick] [--work DIR]
 
 Builds, in a scratch directory (``--work``, default a temporary one):
 
@@ -41,12 +41,12 @@ import time
 import zipfile
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[2]
-for _p in (ROOT / "fmu_src", ROOT / "build_scripts" / "benchmarks"):
+ROOT = Path(__file__).resolve().parents[1]
+for _p in (ROOT / "fmu_src", ROOT / "benchmarks"):
     if str(_p) not in sys.path:
         sys.path.insert(0, str(_p))
 
-from accuracy_bench.timing import interleaved, median, median_ratio  # noqa: E402
+from harness import interleaved, median, median_ratio  # noqa: E402
 
 MODEL = "SpherePlateImpact"
 TWIN = "PlainSpherePlateImpact"
@@ -62,6 +62,7 @@ from types import SimpleNamespace
 
 from pythonfmu import Fmi2Causality, Fmi2Slave, Fmi2Variability, Boolean, Integer, Real
 from pythonfmu.enums import Fmi2Initial
+from harness import cpu_name  # noqa: E402
 
 #: (name, type, causality, variability, value): the interface table's rows, outputs given a constant
 VARIABLES = {rows!r}
@@ -256,7 +257,7 @@ def report(res: dict, quick: bool) -> str:
     us = 1e6
     rt = res["round_trip"]
     lines = [f"bench_pythonfmu ({'quick' if quick else 'full'} run, {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}, "
-             f"{platform.node()}, {platform.processor() or platform.machine()}, {os.cpu_count()} cpus)",
+             f"{platform.node()}, {cpu_name()}, {os.cpu_count()} cpus)",
              "host: this Python process, fmpy's ctypes functions called raw; CPU time of the thread",
              "round trip (set v_approach, doStep, get every Real and Boolean output):",
              f"  product (guard + pythonfmu + slave + physics) {rt['product'] * us:8.2f} us",

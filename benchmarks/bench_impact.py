@@ -1,7 +1,7 @@
 #!/usr/bin/env python
 """What ``restitution.impact`` costs on an array of cases, against a plain numpy expression of the same equations.
 
-    .venv/bin/python build_scripts/benchmarks/bench_impact.py [--cases N] [--repeats N] [--quick]
+    .venv/bin/python benchmarks/bench_impact.py [--cases N] [--repeats N] [--quick]
 
 One sphere/plate pair (S2 tool steel, d = 6.35 mm, on Al 6061), ``--cases`` cases (default 10^6) with
 random approach speeds (0.005 ... 20 m/s, log-uniform: V_c = 0.026 m/s, so both branches of Eq. (8)) and
@@ -35,8 +35,9 @@ from importlib.resources import files
 from pathlib import Path
 
 import numpy as np
+from harness import cpu_name
 
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = Path(__file__).resolve().parents[1]
 if str(ROOT / "fmu_src") not in sys.path:
     sys.path.insert(0, str(ROOT / "fmu_src"))
 
@@ -170,7 +171,7 @@ def main(argv=None) -> None:
     args = parser.parse_args(argv)
     sizes = [10_000] if args.quick else (args.cases or [1_000_000])
     repeats = 3 if args.quick else args.repeats
-    print(f"bench_impact.py on {datetime.now(timezone.utc):%Y-%m-%d %H:%M} UTC: {platform.processor() or platform.machine()}"
+    print(f"bench_impact.py on {datetime.now(timezone.utc):%Y-%m-%d %H:%M} UTC: {cpu_name()}"
           f", {len(__import__('os').sched_getaffinity(0))} cores; Python {platform.python_version()}, numpy {np.__version__}; "
           f"{SPHERE} d = {DIAMETER * 1e3:g} mm on {PLATE}, default options, {repeats} interleaved turns, thread CPU time")
     for n in sizes:

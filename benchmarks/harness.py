@@ -1,9 +1,50 @@
-"""The timing harness: variants interleaved batch by batch, CPU time of this thread, medians and
-median ratios (ratios compare like with like on a shared, noisy machine)."""
+"""The benchmarks' one harness: the machine a figure was measured on, and the timing (variants
+interleaved batch by batch, CPU time of this thread, medians and median ratios: ratios compare like with
+like on a shared, noisy machine). Every benchmark in this folder describes its machine and times through
+here."""
 from __future__ import annotations
 
+import os
+import platform
 import statistics
+import subprocess
 import time
+from pathlib import Path
+
+
+def cpu_name() -> str:
+    """The CPU's model name (Linux's /proc/cpuinfo), else what the platform module knows."""
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.lower().startswith("model name"):
+                return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor() or platform.machine()
+
+
+def machine() -> dict:
+    """The machine a run measured on: CPU, cores, platform, the versions that bear on the figures, the
+    date and the load average at the start (a shared machine's load is part of every figure)."""
+    versions = {"python": platform.python_version()}
+    for module in ("numpy", "scipy", "fmpy", "pythonfmu"):
+        try:
+            versions[module] = __import__(module).__version__
+        except Exception:  # noqa: BLE001 - reporting only: a missing or broken package is "?"
+            versions[module] = "?"
+    try:
+        versions["gcc"] = subprocess.run(["gcc", "-dumpfullversion"], capture_output=True,
+                                         text=True).stdout.strip() or "?"
+    except OSError:
+        versions["gcc"] = "?"
+    line = ", ".join(f"{'Python' if k == 'python' else k} {v}" for k, v in versions.items() if v != "?")
+    return {"cpu": cpu_name(), "cores": os.cpu_count(), "platform": platform.platform(), **versions,
+            "versions": line, "date": time.strftime("%Y-%m-%d"), "load_start": os.getloadavg()[0]}
+
+
+def machine_line() -> str:
+    """The machine in one phrase for a page: architecture, CPU model, CPU count."""
+    return ", ".join(x for x in (platform.machine(), cpu_name(), f"{os.cpu_count()} CPUs") if x)
 
 
 def clock() -> float:

@@ -1,4 +1,4 @@
-/* The precomputed C floor (build_scripts/benchmarks/bench_native_build.py): what one impact costs with no
+/* The precomputed C floor (benchmarks/bench_native_build.py): what one impact costs with no
  * FMI at all and the least work the physics allows: the parameter-only terms computed once
  * (rst_impact_terms_of), the speed-dependent work per impact (rst_impact_with_terms). The timing host runs
  * it as one of its variants, batches interleaved with the FMUs'. */

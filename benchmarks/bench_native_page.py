@@ -1,4 +1,4 @@
-"""The page build_scripts/benchmarks/bench_native.py writes (docs/native_cost.md) and the table it prints."""
+"""The page benchmarks/bench_native.py writes (docs/native_cost.md) and the table it prints."""
 from __future__ import annotations
 
 import math
@@ -118,11 +118,11 @@ def render(res: dict) -> str:
     lines = [
         "# What the native FMU costs",
         "",
-        f"Measured by `build_scripts/benchmarks/bench_native.py` on {res['date']} ({res['duration']:.0f} s, "
+        f"Measured by `benchmarks/bench_native.py` on {res['date']} ({res['duration']:.0f} s, "
         f"{cfg['name']} run). Generated: rerun it to measure your machine:",
         "",
         "```sh",
-        ".venv/bin/python build_scripts/benchmarks/bench_native.py   # writes docs/native_cost.md; --quick for a short run",
+        ".venv/bin/python benchmarks/bench_native.py   # writes docs/native_cost.md; --quick for a short run",
         "```",
         "",
         f"Machine: {m['cpu']}, {m['cores']} cores; {m['versions']}; {m['platform']}.",
@@ -152,14 +152,14 @@ def render(res: dict) -> str:
         "arrays (as `tests/fmu/test_fmu_robustness.py`'s million-step test calls them). The *floor* is an FMU "
         "with the same modelDescription built from the same C front (`fmu_src/restitution/fmu/cfront/`), the "
         "same generated interface table and the same compiler flags as the native FMU, with a backend that "
-        "does nothing (every hook returns at once, outputs are constants: `build_scripts/benchmarks/bench_c/floor_fmu.c`): "
+        "does nothing (every hook returns at once, outputs are constants: `benchmarks/bench_c/floor_fmu.c`): "
         "native / floor is what the physics and its glue add to what the front and fmpy cost.",
         "",
         *_fmu_table(res["fmpy"], "floor", FMU_NOTE),
         "",
         "## In a plain C host",
         "",
-        "A C timing host (`build_scripts/benchmarks/bench_c/timing_host.c`: dlopen of the FMU binary, the four calls in a loop, "
+        "A C timing host (`benchmarks/bench_c/timing_host.c`: dlopen of the FMU binary, the four calls in a loop, "
         "`clock_gettime`) run under `env -i PATH=/usr/bin:/bin` as `tests/hosts/test_c_host_impact.py` runs its "
         "host, all four FMUs instantiated in the one process; the pythonfmu FMU's guard starts the "
         "interpreter recorded in `resources/python_env.txt`. `fmi3` is the native FMI 3.0 FMU "
@@ -186,7 +186,7 @@ def render(res: dict) -> str:
         "",
         "One impact as a simulation uses it: `fmi2SetReal` of `v_approach`, `fmi2DoStep`, `fmi2GetReal` of `e` and "
         "`v_rebound` (no `fmi2GetBoolean`), in the same C host, against the *precomputed C floor* "
-        "(`build_scripts/benchmarks/bench_c/precomputed_floor.c`, linked into the host and timed as one of its "
+        "(`benchmarks/bench_c/precomputed_floor.c`, linked into the host and timed as one of its "
         "variants, batches interleaved with the FMUs'): the same physics with no FMI at all and its "
         "parameter-only terms computed once (`rst_impact_terms_of` at the FMU's start values), only "
         "`rst_impact_with_terms` per impact, e and v_rebound kept: the physics' own cost per impact. The native "
@@ -200,7 +200,7 @@ def render(res: dict) -> str:
         "",
         "## The C physics against the package",
         "",
-        "`rst_impact` in a compiled C loop (`build_scripts/benchmarks/bench_c/physics_loop.c`, v changing every call) against "
+        "`rst_impact` in a compiled C loop (`benchmarks/bench_c/physics_loop.c`, v changing every call) against "
         "the package's scalar `restitution.impact` with Python floats (`validate=False`; what the pythonfmu "
         "FMU evaluates per step), per Zener method the C implements.",
         "",

@@ -1,7 +1,7 @@
 #!/usr/bin/env python
 """What one evaluation of the ``ode`` Zener method costs, worst case over the declared domain; writes docs/ode_cost.md.
 
-    .venv/bin/python build_scripts/benchmarks/bench_ode_cost.py [--out DIR] [--repeats N]
+    .venv/bin/python benchmarks/bench_ode_cost.py [--out DIR] [--repeats N]
 
 The grid: lambda from 0 to the largest value the FMU's declared domain reaches (Eq. (12) at the
 domain's corner: ~5.7e18), dense where the work depends on lambda (0 ... 100, both sides of the
@@ -26,13 +26,14 @@ import time
 import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-ROOT = os.path.dirname(os.path.dirname(HERE))
+ROOT = os.path.dirname(HERE)
 sys.path.insert(0, os.path.join(ROOT, "fmu_src"))
 
 import restitution as r  # noqa: E402
 from restitution import zener_ode as zo  # noqa: E402
 from restitution.model import DOMAIN  # noqa: E402
 from restitution.zener import zener_ode, zener_solution  # noqa: E402
+from harness import cpu_name  # noqa: E402
 
 RTOLS = (1e-14, 1e-13, 1e-12, 3e-12, 1e-11, 3e-11, 1e-10, 1e-9, 1e-8, 1e-6, 1e-4, 1e-3, 1e-2)
 
@@ -118,13 +119,13 @@ def main():
                        f"{max(row[3]['nfev'] for row in sub)} |")
     md = f"""# What one `ode` evaluation costs
 
-Measured by `build_scripts/benchmarks/bench_ode_cost.py` on {time.strftime('%Y-%m-%d')} ({wall:.0f} s). Rerun it to measure your machine:
+Measured by `benchmarks/bench_ode_cost.py` on {time.strftime('%Y-%m-%d')} ({wall:.0f} s). Rerun it to measure your machine:
 
 ```sh
-.venv/bin/python build_scripts/benchmarks/bench_ode_cost.py   # writes docs/ode_cost.md
+.venv/bin/python benchmarks/bench_ode_cost.py   # writes docs/ode_cost.md
 ```
 
-Machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores, shared with other jobs; Python {platform.python_version()}, load average {os.getloadavg()[0]:.1f} at the end.
+Machine: {cpu_name()}, {os.cpu_count()} cores, shared with other jobs; Python {platform.python_version()}, load average {os.getloadavg()[0]:.1f} at the end.
 
 The grid: {len(grid)} values of lambda from 0 to {lam_max:.3g} (the largest the FMU's declared inputs reach, Eq. (12) at
 the domain's corner) times {len(RTOLS)} tolerances over `zener.ode_tolerance`'s declared range 1e-14 ... 1e-2: one call of
