@@ -139,7 +139,10 @@ def _export_host(args, speeds, pair, dt, inputs) -> tuple[str, dict, bool]:
             reasons.append(f"at {v:.6g} m/s: {reason}")
             if not args.allow_invalid:
                 break
-        host = module.parameters(case)
+        try:
+            host = module.parameters(case)
+        except ValueError as exc:  # a COR the host's contact cannot give (e < 0 even with --allow-invalid)
+            raise OptionError(f"at {v:.6g} m/s: {exc}") from None
         entry = {**host, "flags": case.flags()}
         lines += ([f"# v = {v:.6g} m/s"] if len(speeds) > 1 else []) + [module.snippet(host)]
         for step, wanted in ((None, args.verify), (dt, dt is not None)):
