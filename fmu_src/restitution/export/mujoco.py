@@ -23,7 +23,7 @@ import math
 from .linear_contact import clamped_damping_ratio, clamped_release, unclamped_damping_ratio
 
 __all__ = ["NAME", "FORCE_LAW", "SOLIMP", "parameters", "snippet", "simulate_drop", "emulate_drop",
-           "largest_timestep", "solref_for", "drop_mjcf", "mujoco_drop", "STEP_TOLERANCE"]
+           "largest_timestep", "solref_for", "drop_mjcf", "mujoco_drop", "sphere_geom", "STEP_TOLERANCE"]
 
 NAME = "mujoco"
 FORCE_LAW = (
@@ -80,13 +80,20 @@ def parameters(case) -> dict:
 def snippet(params: dict) -> str:
     """The MJCF lines: the sphere's geom with the contact's solref and solimp (priority 1, so that they win
     over the plate's whatever its solmix), and the option's timestep."""
-    solref = " ".join(f"{x:.8g}" for x in params["solref"])
-    solimp = " ".join(f"{x:.8g}" for x in params["solimp"])
     return (f"<!-- e = {params['e']:.6g} at {params['v']:.6g} m/s, contact {params['t_contact']:.4g} s; "
             f"holds to {STEP_TOLERANCE:.0%} at timestep <= {params['timestep']:.3g} s -->\n"
-            f"<option timestep=\"{params['timestep']:.3g}\"/>\n"
-            f"<geom type=\"sphere\" size=\"{params['sphere_radius']:.8g}\" mass=\"{params['sphere_mass']:.8g}\" "
-            f"priority=\"1\" solref=\"{solref}\" solimp=\"{solimp}\"/>")
+            f"<option timestep=\"{params['timestep']:.3g}\"/>\n" + sphere_geom(params, 8))
+
+
+def sphere_geom(params: dict, digits: int, extra: str = "") -> str:
+    """The sphere's ``<geom>`` with params' radius, mass, solref and solimp to ``digits`` digits, priority 1 (its
+    solref and solimp win over the plate's whatever its solmix); ``extra``: more attributes."""
+    def numbers(values):
+        return " ".join(f"{x:.{digits}g}" for x in values)
+
+    return (f"<geom {extra}type=\"sphere\" size=\"{params['sphere_radius']:.{digits}g}\" "
+            f"mass=\"{params['sphere_mass']:.{digits}g}\" priority=\"1\" solref=\"{numbers(params['solref'])}\" "
+            f"solimp=\"{numbers(params['solimp'])}\"/>")
 
 
 def _law(params: dict) -> tuple[float, float]:
@@ -134,15 +141,11 @@ def largest_timestep(params: dict) -> float:
 def drop_mjcf(params: dict, dt: float, phase: float = 0.5) -> str:
     """The MJCF of the verification: the sphere (the snippet's geom) on a vertical slide joint, gravity off,
     starting ``phase`` of a step above the plane (a plane geom), approaching it at the case's speed."""
-    r = params["sphere_radius"]
-    z0 = r + params["v"] * dt * (1.0 - phase)
-    solref = " ".join(f"{x:.17g}" for x in params["solref"])
-    solimp = " ".join(f"{x:.17g}" for x in params["solimp"])
+    z0 = params["sphere_radius"] + params["v"] * dt * (1.0 - phase)
     return (f"<mujoco><option timestep=\"{dt:.17g}\" gravity=\"0 0 0\" integrator=\"Euler\"/>"
             f"<worldbody><geom name=\"plate\" type=\"plane\" size=\"1 1 0.1\" condim=\"1\"/>"
             f"<body name=\"ball\" pos=\"0 0 {z0:.17g}\"><joint name=\"drop\" type=\"slide\" axis=\"0 0 1\"/>"
-            f"<geom name=\"ball\" type=\"sphere\" size=\"{r:.17g}\" mass=\"{params['sphere_mass']:.17g}\" "
-            f"condim=\"1\" priority=\"1\" solref=\"{solref}\" solimp=\"{solimp}\"/></body></worldbody></mujoco>")
+            + sphere_geom(params, 17, "name=\"ball\" condim=\"1\" ") + "</body></worldbody></mujoco>")
 
 
 def mujoco_drop(params: dict, dt: float, phase: float = 0.5) -> tuple[float, float]:

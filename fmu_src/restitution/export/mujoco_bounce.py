@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-from .mujoco import SOLIMP
+from .mujoco import SOLIMP, sphere_geom
 
 __all__ = ["Bounces", "bounce_in_mujoco", "solref_from_model", "G"]
 
@@ -36,11 +36,13 @@ class Bounces:
 
 
 def _mjcf(radius: float, mass: float, height: float, flight_dt: float) -> str:
+    """A plane and the ball on a vertical slide joint, its bottom ``height`` [m] above the plane; the ball's
+    solref is MuJoCo's default until :func:`bounce_in_mujoco` sets it before the first contact."""
+    ball = {"sphere_radius": radius, "sphere_mass": mass, "solref": (0.02, 1.0), "solimp": SOLIMP}
     return (f"<mujoco><option timestep=\"{flight_dt!r}\" gravity=\"0 0 {-G!r}\" integrator=\"Euler\"/><worldbody>"
             f"<geom name=\"plate\" type=\"plane\" size=\"1 1 0.1\" condim=\"1\"/>"
             f"<body name=\"ball\" pos=\"0 0 {radius + height!r}\"><joint type=\"slide\" axis=\"0 0 1\"/>"
-            f"<geom name=\"ball\" type=\"sphere\" size=\"{radius!r}\" mass=\"{mass!r}\" condim=\"1\" priority=\"1\" "
-            f"solimp=\"{' '.join(map(repr, SOLIMP))}\"/></body></worldbody></mujoco>")
+            + sphere_geom(ball, 17, "name=\"ball\" condim=\"1\" ") + "</body></worldbody></mujoco>")
 
 
 def bounce_in_mujoco(solref_at, radius: float, mass: float, height: float, v_min: float = 0.05,
