@@ -65,10 +65,10 @@ def test_mujoco_json_contract(tmp_path):
 def test_verify_and_dt(tmp_path):
     """--verify passes at a fine contact; a coarse --dt is reported with a warning, and --verify at it exits 1
     (at t_contact/5 the damped contact's first step alone misses e by far more than 1 %)."""
-    fine = _run("mujoco", *PAIR, "--v", "1.3 m/s", "--verify")
+    fine = _run("mujoco", *PAIR, "--v", "1.3 m/s", "--verify", "--json", str(tmp_path / "m.json"))
     assert fine.returncode == 0 and "error" in fine.stdout, fine.stdout + fine.stderr
-    data = json.loads(_run("mujoco", *PAIR, "--v", "1.3 m/s", "--json", str(tmp_path / "m.json")).stdout and
-                      (tmp_path / "m.json").read_text())
+    data = json.loads((tmp_path / "m.json").read_text())
+    assert abs(data["verify"][0]["error"]) < 0.01 and data["verify"][0]["dt"] is None
     coarse = _run("mujoco", *PAIR, "--v", "1.3 m/s", "--verify", "--dt", f"{data['t_contact'] / 5} s")
     assert coarse.returncode == 1 and "warning: dt" in coarse.stdout, coarse.stdout + coarse.stderr
 
@@ -108,3 +108,16 @@ def test_a_flag_outside_validity_is_a_refusal():
                       vstar_in_range=True, e_negative=False, contact_ends=True, concurrent=False, edge_clear=True,
                       plasticity_used=True, plate_waves_used=True)
     assert "lambda_in_range = no" in case.refusal()
+
+
+def test_verify_without_mujoco_integrates_its_documented_step(tmp_path):
+    """Where MuJoCo cannot be imported (made unimportable in the child, as for a package not installed),
+    --verify steps the contact as MuJoCo's documentation describes it and says so; the e it gets is the same
+    mapping's, within 1 %."""
+    code = ("import sys; sys.modules['mujoco'] = None\n"
+            "from restitution.command import main\n"
+            f"sys.exit(main({['export', 'mujoco', *PAIR, '--v', '1.3 m/s', '--verify', '--json', 'v.json']!r}))")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=tmp_path, timeout=300)
+    assert done.returncode == 0 and "published force law, integrated here" in done.stdout, done.stdout + done.stderr
+    check = json.loads((tmp_path / "v.json").read_text())["verify"][0]
+    assert check["law"] == "published force law, integrated here" and abs(check["error"]) < 0.01
