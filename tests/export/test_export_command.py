@@ -62,6 +62,17 @@ def test_mujoco_json_contract(tmp_path):
     assert "<geom" in done.stdout and f"{data['solref'][1]:.8g}" in done.stdout and 'solimp="' in done.stdout
 
 
+def test_a_speed_range_gives_the_parameters_per_speed(tmp_path):
+    out = tmp_path / "r.json"
+    done = _run("mujoco", *PAIR, "--v-range", "0.2 m/s", "2 m/s", "--points", "3", "--json", str(out))
+    assert done.returncode == 0 and done.stdout.count("<geom") == 3, done.stderr
+    speeds = json.loads(out.read_text())["speeds"]
+    for entry, v in zip(speeds, (0.2, 1.1, 2.0)):
+        assert entry["v"] == pytest.approx(v, rel=1e-12)
+        assert entry["e"] == pytest.approx(r.impact(v, **PARAMS, plate_edge_distance=0.0).e, rel=1e-12)
+    assert speeds[0]["e"] > speeds[2]["e"] and speeds[0]["solref"][1] < speeds[2]["solref"][1]
+
+
 def test_verify_and_dt(tmp_path):
     """--verify passes at a fine contact; a coarse --dt is reported with a warning, and --verify at it exits 1
     (at t_contact/5 the damped contact's first step alone misses e by far more than 1 %)."""

@@ -141,19 +141,23 @@ def _export_host(args, speeds, pair, dt, inputs) -> tuple[str, dict, bool]:
                 break
         try:
             host = module.parameters(case)
-        except ValueError as exc:  # a COR the host's contact cannot give (e < 0 even with --allow-invalid)
-            raise OptionError(f"at {v:.6g} m/s: {exc}") from None
+        except ValueError as exc:  # a COR the host's contact cannot give (e < 0), even with --allow-invalid
+            if len(speeds) == 1:
+                raise OptionError(f"at {v:.6g} m/s: {exc}") from None
+            lines.append(f"# v = {v:.6g} m/s: left out, {exc}")
+            continue
         entry = {**host, "flags": case.flags()}
         lines += ([f"# v = {v:.6g} m/s"] if len(speeds) > 1 else []) + [module.snippet(host)]
-        for step, wanted in ((None, args.verify), (dt, dt is not None)):
-            if wanted and (step is not None or not entry.get("verify")):
-                result = module.simulate_drop(host, case, step)
-                report, ok = _check(result, case, host, step, args.tolerance)
-                lines += report
-                passed = passed and (ok or not args.verify)
-                entry.setdefault("verify", []).append({**result, "dt": step, "error": result["e"] / case.e - 1.0})
+        for step in ([None] if args.verify else []) + ([dt] if dt is not None else []):
+            result = module.simulate_drop(host, case, step)
+            report, ok = _check(result, case, host, step, args.tolerance)
+            lines += report
+            passed = passed and (ok or not args.verify)
+            entry.setdefault("verify", []).append({**result, "dt": step, "error": result["e"] / case.e - 1.0})
         entries.append(entry)
     notes = _refuse_invalid(reasons, args.allow_invalid)
+    if not entries:
+        raise OptionError("no speed of the range has a COR the host's contact can give (e < 0 at every one)")
     document = {"inputs": inputs, **entries[0]} if len(speeds) == 1 else {"inputs": inputs, "speeds": entries}
     if notes:
         document["allow_invalid"] = notes
