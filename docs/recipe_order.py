@@ -10,6 +10,7 @@ RECIPES = (
     "fmi2_fmu_in_fmpy.py",
     "fmi3_fmu_in_fmpy.py",
     "plot_model_exchange_bounce.py",
+    "plot_mujoco_velocity_dependent.py",
 )
 
 

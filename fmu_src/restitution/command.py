@@ -6,6 +6,7 @@
     restitution scene ...        drop scenes through the FMUs (restitution.scene; the `scene` extra)
     restitution materials        the material presets
     restitution fmu build ...    build the FMUs (restitution.fmu; the `fmu` extra)
+    restitution export HOST ...  the COR as a host simulator's parameters (restitution.export)
 
 Each subcommand is the tool's own command line, and names itself ``restitution X`` in its usage line and
 its errors however it is started: ``restitution-sweep``, ``python -m restitution.sweep`` (and the same for
@@ -26,6 +27,8 @@ SUBCOMMANDS = {
     "scene": ("restitution.scene.__main__", "drop scenes: balls bouncing on plates through the FMUs"),
     "materials": ("restitution.materials_table", "the material presets and their sources"),
     "fmu": ("restitution.fmu.__main__", "build the FMUs (restitution fmu build --out DIR)"),
+    "export": ("restitution.export.command", "the COR as another simulator's contact parameters (MuJoCo, Chrono, "
+                                             "LIGGGHTS, Yade, ElastoGap, a table), verified by a drop"),
 }
 
 

@@ -18,16 +18,15 @@ import sys
 from .assumptions import E_NEGATIVE_MEANING, VALID_MEANING
 from .model import ZENER_METHODS, impact, published
 from .zener import WAVE_DELAY_LIMIT
-from .options import (BARE_NUMBER_RULE, ArgumentParser, OptionError, add_material_options, check_plausible_lengths,
-                      input_reading, material, material_from_args)
+from .options import (BARE_NUMBER_RULE, IMPACT_QUANTITIES, ArgumentParser, OptionError, add_impact_options,
+                      impact_inputs, material_from_args)
 from .output_files import (EXIT_IO_ERROR, EXIT_REFUSED, OutputPathError, atomic_write, check_output,
                            finish_stdout)
 
 __all__ = ["main", "evaluate"]
 
 #: The options with a unit: option -> (FMU input name whose unit and range apply, impact keyword).
-QUANTITIES = {"d": ("sphere.d", "sphere_d"), "t": ("plate.t", "plate_t"), "v": ("v_approach", "v"),
-              "edge": ("plate.edge_distance", "plate_edge_distance")}
+QUANTITIES = IMPACT_QUANTITIES
 #: Units of the result's fields, as printed and in the JSON (SI).
 UNITS = {"e": "1", "e_ep": "1", "e_ze": "1", "v_rebound": "m/s", "V_c": "m/s", "V_star": "1", "eps_y": "1",
          "lam": "1", "tau0": "1", "T": "s", "t_contact": "s", "m_a": "kg", "m_eff": "kg", "mass_ratio": "1",
@@ -42,19 +41,11 @@ def evaluate(sphere, d, plate, t, v, zener_method: str = "exact", edge=None,
     ``edge`` None or 0: an unbounded plate). Without ``allow_implausible`` a bare-number length that is
     a likely slip is refused (:func:`~restitution.options.check_plausible_lengths`).
     :class:`~restitution.options.OptionError` (one line) for an unknown material or a value outside the domain."""
-    bodies = {role: (material(role, body) if isinstance(body, str) else body)
-              for role, body in (("sphere", sphere), ("plate", plate))}
-    readings = {option: input_reading(option, QUANTITIES[option][0], str(text))
-                for option, text in (("d", d), ("t", t), ("v", v), ("edge", edge)) if text is not None}
-    check_plausible_lengths(*((f"--{option} {text}", *readings[option]) for option, text in (("d", d), ("t", t))),
-                            allow=allow_implausible)
-    values = {option: value for option, (value, _) in readings.items()}
-    params = {**bodies["sphere"].params("sphere"), **bodies["plate"].params("plate"),
-              "sphere_d": values["d"], "plate_t": values["t"], "plate_edge_distance": values.get("edge", 0.0)}
-    result = published(impact(values["v"], **params, zener_method=zener_method).as_dict())
+    v, params = impact_inputs(sphere, d, plate, t, v, edge, allow_implausible)
+    result = published(impact(v, **params, zener_method=zener_method).as_dict())
     inputs = {"sphere": sphere if isinstance(sphere, str) else sphere.name,
               "plate": plate if isinstance(plate, str) else plate.name,
-              "v": values["v"], **params, "zener_method": zener_method}
+              "v": v, **params, "zener_method": zener_method}
     return inputs, {key: (bool(value) if isinstance(value, bool) or key not in UNITS else float(value))
                     for key, value in result.items()}
 
@@ -95,20 +86,10 @@ def main(argv=None) -> int:
     parser = ArgumentParser(prog="restitution cor", description=__doc__.split("\n\n")[0],
                             epilog="Lengths and speeds take a unit (\"6.35 mm\", \"1/4 in\", \"2 m/s\"). "
                                    + BARE_NUMBER_RULE)
-    parser.add_argument("--d", required=True, metavar="LEN", help="sphere diameter, e.g. \"6.35 mm\" (a bare "
-                                                                  "number is metres)")
-    parser.add_argument("--t", required=True, metavar="LEN", help="plate thickness, e.g. \"3 mm\" (a bare number "
-                                                                  "is metres)")
-    parser.add_argument("--v", required=True, metavar="SPEED", help="approach speed, e.g. \"2 m/s\"")
-    parser.add_argument("--edge", metavar="LEN", help="distance from the impact point to the plate's nearest "
-                                                      "edge, e.g. \"76 mm\" (default: an unbounded plate)")
-    parser.add_argument("--allow-implausible", action="store_true",
-                        help="accept a bare-number length that looks like a slip (a 10 m sphere)")
     parser.add_argument("--zener-method", default="exact", choices=ZENER_METHODS,
                         help="Zener's COR and contact time (default: exact)")
     parser.add_argument("--json", metavar="FILE", help="write the inputs and every field of the result (SI)")
-    add_material_options(parser, "sphere")
-    add_material_options(parser, "plate")
+    add_impact_options(parser)
     args = parser.parse_args(argv)
     try:
         if args.json:

@@ -12,7 +12,8 @@ import re
 __all__ = ["OptionError", "ArgumentParser", "material", "input_quantity", "input_reading", "positive_quantity",
            "read_quantity", "python_quantity", "add_material_options", "material_from_args", "custom_material",
            "read_material_file", "check_plausible_lengths", "echo", "shorten_quoted", "ECHO_CHARS", "MAX_VALUE_CHARS",
-           "MATERIAL_PROPERTIES", "MAX_BARE_LENGTH", "PLAUSIBLE_T_OVER_D", "BARE_NUMBER_RULE"]
+           "MATERIAL_PROPERTIES", "MAX_BARE_LENGTH", "PLAUSIBLE_T_OVER_D", "BARE_NUMBER_RULE", "IMPACT_QUANTITIES",
+           "add_impact_options", "impact_inputs"]
 
 #: The most characters of a user's text a refusal echoes; longer text is cut, "..." and its length added.
 ECHO_CHARS = 60
@@ -299,3 +300,45 @@ def check_plausible_lengths(d, t, allow: bool = False) -> None:
     raise OptionError(f"{echo(shown[0])}: a bare number is metres: t/d = {ratio:.3g} (d = {number_text(d[1])} m, "
                       f"t = {number_text(t[1])} m) is implausible, outside {low:g} to {high:g}{hint} "
                       f"(--allow-implausible accepts it)")
+
+
+# --- one impact's bodies, sizes and speed (restitution cor, restitution export) -------------------
+#: The options with a unit: option -> (FMU input name whose unit and range apply, impact keyword).
+IMPACT_QUANTITIES = {"d": ("sphere.d", "sphere_d"), "t": ("plate.t", "plate_t"), "v": ("v_approach", "v"),
+                     "edge": ("plate.edge_distance", "plate_edge_distance")}
+
+
+def add_impact_options(parser, speed_required: bool = True) -> None:
+    """``--d``, ``--t``, ``--v`` (required unless not ``speed_required``), ``--edge``, ``--allow-implausible``
+    and the sphere's and the plate's material options (:func:`add_material_options`) on ``parser``."""
+    parser.add_argument("--d", required=True, metavar="LEN", help="sphere diameter, e.g. \"6.35 mm\" (a bare "
+                                                                  "number is metres)")
+    parser.add_argument("--t", required=True, metavar="LEN", help="plate thickness, e.g. \"3 mm\" (a bare number "
+                                                                  "is metres)")
+    parser.add_argument("--v", required=speed_required, metavar="SPEED", help="approach speed, e.g. \"2 m/s\"")
+    parser.add_argument("--edge", metavar="LEN", help="distance from the impact point to the plate's nearest "
+                                                      "edge, e.g. \"76 mm\" (default: an unbounded plate)")
+    parser.add_argument("--allow-implausible", action="store_true",
+                        help="accept a bare-number length that looks like a slip (a 10 m sphere)")
+    add_material_options(parser, "sphere")
+    add_material_options(parser, "plate")
+
+
+def impact_inputs(sphere, d, plate, t, v=None, edge=None, allow_implausible: bool = True) -> tuple[dict, dict]:
+    """(the approach speed ``v`` [m/s] (None where not given) and the keyword arguments of
+    :func:`restitution.impact` but the speed, SI) for the materials ``sphere`` and ``plate`` (a preset's name or
+    a :class:`~restitution.Material`), the diameter ``d``, the thickness ``t``, the speed ``v`` and the edge
+    distance ``edge`` (each a number in SI or a text with its unit; ``edge`` None or 0: an unbounded plate).
+    Without ``allow_implausible`` a bare-number length that is a likely slip is refused
+    (:func:`check_plausible_lengths`). OptionError (one line) for an unknown material or a value outside the
+    domain."""
+    bodies = {role: (material(role, body) if isinstance(body, str) else body)
+              for role, body in (("sphere", sphere), ("plate", plate))}
+    readings = {option: input_reading(option, IMPACT_QUANTITIES[option][0], str(text))
+                for option, text in (("d", d), ("t", t), ("v", v), ("edge", edge)) if text is not None}
+    check_plausible_lengths(*((f"--{option} {text}", *readings[option]) for option, text in (("d", d), ("t", t))),
+                            allow=allow_implausible)
+    values = {option: value for option, (value, _) in readings.items()}
+    params = {**bodies["sphere"].params("sphere"), **bodies["plate"].params("plate"),
+              "sphere_d": values["d"], "plate_t": values["t"], "plate_edge_distance": values.get("edge", 0.0)}
+    return values.get("v"), params

@@ -19,7 +19,7 @@ OLD = ("python -m restitution.", "restitution-fmu", "restitution-sweep", "restit
 HELP = {("sweep",): "usage: restitution sweep ", ("scene",): "usage: restitution scene ",
         ("scene", "run"): "usage: restitution scene run ", ("scene", "report"): "usage: restitution scene report ",
         ("scene", "check"): "usage: restitution scene check ", ("fmu",): "usage: restitution fmu ",
-        ("fmu", "build"): "usage: restitution fmu build "}
+        ("fmu", "build"): "usage: restitution fmu build ", ("export",): "usage: restitution export "}
 
 
 def _run(args, cwd=None):

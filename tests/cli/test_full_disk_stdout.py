@@ -8,7 +8,10 @@ import pytest
 
 COMMANDS = [[], ["--version"], ["materials"], ["materials", "--help"], ["sweep", "--help"], ["scene", "--help"],
             ["scene", "run", "--help"], ["fmu", "--help"], ["fmu", "build", "--help"], ["cor", "--help"],
-            ["fit", "--help"], ["sweep", "--grid", "v=1,2", "--scheduler", "serial", "--no-plot", "--no-progress"]]
+            ["fit", "--help"], ["export", "--help"],
+            ["export", "table", "--sphere", "chrome_steel", "--d", "6 mm", "--plate", "al_6061", "--t", "3 mm",
+             "--v-range", "1", "2"],
+            ["sweep", "--grid", "v=1,2", "--scheduler", "serial", "--no-plot", "--no-progress"]]
 
 
 @pytest.mark.parametrize("args", COMMANDS, ids=lambda a: " ".join(a) or "(none)")
