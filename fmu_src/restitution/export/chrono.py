@@ -36,7 +36,7 @@ def parameters(case) -> dict:
     "nu2", "t_contact" [s] (Chrono's contact, Hertz), "R" [m] (set as the effective curvature radius), "m" [kg],
     "plate_mass" [kg] (the fixed plate's mass to give Chrono), "cr_naive_gives" (the e Chrono returns for
     cr = e), "v" [m/s], "contact_model": "Hertz", "scheme". UnreachableRestitution where e < 0.136."""
-    params = tsuji_parameters(case, CR_MIN, "Chrono SMC")
+    params = tsuji_parameters(case, CR_MIN, "Chrono SMC", "restitution")
     return {**params, "plate_mass": PLATE_MASS_RATIO * case.m_sphere, "contact_model": "Hertz", "scheme": SCHEME}
 
 

@@ -177,16 +177,17 @@ def tsuji_restitution(beta: float, clamp: bool = True) -> float:
     return bounce(lambda x, xdot: tsuji_force(x, xdot, unit_modulus, 1.0, 1.0, beta, clamp), 1.0, 1.0, 1.0).e
 
 
-def tsuji_beta_for(e: float, cr_min: float, host: str) -> float:
-    """The beta [1] at which the clamped :func:`tsuji_force` gives the COR ``e`` [1], for a host that accepts
-    cr >= ``cr_min`` [1] (its own lower bound). e = 1: beta = 0 (no damping). A clamped contact cannot go below
-    the COR at the host's smallest cr (0.135 as cr tends to 0): :class:`UnreachableRestitution` there."""
+def tsuji_beta_for(e: float, cr_min: float, host: str, parameter: str = "cr") -> float:
+    """The beta [1] at which the clamped :func:`tsuji_force` gives the COR ``e`` [1], for ``host`` whose
+    restitution ``parameter`` accepts values >= ``cr_min`` [1]. e = 1: beta = 0 (no damping). A clamped contact
+    cannot go below the COR at the host's smallest parameter (0.136 as it tends to 0):
+    :class:`UnreachableRestitution` there, naming the host and the parameter."""
     if e >= 1.0:
         return 0.0
     beta_min = tsuji_beta(cr_min)
     # brentq over -beta (the damping), which the COR falls with
     return -solve_decreasing(lambda damping: tsuji_restitution(-damping), e, 0.0, -beta_min,
-                             f"{host}'s clamped Hertz law (restitution coefficient >= {cr_min:.3g})")
+                             f"{host}'s clamped Hertz law with {parameter} >= {cr_min:.3g}")
 
 
 def tsuji_drop(cr: float, E_eff: float, R: float, m: float, v: float, dt: float | None = None,
@@ -202,12 +203,13 @@ def tsuji_drop(cr: float, E_eff: float, R: float, m: float, v: float, dt: float 
                   scheme)
 
 
-def tsuji_parameters(case, cr_min: float, host: str) -> dict:
+def tsuji_parameters(case, cr_min: float, host: str, parameter: str) -> dict:
     """What the three damped-Hertz hosts share for ``case`` (an ExportCase: e, v, m_sphere, R_sphere, E_eff,
-    E1, nu1, E2, nu2): "e", "cr" (the restitution coefficient to give the host, the exact inverse of its
-    clamped law), "cr_naive_gives" (the COR the host returns if given cr = e), "t_contact" (the host's contact
-    time [s]), the sphere's "R" [m] and "m" [kg], "v" [m/s] and the bodies' moduli. SI units."""
-    cr = restitution_of_beta(tsuji_beta_for(case.e, cr_min, host))
+    E1, nu1, E2, nu2), for ``host`` and its restitution ``parameter`` (>= ``cr_min``): "e"; "cr", the
+    restitution coefficient to give the host, the exact inverse of its clamped law; "cr_naive_gives", the COR
+    the host returns if given cr = e; "t_contact", the host's contact time [s]; the sphere's "R" [m] and "m"
+    [kg]; "v" [m/s]; the bodies' moduli "E_eff", "E1", "E2" [Pa] and "nu1", "nu2". SI units."""
+    cr = restitution_of_beta(tsuji_beta_for(case.e, cr_min, host, parameter))
     return {"e": case.e, "cr": cr,
             "cr_naive_gives": tsuji_restitution(tsuji_beta(min(max(case.e, cr_min), 1.0))),
             "t_contact": tsuji_drop(cr, case.E_eff, case.R_sphere, case.m_sphere, case.v).t_contact,

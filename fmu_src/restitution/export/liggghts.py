@@ -32,7 +32,7 @@ def parameters(case) -> dict:
     type (1 the sphere, 2 the plate), "E_eff" [Pa] (LIGGGHTS's Y_eff), "t_contact" [s] (LIGGGHTS's Hertz
     contact), "cr_naive_gives" (the e LIGGGHTS returns for coefficientRestitution = e), "R" [m], "m" [kg],
     "v" [m/s], "scheme". UnreachableRestitution where e < 0.214."""
-    params = tsuji_parameters(case, CR_MIN, "LIGGGHTS (coefficientRestitution > 0.05)")
+    params = tsuji_parameters(case, CR_MIN, "LIGGGHTS", "coefficientRestitution")
     cr = params.pop("cr")
     return {"e": params.pop("e"), "coefficientRestitution": cr,
             "youngsModulus": [case.E1, case.E2], "poissonsRatio": [case.nu1, case.nu2], **params,

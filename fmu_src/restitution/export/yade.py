@@ -30,7 +30,7 @@ def parameters(case) -> dict:
     Ip2_FrictMat_FrictMat_MindlinPhys functor), "young" [Pa] and "poisson" (sphere, plate), "E_eff" [Pa],
     "t_contact" [s] (Yade's Hertz contact), "cr_naive_gives" (the e Yade returns for en = e), "R" [m],
     "m" [kg], "v" [m/s], "scheme". UnreachableRestitution where e < 0.136."""
-    params = tsuji_parameters(case, CR_MIN, "Yade's Mindlin law")
+    params = tsuji_parameters(case, CR_MIN, "Yade", "en")
     en = params.pop("cr")
     return {"e": params.pop("e"), "en": en, "young": [case.E1, case.E2], "poisson": [case.nu1, case.nu2],
             **params, "scheme": SCHEME}
