@@ -96,13 +96,22 @@ def _bounce_fine(force, m: float, v: float, time_unit: float) -> Bounce:
 
     def separated(_t, y):
         return y[0]
-    separated.terminal, separated.direction = True, -1.0
-    # x(0) = 0 is no crossing (the event counts x going from > 0 to <= 0); 200 T: a contact never lasts that long
-    sol = solve_ivp(rhs, (0.0, 200.0 * time_unit), [0.0, v], method="DOP853", events=separated, rtol=_RTOL,
-                    atol=[_RTOL * v * time_unit, _RTOL * v], max_step=0.05 * time_unit)
-    if not sol.t_events[0].size:
+
+    def released(_t, y):
+        # the clamped force reaching zero on the way out; it stays zero from there (the spring weakens as the
+        # overlap closes, the damper's demand does not), so the sphere flies out at the speed it has
+        return force(max(y[0], 0.0), y[1]) if y[1] < 0.0 else 1.0
+    for event in (separated, released):
+        event.terminal, event.direction = True, -1.0
+    # x(0) = 0 is no crossing (an event counts g going from > 0 to <= 0); 200 T: a contact never lasts that long
+    sol = solve_ivp(rhs, (0.0, 200.0 * time_unit), [0.0, v], method="DOP853", events=(separated, released),
+                    rtol=_RTOL, atol=[_RTOL * v * time_unit, _RTOL * v], max_step=0.05 * time_unit)
+    ends = [(float(t[0]), y[0]) for t, y in zip(sol.t_events, sol.y_events) if t.size]
+    if not ends:
         raise RuntimeError("the sphere did not leave the plate within 200 contact time units")
-    return Bounce(e=float(-sol.y_events[0][0][1] / v), t_contact=float(sol.t_events[0][0]))
+    t_end, (x_end, u_end) = min(ends, key=lambda end: end[0])
+    flight = max(x_end, 0.0) / -u_end  # the free flight from the release to separation [s]
+    return Bounce(e=float(-u_end / v), t_contact=float(t_end + flight))
 
 
 def _bounce_stepped(force, m: float, v: float, dt: float, scheme: str) -> Bounce:
@@ -132,14 +141,14 @@ def solve_decreasing(restitution_of: Callable[[float], float], e: float, low: fl
     from scipy.optimize import brentq
 
     top = restitution_of(low)
+    if top <= e <= top + _RTOL * 100:  # e at the undamped end, within the integration's error
+        return low
     bottom = restitution_of(high)
     while grow and bottom > e and high < 1e12:
         high *= 2.0
         bottom = restitution_of(high)
     if not bottom <= e <= top:
         raise UnreachableRestitution(f"e = {e:.4g} is outside what {what} can give ({bottom:.4g} to {top:.4g})")
-    if e == top:
-        return low
     return brentq(lambda p: restitution_of(p) - e, low, high, xtol=1e-14, rtol=1e-12)
 
 

@@ -3,7 +3,7 @@ spring (n = 1.5) and the damping d that makes ElastoGap's own bounded-damper law
 case's mass and speed (docs/exports_clamped_hosts.md)."""
 from __future__ import annotations
 
-from .clamped import bounce, hertz_constant, hertz_time_unit, solve_decreasing
+from .clamped import UnreachableRestitution, bounce, hertz_constant, hertz_time_unit, solve_decreasing
 
 __all__ = ["NAME", "FORCE_LAW", "SCHEME", "EXPONENT", "parameters", "snippet", "simulate_drop", "elastogap_force"]
 
@@ -44,7 +44,9 @@ def parameters(case) -> dict:
     """The JSON of ``restitution export elastogap`` for ``case`` (an ExportCase): "e", "c" [N/m^1.5] (with
     ElastoGap's default s_ref = 1 m), "d" [N s/m], "n" = 1.5, "t_contact" [s] (ElastoGap's contact at that
     speed), "m" [kg] (the sliding mass), "v" [m/s] (d holds at this speed only), "E_eff" [Pa], "R" [m],
-    "scheme". Every e in (0, 1] is reachable."""
+    "scheme". Every e in (0, 1] is reachable; UnreachableRestitution for e <= 0."""
+    if not case.e > 0.0:
+        raise UnreachableRestitution(f"e = {case.e:.4g}: ElastoGap's bounded damper gives an e above 0 only")
     c = hertz_constant(case.E_eff, case.R_sphere)
     time_unit = hertz_time_unit(case.m_sphere, c, case.v)
     scale = case.m_sphere / time_unit  # d = (d T / m) m / T
