@@ -74,8 +74,9 @@ def bounce(force: Callable[[float, float], float], m: float, v: float, time_unit
     """The sphere of mass ``m`` [kg] meets the fixed plate at ``v`` [m/s]: x the penetration [m], x' its rate
     [m/s], m x'' = -force(x, x') from x = 0, x' = v until x returns to 0. ``force`` [N] is the host's law,
     clamp included (it pushes the sphere out, >= 0). ``time_unit`` [s]: the contact's time scale (Hertz:
-    :func:`hertz_time_unit`). ``dt`` None: adaptive Dormand-Prince 8(5,3) at rtol 1e-10; else the host's
-    fixed step [s] with ``scheme`` (:data:`SCHEMES`), the contact starting on a step boundary."""
+    :func:`hertz_time_unit`). ``dt`` None: adaptive Dormand-Prince 8(5,3) at rtol 1e-10, up to where the
+    force reaches zero on the way out, then the free flight (the clamped laws here never push again); else
+    the host's fixed step [s] with ``scheme`` (:data:`SCHEMES`), the contact starting on a step boundary."""
     if not (m > 0.0 and v > 0.0 and time_unit > 0.0):
         raise ValueError(f"bounce needs m, v and the time unit > 0 (m = {m}, v = {v}, time unit = {time_unit})")
     if dt is None:
