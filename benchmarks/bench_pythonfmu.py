@@ -30,6 +30,8 @@ The process ends with ``os._exit``: the plain twin brings pythonfmu 0.7's exit-t
 """
 from __future__ import annotations
 
+from harness import cpu_name  # this folder: the benchmarks' harness
+
 import argparse
 import ctypes
 import os
@@ -62,7 +64,6 @@ from types import SimpleNamespace
 
 from pythonfmu import Fmi2Causality, Fmi2Slave, Fmi2Variability, Boolean, Integer, Real
 from pythonfmu.enums import Fmi2Initial
-from harness import cpu_name  # noqa: E402
 
 #: (name, type, causality, variability, value): the interface table's rows, outputs given a constant
 VARIABLES = {rows!r}

@@ -20,6 +20,8 @@ Ratios are what counts on a shared machine: both sides of each are measured in t
 """
 from __future__ import annotations
 
+from harness import cpu_name  # this folder: the benchmarks' harness
+
 import argparse
 import json
 import os
@@ -46,7 +48,6 @@ IMPACT_ALONE = """
 import json, sys
 import numpy as np
 import restitution
-from harness import cpu_name
 grid = json.load(open(sys.argv[1]))
 v = np.repeat(np.geomspace(*grid["v"][:2], int(grid["v"][2])), int(grid["t_over_d"][2]))
 t_over_d = np.tile(np.geomspace(*grid["t_over_d"][:2], int(grid["t_over_d"][2])), int(grid["v"][2]))

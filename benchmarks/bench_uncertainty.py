@@ -36,6 +36,8 @@ sizes (a test runs it). The full run takes about 2 minutes on a shared 2-core ma
 """
 from __future__ import annotations
 
+from harness import cpu_name  # this folder: the benchmarks' harness
+
 import argparse
 import json
 import os
@@ -65,7 +67,6 @@ PLAIN = """\
 import json, sys
 import numpy as np
 import restitution
-from harness import cpu_name
 N, SEED, BLOCK, DISTS, BASE, FIXED = {n}, {seed}, {block}, {dists!r}, {base!r}, {fixed!r}
 draws = {{k: np.empty(N) for k in DISTS}}
 for b in range(-(-N // BLOCK)):

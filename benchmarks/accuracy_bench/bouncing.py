@@ -11,7 +11,7 @@ import numpy as np
 import restitution as r  # noqa: E402
 
 from .config import Config
-from .timing import median
+from harness import median
 
 
 def bouncing(cfg: Config, fmus: dict, work: Path, drop_height: float = 0.3, t_end: float = 1.0,

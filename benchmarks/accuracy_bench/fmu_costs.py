@@ -10,7 +10,7 @@ from restitution.cosim import FmuInstance
 from restitution.fmu.models import table
 
 from .config import Config, RANGES
-from .timing import timed, interleaved, median, median_ratio
+from harness import timed, interleaved, median, median_ratio
 
 
 FLOOR_SCRIPT = '''"""Trivial pythonfmu FMU with the variables of SpherePlateImpact (counts and types): the floor."""

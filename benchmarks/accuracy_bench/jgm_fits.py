@@ -8,7 +8,7 @@ from restitution.jgm import restitution_e44, restitution_e45
 import restitution as r  # noqa: E402
 
 from .config import Config
-from .timing import interleaved, median, median_ratio
+from harness import interleaved, median, median_ratio
 
 
 JGM_PAIRS = (("s2_tool_steel", "al_6061"), ("tungsten_carbide", "al_6061"), ("brass_260", "s7_tool_steel"),

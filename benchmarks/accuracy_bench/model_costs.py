@@ -8,7 +8,7 @@ import numpy as np
 import restitution as r  # noqa: E402
 
 from .config import Config, STEEL_ON_AL
-from .timing import interleaved, median, median_ratio
+from harness import interleaved, median, median_ratio
 
 
 def sweep_cases(n: int, seed: int = 3):

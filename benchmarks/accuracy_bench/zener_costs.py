@@ -7,7 +7,7 @@ import numpy as np
 from restitution.zener import zener_restitution
 
 from .config import Config, RANGES
-from .timing import clock, timed, interleaved, median, median_ratio
+from harness import clock, timed, interleaved, median, median_ratio
 
 
 def method_list(cfg: Config):
