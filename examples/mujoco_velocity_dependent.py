@@ -8,8 +8,9 @@ waves). The ball is dropped on a plane in MuJoCo (``pip install "restitution[exp
 contact the geom's solref and solimp are set from ``restitution export mujoco``'s mapping for the approach
 speed predicted from the ball's height and speed (:func:`restitution.export.mujoco_bounce.bounce_in_mujoco`),
 and MuJoCo steps the contact with the step they are tuned for (t_contact/50). A second run keeps the first
-contact's solref for every bounce (a constant e; solimp's ramp still spans one step's approach). The picture (examples/output/mujoco_velocity_dependent.png) shows the achieved e
-of each bounce against its approach speed, beside the model's e(v) and the constant-e run.
+contact's solref for every bounce (a constant e; solimp's ramp still spans one step's approach). The
+picture (examples/output/mujoco_velocity_dependent.png) shows the achieved e of each bounce against its
+approach speed, beside the model's e(v) and the constant-e run.
 """
 from __future__ import annotations
 

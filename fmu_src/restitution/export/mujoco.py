@@ -126,9 +126,9 @@ def _errors(zeta: float, e: float, t_contact: float, v: float, dt: float, finer:
     return errors
 
 
-def _centred_zeta(e: float, t_contact: float, v: float, dt: float, finer: bool) -> tuple[float, float]:
-    """(the damping ratio [1] whose errors (:func:`_errors`) are centred on zero, by brentq; half their
-    range [1]). ValueError where no damping ratio within a factor of 8 of the continuous one centres them."""
+def _centred_zeta(e: float, t_contact: float, v: float, dt: float, finer: bool) -> float:
+    """The damping ratio [1] whose errors (:func:`_errors`) are centred on zero, by brentq. ValueError where no
+    damping ratio within a factor of 8 of the continuous one centres them (a step far too coarse)."""
     from scipy.optimize import brentq
 
     zeta0 = clamped_damping_ratio(e)
@@ -143,21 +143,15 @@ def _centred_zeta(e: float, t_contact: float, v: float, dt: float, finer: bool) 
         high *= 2.0
     if not midrange(low) >= 0.0 >= midrange(high):
         raise ValueError(f"e = {e:.4g} cannot be tuned at dt = {dt:.4g} s ({t_contact / dt:.3g} steps a contact)")
-    zeta = brentq(midrange, low, high, xtol=1e-9 * zeta0)
-    errors = _errors(zeta, e, t_contact, v, dt, finer)
-    return zeta, 0.5 * (max(errors) - min(errors))
+    return brentq(midrange, low, high, xtol=1e-9 * zeta0)
 
 
-def tuned_solref(e: float, t_contact: float, v: float, dt: float) -> tuple[list, bool]:
-    """([timeconst [s], dampratio [1]], whether it holds at finer steps too) for the ramp of
-    :func:`ramp_solimp` at the step ``dt`` [s], on MuJoCo's step (:func:`emulate_drop`); omega as in
-    :func:`solref_for`. The damping ratio centres on zero the errors of every onset phase at the steps from dt
-    to dt/20 and as the step goes to zero; where that leaves more than :data:`STEP_TOLERANCE` (a step too
-    coarse for the contact: MuJoCo's error is first order in it), it centres those of the step dt alone."""
-    zeta, half_range = _centred_zeta(e, t_contact, v, dt, finer=True)
-    if half_range <= _PHASE_MARGIN * STEP_TOLERANCE:
-        return _solref_of_zeta(zeta, t_contact), True
-    return _solref_of_zeta(_centred_zeta(e, t_contact, v, dt, finer=False)[0], t_contact), False
+def tuned_solref(e: float, t_contact: float, v: float, dt: float, finer: bool = True) -> list:
+    """[timeconst [s], dampratio [1]] for the ramp of :func:`ramp_solimp` at the step ``dt`` [s], on MuJoCo's
+    step (:func:`emulate_drop`); omega as in :func:`solref_for`. The damping ratio centres on zero the errors
+    of every onset phase at the step dt and, with ``finer``, at the steps down to dt/20 and as the step goes to
+    zero (:func:`_errors`)."""
+    return _solref_of_zeta(_centred_zeta(e, t_contact, v, dt, finer), t_contact)
 
 
 def parameters(case, dt: float | None = None) -> dict:
@@ -171,24 +165,26 @@ def parameters(case, dt: float | None = None) -> dict:
     -damping [1/s], with the ramped solimp), the damping ratio the usual unclamped formula would give
     (dampratio_unclamped), and the sphere's radius [m] and mass [kg] for the geom."""
     step = case.t_contact / DEFAULT_STEPS if dt is None else dt
-    solref, finer = tuned_solref(case.e, case.t_contact, case.v, step)
-    omega = 1.0 / (solref[0] * solref[1])
-    continuous = solref_for(case.e, case.t_contact)
-    params = {"e": case.e, "t_contact": case.t_contact, "solref": solref, "solimp": list(ramp_solimp(case.v, step)),
-              "tuned_dt": step, "holds_at_finer_steps": finer, "solref_continuous": list(continuous[:2]),
-              "solimp_continuous": list(SOLIMP), "solref_direct": [-omega * omega, -2.0 * solref[1] * omega],
+    params = {"e": case.e, "t_contact": case.t_contact, "solimp": list(ramp_solimp(case.v, step)), "tuned_dt": step,
+              "solref_continuous": list(solref_for(case.e, case.t_contact)[:2]), "solimp_continuous": list(SOLIMP),
               "dampratio_unclamped": unclamped_damping_ratio(case.e), "v": case.v,
               "sphere_radius": case.R_sphere, "sphere_mass": case.m_sphere}
-    if finer:
-        params["timestep"] = largest_timestep(params)
-    else:
+    # tuned for the step and every finer one where that holds there (a step too coarse for the contact: the
+    # step's first-order error alone exceeds twice the tolerance), else for the step alone
+    params.update(solref=tuned_solref(case.e, case.t_contact, case.v, step), holds_at_finer_steps=True)
+    params["timestep"] = largest_timestep(params)
+    if not params["timestep"] >= step * (1.0 - 1e-12):
+        params.update(solref=tuned_solref(case.e, case.t_contact, case.v, step, finer=False),
+                      holds_at_finer_steps=False)
         params["timestep"] = step if _holds(params, step) else math.nan
+    omega = 1.0 / (params["solref"][0] * params["solref"][1])
+    params["solref_direct"] = [-omega * omega, -2.0 * params["solref"][1] * omega]
     return params
 
 
 def snippet(params: dict) -> str:
     """The MJCF lines: the sphere's geom with the contact's solref and solimp (priority 1, so that they win
-    over the plate's whatever its solmix), and the option's timestep."""
+    over the plate's whatever its solmix), and the option's timestep: the step the parameters are tuned for."""
     return (f"<!-- e = {params['e']:.6g} at {params['v']:.6g} m/s, contact {params['t_contact']:.4g} s; "
             + _step_note(params) + " -->\n"
             f"<option timestep=\"{params['tuned_dt']:.4g}\"/>\n" + sphere_geom(params, 8))
@@ -257,11 +253,13 @@ def _holds(params: dict, dt: float) -> bool:
 
 
 def largest_timestep(params: dict) -> float:
-    """The largest step [s] at which :func:`_holds`, at that step and every finer one tried
-    (t_contact / n, n from :data:`_STEPS_TRIED`); NaN where the finest fails."""
-    finest_failing = max((n for n in _STEPS_TRIED if not _holds(params, params["t_contact"] / n)), default=0)
-    passing = [n for n in _STEPS_TRIED if n > finest_failing]
-    return params["t_contact"] / passing[0] if passing else math.nan
+    """The largest step [s] at which :func:`_holds`, at that step and every finer one tried (t_contact / n, n
+    from :data:`_STEPS_TRIED`, and params' tuned_dt); NaN where the finest fails."""
+    steps = sorted({params["t_contact"] / n for n in _STEPS_TRIED} | ({params["tuned_dt"]} if "tuned_dt" in params
+                                                                      else set()), reverse=True)
+    finest_failing = min((dt for dt in steps if not _holds(params, dt)), default=math.inf)
+    passing = [dt for dt in steps if dt < finest_failing]
+    return passing[0] if passing else math.nan
 
 
 def drop_mjcf(params: dict, dt: float, phase: float = 0.5) -> str:

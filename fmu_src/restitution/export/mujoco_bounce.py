@@ -86,8 +86,8 @@ def bounce_in_mujoco(solref_at, radius: float, mass: float, height: float, v_min
 
 def solref_from_model(sphere, plate, d: float, t: float, **impact_options):
     """``solref_at(v)`` for :func:`bounce_in_mujoco`: (solref, solimp, the step [s] they are tuned for) of
-    ``restitution export mujoco`` (tuned for t_contact/50) for ``sphere`` (a :class:`~restitution.Material`) of diameter ``d`` [m] on
-    ``plate`` of thickness ``t`` [m] at the approach speed v [m/s]."""
+    ``restitution export mujoco`` (tuned for t_contact/50) for ``sphere`` (a :class:`~restitution.Material`) of
+    diameter ``d`` [m] on ``plate`` of thickness ``t`` [m] at the approach speed v [m/s]."""
     from .hosts import export_case
     from .mujoco import parameters
 
