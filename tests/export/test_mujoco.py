@@ -95,13 +95,15 @@ def test_continuous_law_gives_e(e):
     assert tuned_t == pytest.approx(params["t_contact"], rel=0.05)  # the ramp's first step softer: 1/50 of it
 
 
-@pytest.mark.parametrize("e, dt_steps", [(0.3, 60), (0.6, 25), (0.9, 12)])
+@pytest.mark.parametrize("e, dt_steps", [(0.3, 60), (0.6, 25), (0.9, 12), (0.05, 6)])
 def test_documented_step_is_mujocos_step(e, dt_steps):
     """The step written from MuJoCo's documentation (emulate_drop, on which the parameters are tuned) is
-    MuJoCo's, ramped impedance included: the same e to 1e-9 at coarse steps and every onset phase."""
+    MuJoCo's, ramped impedance included: the same e to 1e-9 at coarse steps and every onset phase. At e = 0.05
+    and t_contact/6 the timeconst is below two steps, where MuJoCo raises it to 2 dt (refsafe)."""
     _mujoco()
     params = export_mujoco.parameters(_case(e))
     dt = params["t_contact"] / dt_steps
+    assert (params["solref"][0] < 2 * dt) is (e == 0.05)
     for phase in PHASES:
         assert export_mujoco.emulate_drop(params, params["v"], dt, phase)[0] == pytest.approx(
             export_mujoco.mujoco_drop(params, dt, phase)[0], rel=1e-9)

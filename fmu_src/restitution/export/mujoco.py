@@ -211,10 +211,12 @@ def sphere_geom(params: dict, digits: int, extra: str = "") -> str:
             f"solimp=\"{numbers(params['solimp'])}\"/>")
 
 
-def _law(params: dict) -> tuple[float, float]:
+def _law(params: dict, dt: float) -> tuple[float, float]:
     """(stiffness [1/s^2], damping [1/s]) of the contact's reference acceleration at full impedance (d = dmax),
-    per unit penetration and speed."""
+    per unit penetration and speed, at the step ``dt`` [s]: MuJoCo raises a positive solref's timeconst to
+    2 dt (its "refsafe" rule, XML reference, solref), keeping dampratio."""
     timeconst, zeta = params["solref"]
+    timeconst = max(timeconst, 2.0 * dt)
     omega = 1.0 / (timeconst * zeta)
     return omega * omega, 2.0 * zeta * omega
 
@@ -225,7 +227,7 @@ def emulate_drop(params: dict, v: float, dt: float, phase: float = 0.5) -> tuple
     sphere reaching the plate at ``v`` [m/s] with gravity off, the contact's acceleration
     -s^2 k r - s b r' (s = d(r)/dmax, :func:`impedance`) while that pushes, zero otherwise. ``phase``: where
     in a step the sphere first touches (0 to 1)."""
-    stiffness, damping = _law(params)
+    stiffness, damping = _law(params, dt)
     solimp = params["solimp"]
     dmax = impedance(solimp, math.inf)
     gap, speed = v * dt * (1.0 - phase), -v  # above the plate by that much of a step: as drop_mjcf starts
