@@ -5,11 +5,12 @@
 
 MuJoCo's geoms have one solref each; this model's e falls with the impact speed (plasticity and the plate's
 waves). The ball is dropped on a plane in MuJoCo (``pip install "restitution[export]"``); before each
-contact the geom's solref is set from ``restitution export mujoco``'s mapping for the approach speed
-predicted from the ball's height and speed (:func:`restitution.export.mujoco_bounce.bounce_in_mujoco`), and
-MuJoCo steps the contact with the exported timestep. A second run keeps the first contact's solref for
-every bounce (a constant e). The picture (examples/output/mujoco_velocity_dependent.png) shows the achieved e
-of each bounce against its approach speed, beside the model's e(v) and the constant-e run.
+contact the geom's solref and solimp are set from ``restitution export mujoco``'s mapping for the approach
+speed predicted from the ball's height and speed (:func:`restitution.export.mujoco_bounce.bounce_in_mujoco`),
+and MuJoCo steps the contact with the step they are tuned for (t_contact/50). A second run keeps the first
+contact's solref for every bounce (a constant e; solimp's ramp still spans one step's approach). The
+picture (examples/output/mujoco_velocity_dependent.png) shows the achieved e of each bounce against its
+approach speed, beside the model's e(v) and the constant-e run.
 """
 from __future__ import annotations
 
@@ -21,6 +22,7 @@ import numpy as np
 
 import restitution as r
 from restitution.export import export_case
+from restitution.export.mujoco import ramp_solimp
 from restitution.export.mujoco_bounce import G, bounce_in_mujoco, solref_from_model
 from restitution.options import OptionError, input_quantity, material, positive_quantity
 from restitution.viz import finish
@@ -74,8 +76,9 @@ def run(show_plot: bool = False, out_dir=None, dpi: int = 90, verbose: bool = Tr
     first = export_case(float(np.sqrt(2 * G * height)), sphere_m, plate_m, d, t)
     solref_at = solref_from_model(sphere_m, plate_m, d, t)
     variable = bounce_in_mujoco(solref_at, 0.5 * d, first.m_sphere, height, v_min=v_min)
-    kept = solref_at(first.v)
-    constant = bounce_in_mujoco(lambda _v: kept, 0.5 * d, first.m_sphere, height, v_min=v_min)
+    kept, _solimp, step = solref_at(first.v)  # the solimp ramp spans one step's approach: it follows the speed
+    constant = bounce_in_mujoco(lambda v: (kept, ramp_solimp(v, step), step), 0.5 * d, first.m_sphere, height,
+                                v_min=v_min)
     want = model_e(sphere_m, plate_m, d, t, variable.v_in)
     errors = np.asarray(variable.e) / want - 1.0
     png = plot(variable, constant, sphere, plate, d, t, Path(out_dir or OUTPUT) / "mujoco_velocity_dependent.png",

@@ -59,6 +59,9 @@ def test_mujoco_json_contract(tmp_path):
                                                                                                 rel=1e-12)
     assert len(data["solref"]) == 2 and all(x > 0 for x in data["solref"]) and len(data["solimp"]) == 5
     assert 0 < data["timestep"] <= data["t_contact"] / 5
+    # tuned for the default step, t_contact/50, and holding there and at every finer step
+    assert data["tuned_dt"] == pytest.approx(data["t_contact"] / 50, rel=1e-12) and data["holds_at_finer_steps"]
+    assert data["timestep"] >= data["tuned_dt"] * (1 - 1e-12) and len(data["solref_continuous"]) == 2
     assert "<geom" in done.stdout and f"{data['solref'][1]:.8g}" in done.stdout and 'solimp="' in done.stdout
 
 
@@ -75,13 +78,21 @@ def test_a_speed_range_gives_the_parameters_per_speed(tmp_path):
 
 def test_verify_and_dt(tmp_path):
     """--verify passes at a fine contact; a coarse --dt is reported with a warning, and --verify at it exits 1
-    (at t_contact/5 the damped contact's first step alone misses e by far more than 1 %)."""
+    (at t_contact/5 the damped contact's first step alone misses e by far more than 1 %); at t_contact/25 the
+    parameters are tuned for the step and the drop at it holds."""
     fine = _run("mujoco", *PAIR, "--v", "1.3 m/s", "--verify", "--json", str(tmp_path / "m.json"))
     assert fine.returncode == 0 and "error" in fine.stdout, fine.stdout + fine.stderr
     data = json.loads((tmp_path / "m.json").read_text())
     assert abs(data["verify"][0]["error"]) < 0.01 and data["verify"][0]["dt"] is None
     coarse = _run("mujoco", *PAIR, "--v", "1.3 m/s", "--verify", "--dt", f"{data['t_contact'] / 5} s")
     assert coarse.returncode == 1 and "warning: dt" in coarse.stdout, coarse.stdout + coarse.stderr
+    # a step of t_contact/25: the export tunes solref and solimp for it, and the drop at it holds 1 %
+    middle = _run("mujoco", *PAIR, "--v", "1.3 m/s", "--verify", "--dt", f"{data['t_contact'] / 25} s", "--json",
+                  str(tmp_path / "m25.json"))
+    assert middle.returncode == 0, middle.stdout + middle.stderr
+    tuned = json.loads((tmp_path / "m25.json").read_text())
+    assert tuned["tuned_dt"] == pytest.approx(data["t_contact"] / 25, rel=1e-9)
+    assert abs(tuned["verify"][1]["error"]) < 0.01 and tuned["verify"][1]["dt"] == tuned["tuned_dt"]
 
 
 @pytest.mark.parametrize("args, words", [

@@ -10,6 +10,8 @@ defines::
     def parameters(case: ExportCase) -> dict
         # the JSON dict of the host's contract (docs/exports.md): always "e" and "t_contact", then the
         # host's own parameters, SI
+        # (a host whose parameters depend on the time step sets TUNES_TO_STEP = True and takes
+        #  parameters(case, dt), dt the user's step [s] or None for its default)
     def snippet(params: dict) -> str
         # ready-to-paste text in the host's syntax, from the dict parameters() gave
     def simulate_drop(params: dict, case: ExportCase, dt: float | None) -> dict

@@ -2,9 +2,9 @@
 
 MuJoCo has one ``solref`` per geom, not a COR per impact speed. Between contacts the ball flies freely,
 so its approach speed is known before it touches: this loop steps MuJoCo with a coarse step in flight,
-switches to a step that resolves the contact (:func:`restitution.export.mujoco.largest_timestep`) once
-the ball is within a few coarse steps of the plate, sets the geom's solref for the predicted approach speed
-(``solref_at(v)``, e.g. the model's e(v) through :func:`restitution.export.mujoco.solref_for`) and measures
+switches to the step the contact's parameters are tuned for once the ball is within a few coarse steps of
+the plate, sets the geom's solref and solimp for the predicted approach speed (``solref_at(v)``, e.g. the
+model's e(v) through :func:`restitution.export.mujoco.parameters`) and measures
 each contact's approach and rebound speeds. Needs MuJoCo (the ``export`` extra).
 """
 from __future__ import annotations
@@ -48,9 +48,10 @@ def _mjcf(radius: float, mass: float, height: float, flight_dt: float) -> str:
 def bounce_in_mujoco(solref_at, radius: float, mass: float, height: float, v_min: float = 0.05,
                      flight_dt: float = 1e-4, max_bounces: int = 30) -> Bounces:
     """The contacts of a ball of ``radius`` [m] and ``mass`` [kg] dropped from ``height`` [m] above a plane in
-    MuJoCo until it rebounds slower than ``v_min`` [m/s]. ``solref_at(v)`` -> (timeconst [s], dampratio [1],
-    step [s]): the solref for an approach speed v [m/s] and the step that resolves that contact. Flight steps are
-    ``flight_dt`` [s]; within three of them from the plate the step becomes the contact's, and solref is set from
+    MuJoCo until it rebounds slower than ``v_min`` [m/s]. ``solref_at(v)`` -> (solref [timeconst s,
+    dampratio], solimp [5 numbers], step [s]): the contact's parameters for an approach speed v [m/s] and the
+    step they are tuned for. Flight steps are ``flight_dt`` [s]; within three of them from the plate the step
+    becomes the contact's, and solref and solimp are set from
     the approach speed predicted there, sqrt(v^2 + 2 g gap)."""
     import mujoco
 
@@ -62,8 +63,9 @@ def bounce_in_mujoco(solref_at, radius: float, mass: float, height: float, v_min
         gap, speed = height + data.qpos[0], data.qvel[0]  # the slide joint moves from the start, height above
         if not armed and speed < 0.0 and gap < 3.0 * flight_dt * (abs(speed) + G * flight_dt):
             predicted = math.sqrt(speed * speed + 2.0 * G * max(gap, 0.0))
-            timeconst, dampratio, step = solref_at(predicted)
-            model.geom_solref[ball] = (timeconst, dampratio)
+            solref, solimp, step = solref_at(predicted)
+            model.geom_solref[ball] = solref
+            model.geom_solimp[ball] = solimp
             model.opt.timestep = step
             armed = True
         mujoco.mj_step(model, data)
@@ -83,14 +85,14 @@ def bounce_in_mujoco(solref_at, radius: float, mass: float, height: float, v_min
 
 
 def solref_from_model(sphere, plate, d: float, t: float, **impact_options):
-    """``solref_at(v)`` for :func:`bounce_in_mujoco`: (timeconst [s], dampratio [1], timestep [s]) of
-    ``restitution export mujoco`` for ``sphere`` (a :class:`~restitution.Material`) of diameter ``d`` [m] on
-    ``plate`` of thickness ``t`` [m] at the approach speed v [m/s]."""
+    """``solref_at(v)`` for :func:`bounce_in_mujoco`: (solref, solimp, the step [s] they are tuned for) of
+    ``restitution export mujoco`` (tuned for t_contact/50) for ``sphere`` (a :class:`~restitution.Material`) of
+    diameter ``d`` [m] on ``plate`` of thickness ``t`` [m] at the approach speed v [m/s]."""
     from .hosts import export_case
     from .mujoco import parameters
 
     def solref_at(v: float):
         params = parameters(export_case(v, sphere, plate, d, t, **impact_options))
-        return params["solref"][0], params["solref"][1], params["timestep"]
+        return tuple(params["solref"]), tuple(params["solimp"]), params["tuned_dt"]
 
     return solref_at
