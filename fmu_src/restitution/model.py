@@ -216,7 +216,8 @@ def published(values):
     m_eff = +inf; ``edge_echo`` is capped at :data:`EDGE_ECHO_PUBLISHED_MAX` (+inf for an unbounded plate)
     and ``wave_delay`` reads 0 with tau0 where the contact never ends.
     Nothing else changes; the package's own results keep the infinities. A dict gives a dict; a record
-    gives a record (itself where nothing changes, else a list in the same order)."""
+    gives a record (itself where nothing changes, else a list in the same order). A dict of some outputs
+    (``impact(outputs=...)``) needs ``contact_ends`` and ``edge_echo`` among them."""
     at = _BY_NAME if values.__class__ is dict else _RECORD_AT  # where each value sits
     ends, echo = values[at["contact_ends"]], values[at["edge_echo"]]
     if ends is True and echo.__class__ is float:  # one impact whose contact ends
@@ -230,7 +231,8 @@ def published(values):
     if ends is True or (ends.__class__ is np.ndarray and ends.all()):  # every contact ends: one reduction,
         return out                                                      # not three whole-array selections
     for name in ENDLESS:
-        out[at[name]] = where(ends, values[at[name]], 0.0)
+        if at is _RECORD_AT or name in values:  # a dict of some outputs (impact(outputs=...)): those it has
+            out[at[name]] = where(ends, values[at[name]], 0.0)
     return out
 
 
