@@ -519,19 +519,25 @@ def _pipeline(v, terms, want=None):
         values = tuple(_own_array(value, shape, bool if name in _FLAGS else float)
                        for name, value in zip(_FIELD_NAMES, values))
         return values + (_both(values[_LAMBDA_OK_AT], values[_VSTAR_OK_AT]),)
-    derived = dict(  # what the record computes from the steps, only where asked (the same expressions)
-        v_rebound=lambda: e * v, m_eff=lambda: plate_mass_from_ratio(m_a, ratio),
-        v_plate=lambda: plate_velocity_after_impact(v, e_ep, d_ze), plasticity_used=lambda: e_ep < 1.0,
-        e_negative=lambda: e < 0.0, contact_ends=lambda: tau0 < math.inf, concurrent=lambda: waves_concurrent(delay),
-        edge_clear=lambda: edge_clear(echo), valid=lambda: _both(lambda_ok, vstar_ok))
-    steps = dict(e=e, e_ep=e_ep, V_c=V_c, V_star=V_star, eps_y=eps_y, e_ze=e_ze, lam=lam, tau0=tau0, T=T,
+    steps = dict(v=v, e=e, e_ep=e_ep, V_c=V_c, V_star=V_star, eps_y=eps_y, e_ze=e_ze, d_ze=d_ze, lam=lam, tau0=tau0, T=T,
                  t_contact=t_contact, m_a=m_a, mass_ratio=ratio, wave_delay=delay, edge_echo=echo,
                  plate_waves_used=needed, lambda_in_range=lambda_ok, vstar_in_range=vstar_ok)
-    out = {name: derived[name]() if name in derived else steps[name] for name in want.names}
+    out = {name: _DERIVED[name](steps) if name in _DERIVED else steps[name] for name in want.names}
     if scalar:
         return out
     shape = np.broadcast_shapes(v.shape, shape)
     return {name: _own_array(value, shape, float if name in _REALS else bool) for name, value in out.items()}
+
+
+#: The record's values that are not a step of :func:`_pipeline` of their own, from its steps (by name), for
+#: ``impact(outputs=...)``: the expressions of the whole record's, evaluated only where asked.
+_DERIVED = {
+    "v_rebound": lambda s: s["e"] * s["v"], "m_eff": lambda s: plate_mass_from_ratio(s["m_a"], s["mass_ratio"]),
+    "v_plate": lambda s: plate_velocity_after_impact(s["v"], s["e_ep"], s["d_ze"]),
+    "plasticity_used": lambda s: s["e_ep"] < 1.0, "e_negative": lambda s: s["e"] < 0.0,
+    "contact_ends": lambda s: s["tau0"] < math.inf, "concurrent": lambda s: waves_concurrent(s["wave_delay"]),
+    "edge_clear": lambda s: edge_clear(s["edge_echo"]), "valid": lambda s: _both(s["lambda_in_range"], s["vstar_in_range"]),
+}
 
 
 def output_dependencies(name: str) -> frozenset:

@@ -20,7 +20,7 @@
 typedef struct {
     const char *label;
     int version; /* 2 or 3; 0: the precomputed C floor */
-    rst_impact_terms terms; /* version 0 */
+    precomputed_floor_terms terms; /* version 0 */
     void *dl;
     void *c;
     fmi2SetRealTYPE *set_real;
