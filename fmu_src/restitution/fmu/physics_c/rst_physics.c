@@ -115,18 +115,28 @@ static double hertz_stiffness(double E_prime, double d) { return (4.0 / 3.0) * s
  * speed factor; m_a [kg], k [N/m^1.5]. */
 static double time_scale_per_speed(double m_a, double k) { return pow(m_a / k, 0.4); }
 
-/* `exact`, 0 <= lambda <= 100: the Hermite piece of the generated table (zener_exact._table_scalar). */
-static void zener_exact_table(double lam, double *e_ze, double *deficit, double *tau0)
+/* `exact`, 0 <= lambda <= 100: the Hermite piece of the generated table that holds lambda, and lambda's
+ * coordinate in it (*t); e_ze is the piece's first cubic in t (zener_exact._table_scalar). */
+static const double *zener_exact_piece(double lam, double *t)
 {
     double x = lam * RST_ZT_INV_H;
     int cell = (int)x;
     const double *c;
-    double t;
     if (cell >= RST_ZT_N_CELLS) /* unreachable for lambda <= 100; keeps the index inside the table */
         cell = RST_ZT_N_CELLS - 1;
     c = RST_ZT_PIECES[RST_ZT_CELL_PIECE[cell]];
-    t = x - c[0];
-    *e_ze = c[1] + t * (c[2] + t * (c[3] + t * c[4]));
+    *t = x - c[0];
+    return c;
+}
+
+static double zener_exact_restitution(const double *c, double t) { return c[1] + t * (c[2] + t * (c[3] + t * c[4])); }
+
+/* `exact`, 0 <= lambda <= 100: (e_ze, 1 - e_ze, tau0) by the three cubics of lambda's piece. */
+static void zener_exact_table(double lam, double *e_ze, double *deficit, double *tau0)
+{
+    double t;
+    const double *c = zener_exact_piece(lam, &t);
+    *e_ze = zener_exact_restitution(c, t);
     *deficit = c[5] + t * (c[6] + t * (c[7] + t * c[8]));
     *tau0 = c[9] + t * (c[10] + t * (c[11] + t * c[12]));
 }
@@ -301,15 +311,9 @@ static void zener_restitution(double lam, int method, double *e_ze)
     if (method == RST_ZENER_PAPER_FIT)
         *e_ze = num_exp(-1.68374 * lam);
     else if (method == RST_ZENER_EXACT && lam <= RST_ZT_LAMBDA_MAX) {
-        double x = lam * RST_ZT_INV_H;
-        int cell = (int)x;
-        const double *c;
         double t;
-        if (cell >= RST_ZT_N_CELLS)
-            cell = RST_ZT_N_CELLS - 1;
-        c = RST_ZT_PIECES[RST_ZT_CELL_PIECE[cell]];
-        t = x - c[0];
-        *e_ze = c[1] + t * (c[2] + t * (c[3] + t * c[4]));
+        const double *c = zener_exact_piece(lam, &t);
+        *e_ze = zener_exact_restitution(c, t);
     } else
         (void)rst_zener_solution(lam, method, e_ze, &deficit, &tau0);
 }
