@@ -39,7 +39,7 @@ FLOOR_GLUE = BENCH_C / "floor_fmu.c"
 #: A plain C FMI 2.0 and FMI 3.0 host that times round trips (no Python in it; the pythonfmu FMU's guard starts its
 #: own interpreter). Every FMU named on the command line is opened (dlopen RTLD_LOCAL), instantiated and
 #: initialised; then, REPS times, each FMU in turn (the first one rotating) runs round trips for
-#: BATCH_SECONDS / 10 untimed, then for BATCH_SECONDS timed (64 between clock readings). One round
+#: BATCH_SECONDS / 10 untimed, then for BATCH_SECONDS timed (1024 between clock readings). One round
 #: trip: fmi2SetReal v_approach (a new value every time, so the model is evaluated), fmi2DoStep,
 #: fmi2GetReal of the Real outputs, fmi2GetBoolean of the Boolean outputs (an FMI 3.0 FMU: fmi3SetFloat64,
 #: fmi3DoStep, fmi3GetFloat64, fmi3GetBoolean, the same value references). Times are CPU time of the
