@@ -9,9 +9,8 @@
   does nothing: every hook returns at once and every output is a constant. What the native FMU costs
   above it is the physics and its glue; the floor itself is what the C front costs;
 * the plain C timing host (``bench_c/timing_host.c``), with the *precomputed C floor* linked in
-  (``bench_c/precomputed_floor.c``: the C physics with its parameter-only terms computed once,
-  ``rst_impact_terms_of``, and only ``rst_impact_with_terms`` per impact, no FMI: the least one impact
-  can cost), and the C-physics loop (``bench_c/physics_loop.c``).
+  (``bench_c/precomputed_floor.c``: the least C that computes e and v_rebound, by Eqs. 8, 12, 13 (the
+  paper's fit) and 20 with the parameter-only terms computed once, no FMI: the least one impact can cost), and the C-physics loop (``bench_c/physics_loop.c``).
 
 Each FMU is returned unzipped (``binaries/linux64/<model>.so`` or, FMI 3.0, ``binaries/x86_64-linux/<model>.so``,
 ``resources/``, modelDescription.xml).
@@ -40,7 +39,7 @@ FLOOR_GLUE = BENCH_C / "floor_fmu.c"
 #: A plain C FMI 2.0 and FMI 3.0 host that times round trips (no Python in it; the pythonfmu FMU's guard starts its
 #: own interpreter). Every FMU named on the command line is opened (dlopen RTLD_LOCAL), instantiated and
 #: initialised; then, REPS times, each FMU in turn (the first one rotating) runs round trips for
-#: BATCH_SECONDS / 10 untimed, then for BATCH_SECONDS timed (64 between clock readings). One round
+#: BATCH_SECONDS / 10 untimed, then for BATCH_SECONDS timed (1024 between clock readings). One round
 #: trip: fmi2SetReal v_approach (a new value every time, so the model is evaluated), fmi2DoStep,
 #: fmi2GetReal of the Real outputs, fmi2GetBoolean of the Boolean outputs (an FMI 3.0 FMU: fmi3SetFloat64,
 #: fmi3DoStep, fmi3GetFloat64, fmi3GetBoolean, the same value references). Times are CPU time of the
@@ -55,8 +54,8 @@ FLOOR_GLUE = BENCH_C / "floor_fmu.c"
 #: (VRS comma-separated); prints "BATCH <label>[/<call>] <rep> <seconds per round trip or call>" per batch.
 TIMING_HOST = BENCH_C / "timing_host.c"
 
-#: The precomputed C floor, linked into the timing host: ``rst_impact_terms_of`` once for the native FMU's start
-#: values, then per impact ``rst_impact_with_terms`` at the round trip's speed, e and v_rebound kept.
+#: The precomputed C floor, linked into the timing host: its parameter terms once for the native FMU's start
+#: values, then per impact e and v_rebound at the round trip's speed (bench_c/precomputed_floor.h).
 PRECOMPUTED_FLOOR = BENCH_C / "precomputed_floor.c"
 
 #: The C physics alone: rst_impact in a loop, v changing every call so nothing is cached.

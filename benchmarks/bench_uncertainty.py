@@ -22,7 +22,11 @@ Measured in one run, each ratio's two sides interleaved (A B A B ...), medians:
        percentiles of e). The command writes all 37 columns (a 139 MB table and its parts) and the
        statistics of every output, which the plain process does not: the price of the full table, printed
        without a goal;
-   (c) the same with ``--columns e``: the command then keeps and describes e alone, the plain process's work.
+   (c) the same with ``--columns e``: the command then keeps and describes e alone, the plain process's work;
+   (d) against the numpy floor: a Monte Carlo of the speed alone (v_approach = uniform:0.2:5, the FMU's start
+       values otherwise: one sphere on one plate), ``--columns e --summary``, the whole command, against a plain
+       ``python -c`` that imports numpy and numpy_floor.py only, draws the same speeds, computes e and v_rebound
+       by the numpy floor (its parameter terms once) and e's mean, std and percentiles (goal <= 1.5x, CPU).
 
 2. ``--sobol`` with N = ``--sobol-n`` (default 4096) base samples over plate.t = uniform_rel:0.15 and
    v_approach = uniform:0.5:3 (N x 4 cases), the whole command (``--no-plot --summary``), serially and on a
@@ -78,6 +82,25 @@ kw = dict(FIXED)
 for k, x in draws.items():
     kw[k] = x * BASE[k] if k in BASE else x
 e = restitution.impact(**kw).e
+json.dump({{"mean": float(e.mean()), "std": float(e.std(ddof=1)),
+           "percentiles": np.percentile(e, {percentiles!r}).tolist()}}, sys.stdout)
+"""
+
+
+GOAL_FLOOR = 1.5  #: the --columns e command / the numpy floor's plain process, at most
+FLOOR_RANDOM = {"v_approach": "uniform:0.2:5"}
+#: The plain process of 1(d): the speeds the sweep draws, the numpy floor's e and v_rebound, e's statistics.
+PLAIN_FLOOR = """\
+import json, sys
+import numpy as np
+sys.path.insert(0, {here!r})
+import numpy_floor
+N, SEED, BLOCK, (LO, HI), PARAMS = {n}, {seed}, {block}, {bounds!r}, {params!r}
+v = np.empty(N)
+for b in range(-(-N // BLOCK)):
+    lo, hi = b * BLOCK, min(N, (b + 1) * BLOCK)
+    v[lo:hi] = np.random.default_rng([SEED, b]).uniform(LO, HI, BLOCK)[:hi - lo]
+e, v_rebound = numpy_floor.e_and_rebound(v, numpy_floor.floor_terms(PARAMS))
 json.dump({{"mean": float(e.mean()), "std": float(e.std(ddof=1)),
            "percentiles": np.percentile(e, {percentiles!r}).tolist()}}, sys.stdout)
 """
@@ -239,6 +262,38 @@ def mc_processes(samples: int, runs: int, work: Path, columns: str | None = None
     return out
 
 
+def mc_floor_processes(samples: int, runs: int, work: Path) -> dict:
+    """1(d): the Monte Carlo of the speed keeping e, and the numpy floor's plain process, in turn. ``agree``: the
+    largest difference of e's mean and percentiles between the two, which differ by the paper's fit of Zener's
+    COR (the floor's) against the exact solution (the command's): up to 0.0136 in e."""
+    from restitution.sweep import SweepSpec
+    from restitution.sweep.spec import RANDOM_BLOCK
+
+    spec = SweepSpec.from_dict({"random": dict(FLOOR_RANDOM), "samples": samples})
+    _varying, fixed = impact_inputs(SweepSpec.from_dict({"random": dict(FLOOR_RANDOM), "samples": 1}))
+    params = {k: fixed[k] for k in ("sphere_E", "sphere_nu", "sphere_Sy", "sphere_rho", "sphere_d", "plate_E",
+                                    "plate_nu", "plate_Sy", "plate_rho", "plate_t")}
+    kind, args = spec._dists["v_approach"]
+    plain = [sys.executable, "-c", PLAIN_FLOOR.format(here=str(Path(__file__).resolve().parent), n=samples,
+                                                      seed=spec.seed, block=RANDOM_BLOCK, bounds=tuple(map(float, args)),
+                                                      params=params, percentiles=PERCENTILES)]
+    sweep = sweep_command(FLOOR_RANDOM, samples, "--scheduler", "serial", "--columns", "e", "--summary", "s.json",
+                          "--out", "t.parquet")
+    run_process(sweep, work)
+    want = json.loads(run_process(plain, work)["stdout"])
+    got = json.loads((work / "s.json").read_text())["outputs"]["e"]
+    agree = max(abs(got["mean"] - want["mean"]), *(abs(got[f"p{p:g}"] - w) for p, w in zip(PERCENTILES, want["percentiles"])))
+    res = {"sweep": [], "plain": []}
+    for turn in range(runs):
+        for side in (("sweep", "plain") if turn % 2 == 0 else ("plain", "sweep")):
+            res[side].append(run_process(sweep if side == "sweep" else plain, work))
+    out = {"agree": agree, "runs": runs}
+    for fig in ("cpu", "wall"):
+        a, b = [r[fig] for r in res["sweep"]], [r[fig] for r in res["plain"]]
+        out[fig] = {"sweep": _median(a), "plain": _median(b), "ratio": _median([x / y for x, y in zip(a, b)])}
+    return out
+
+
 def sobol_processes(n: int, runs: int, work: Path) -> dict:
     """The whole --sobol command, serially and on a LocalCluster of 2 workers, in turn: wall and CPU
     time, and the model evaluation's elapsed time as the command prints it (medians)."""
@@ -330,6 +385,14 @@ def main(argv=None) -> int:
               f"{pe['runs']} interleaved): sweep command {c['sweep']:.2f} s, plain impact process {c['plain']:.2f} s: "
               f"{c['ratio']:.2f}x (goal <= {GOAL_MC:g}x: {'met' if c['ratio'] <= GOAL_MC else 'NOT met'}); wall "
               f"{w['ratio']:.2f}x")
+        pf = mc_floor_processes(n, args.runs, work)
+        c, w = pf["cpu"], pf["wall"]
+        print(f"1(d) Monte Carlo of the speed, {n:,} draws, --columns e --summary, whole command against the numpy "
+              f"floor's plain process (CPU user + sys, median of {pf['runs']} interleaved; load average "
+              f"{os.getloadavg()[0]:.1f}): sweep command {c['sweep']:.2f} s, numpy floor process {c['plain']:.2f} s: "
+              f"{c['ratio']:.2f}x (goal <= {GOAL_FLOOR:g}x: {'met' if c['ratio'] <= GOAL_FLOOR else 'NOT met'}); "
+              f"wall {w['sweep']:.2f} s / {w['plain']:.2f} s = {w['ratio']:.2f}x; e's mean and percentiles "
+              f"within {pf['agree']:.1e} of the floor's (its paper fit of e_ze: up to 0.0136)")
         sp = sobol_in_process(args.sobol_n, args.reps)
         so = sobol_processes(args.sobol_n, args.sobol_runs, work)
     for name, label in (("serial", "--scheduler serial"), ("cluster", "LocalCluster of 2 workers")):

@@ -31,6 +31,12 @@ def apparent_restitution(e_ep, e_ze):
     e < 0 is a result, not an error: the sphere keeps moving with the plate after
     impact (possible for thin plates, where e_ze is small).
     """
+    if e_ep.__class__ is np.ndarray and e_ze.__class__ is np.ndarray and e_ep.shape == e_ze.shape:
+        e = np.add(1.0, e_ep)  # arrays: the same operations in two temporaries instead of four
+        e *= e_ze
+        e -= np.subtract(1.0, e_ep)
+        e *= 0.5
+        return e
     return 0.5 * (e_ze * (1.0 + e_ep) - (1.0 - e_ep))
 
 

@@ -10,13 +10,15 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, fields
-from fractions import Fraction
 from functools import lru_cache
 from typing import NamedTuple
 
 import numpy as np
 
 from . import fusion, jgm, zener
+from ._array_steps import (_moving, _own_array, _skip_small_loss, _waves_needed, _zener_restitution_where_needed,
+                           _zener_where_needed)
+from ._output_steps import Wanted, dependencies, wanted
 from ._num import fifth_root, is_scalar, minimum, where
 from .fusion import apparent_restitution, mass_ratio, plate_mass_from_ratio, plate_velocity_after_impact
 from .jgm import restitution_e44, restitution_e45, vstar_in_fit_range
@@ -26,7 +28,8 @@ from .validation import (check_choice, check_nonnegative, check_nonnegative_or_i
                          check_positive)
 from .zener import (TAU0_HERTZ, ZENER_METHODS, edge_clear, edge_echo_ratio_from_time, lambda_from_root,
                     lambda_in_studied_range, lambda_material_factor, lambda_speed_factor, time_scale_factor,
-                    time_scale_from_root, wave_delay, waves_concurrent, zener_linear, zener_paper_fit, zener_solution)
+                    time_scale_from_root, wave_delay, waves_concurrent, zener_linear, zener_paper_fit, zener_restitution_only,
+                    zener_solution)
 
 # The pipeline passes SI numbers it has checked: it calls the equations without their unit layer
 # (restitution.quantities), which would cost more than the equations on the scalar path.
@@ -39,7 +42,7 @@ from .zener import (TAU0_HERTZ, ZENER_METHODS, edge_clear, edge_echo_ratio_from_
 __all__ = ["ImpactResult", "impact", "ImpactTerms", "impact_terms", "impact_at", "impact_record_at", "RECORD",
            "published", "RESTITUTION_MODELS", "EFFECT_MODES", "ZENER_SLOPE_BOUND",
            "PARAMETERS", "DOMAIN", "validate_parameters", "RECORD_REALS", "RECORD_FLAGS", "EDGE_ECHO_PUBLISHED_MAX",
-           "check_edge_distance"]
+           "check_edge_distance", "output_dependencies"]
 
 RESTITUTION_MODELS = ("e45", "e44")
 EFFECT_MODES = ("off", "on", "auto")
@@ -213,7 +216,8 @@ def published(values):
     m_eff = +inf; ``edge_echo`` is capped at :data:`EDGE_ECHO_PUBLISHED_MAX` (+inf for an unbounded plate)
     and ``wave_delay`` reads 0 with tau0 where the contact never ends.
     Nothing else changes; the package's own results keep the infinities. A dict gives a dict; a record
-    gives a record (itself where nothing changes, else a list in the same order)."""
+    gives a record (itself where nothing changes, else a list in the same order). A dict of some outputs
+    (``impact(outputs=...)``) needs ``contact_ends`` and ``edge_echo`` among them."""
     at = _BY_NAME if values.__class__ is dict else _RECORD_AT  # where each value sits
     ends, echo = values[at["contact_ends"]], values[at["edge_echo"]]
     if ends is True and echo.__class__ is float:  # one impact whose contact ends
@@ -227,7 +231,8 @@ def published(values):
     if ends is True or (ends.__class__ is np.ndarray and ends.all()):  # every contact ends: one reduction,
         return out                                                      # not three whole-array selections
     for name in ENDLESS:
-        out[at[name]] = where(ends, values[at[name]], 0.0)
+        if at is _RECORD_AT or name in values:  # a dict of some outputs (impact(outputs=...)): those it has
+            out[at[name]] = where(ends, values[at[name]], 0.0)
     return out
 
 
@@ -256,7 +261,7 @@ def impact(v, sphere_E, sphere_nu, sphere_Sy, sphere_rho, sphere_d,
            plate_E, plate_nu, plate_Sy, plate_rho, plate_t, *, plate_edge_distance=math.inf,
            restitution_model: str = "e45", zener_method: str = "exact",
            plasticity="auto", plate_waves="auto", effect_tolerance: float = 1e-6,
-           ode_rtol: float = 1e-10, validate: bool = True) -> ImpactResult:
+           ode_rtol: float = 1e-10, validate: bool = True, outputs=None):
     """Apparent COR and everything behind it for a sphere hitting a plate at normal speed ``v``.
 
     Parameters (units in brackets): ``v`` approach speed [m/s] >= 0; sphere E [Pa],
@@ -274,6 +279,13 @@ def impact(v, sphere_E, sphere_nu, sphere_Sy, sphere_rho, sphere_d,
     linear), so tau0 and t_contact stay continuous at the skip threshold. ``ode_rtol`` is the tolerance of ``zener_method="ode"``.
     ``validate=False`` skips the input checks (for callers that already checked).
 
+    ``outputs``: None (default) gives the whole :class:`ImpactResult`. A sequence of names from
+    :data:`RECORD` (its fields and ``valid``) gives a dict of those values only, in the order asked, and
+    limits the work to them and what they depend on (:func:`output_dependencies`): ``outputs=("e",
+    "v_rebound")`` computes neither the contact time nor the monitors nor Zener's contact time where it
+    can skip them. Each value is the one the full result holds (the same operations). An unknown name
+    raises ValueError naming it, whatever ``validate``.
+
     The equations are computed for any finite positive input. One outside the model's domain (the
     ranges the FMUs declare and :class:`Material`, :class:`Sphere`, :class:`Plate` and
     :func:`impact_between` refuse: :data:`restitution.domain.DOMAIN`) gives a
@@ -286,6 +298,7 @@ def impact(v, sphere_E, sphere_nu, sphere_Sy, sphere_rho, sphere_d,
     ``impact(v, *p, **o)`` is ``impact_at(v, impact_terms(*p, **o))``: many speeds for one parameter set
     (a co-simulation's steps) make the terms once (:func:`impact_terms`, :func:`impact_at`).
     """
+    want = None if outputs is None else _wanted(outputs)
     plasticity = _mode("plasticity", plasticity)
     plate_waves = _mode("plate_waves", plate_waves)
     if validate:
@@ -300,7 +313,9 @@ def impact(v, sphere_E, sphere_nu, sphere_Sy, sphere_rho, sphere_d,
     terms = _terms((sphere_E, sphere_nu, sphere_Sy, sphere_rho, sphere_d, plate_E, plate_nu, plate_Sy, plate_rho,
                     plate_t), plate_edge_distance, restitution_model, zener_method, plasticity, plate_waves,
                    effect_tolerance, ode_rtol)
-    return _result(_pipeline(v, terms))
+    if want is None:
+        return _result(_pipeline(v, terms))
+    return _pipeline(v, terms, want)
 
 
 class ImpactTerms(NamedTuple):
@@ -410,10 +425,14 @@ def _terms(params, edge_distance, restitution_model, zener_method, plasticity, p
         effect_tolerance, ode_rtol, tau0_half_space if plate_waves == "auto" else TAU0_HERTZ, tau0_half_space)
 
 
-def _pipeline(v, terms) -> tuple:
+def _pipeline(v, terms, want=None):
     """The record (:data:`RECORD`: :class:`ImpactResult`'s fields in order, then ``valid``) at the speed ``v``,
     from the parameter-only ``terms``; written once for Python floats
     (``v`` a float and ``terms.floats``, the scalar mode) and numpy arrays alike.
+
+    ``want`` (:func:`_wanted`): None for the whole record; else the dict of the asked outputs only, each
+    step computed only where an asked output depends on it (:data:`_DEPENDS`). A step that runs runs the
+    same operations in both modes, so an asked value is the record's.
 
     Every step goes through the float-or-array helpers of :mod:`restitution._num` and the equations'
     own float-or-array forms; the differences are where results are stored and how many whole-array
@@ -430,60 +449,110 @@ def _pipeline(v, terms) -> tuple:
         v, scalar = float(v), True
     else:
         v, scalar = np.asarray(v, dtype=float), False
+    every = want is None
+    need = None if every else want.steps  # the outputs and every step they depend on
+    e_ep = e_ze = d_ze = tau0 = T = t_contact = e = ratio = delay = echo = None  # the steps not needed
 
     # --- JGM, Eqs. (1)-(8)
     V_star = v / V_c
-    if plasticity == "off":
-        e_ep = 1.0
-    else:
-        e_ep = (restitution_e45(V_star, eps_y) if restitution_model == "e45"
-                else restitution_e44(V_star))
-        if plasticity == "auto":
-            e_ep = ((1.0 if 1.0 - e_ep < effect_tolerance else e_ep) if scalar
-                    else _skip_small_loss(e_ep, effect_tolerance))
+    if every or "e_ep" in need:
+        if plasticity == "off":
+            e_ep = 1.0
+        else:
+            e_ep = (restitution_e45(V_star, eps_y) if restitution_model == "e45"
+                    else restitution_e44(V_star))
+            if plasticity == "auto":
+                e_ep = ((1.0 if 1.0 - e_ep < effect_tolerance else e_ep) if scalar
+                        else _skip_small_loss(e_ep, effect_tolerance))
 
     # --- Zener, Eqs. (9)-(13a)
     v_root = v ** 0.2 if scalar else fifth_root(v)  # v^(1/5), in Eq. (12) and Eq. (9)
     lam = lambda_from_root(v_root, lambda_factor)  # Eq. (12)
     # Eq. (9), +inf at v = 0; for arrays into v_root's own memory where the shapes allow (one array
     # fewer alive while Zener's table is read)
-    T = time_scale_from_root(time_factor, v_root, None if scalar or np.shape(time_factor) not in (
-        (), np.shape(v_root)) else v_root)
+    if every or "T" in need:
+        T = time_scale_from_root(time_factor, v_root, None if scalar or np.shape(time_factor) not in (
+            (), np.shape(v_root)) else v_root)
     del v_root
     if plate_waves == "auto":
-        needed = ZENER_SLOPE_BOUND * lam >= effect_tolerance if scalar else _waves_needed(lam, effect_tolerance)
+        needed = ZENER_SLOPE_BOUND * lam >= effect_tolerance if scalar else _waves_needed(lam, effect_tolerance, ZENER_SLOPE_BOUND)
     else:
         needed = plate_waves == "on"
-    if scalar:
-        e_ze, d_ze, tau0 = zener_solution(lam, zener_method, ode_rtol) if needed else (1.0, 0.0, skipped_tau0)
-    else:
-        e_ze, d_ze, tau0 = _zener_where_needed(lam, needed, zener_method, ode_rtol, skipped_tau0)
+    if every or "zener" in need:
+        if scalar:
+            e_ze, d_ze, tau0 = zener_solution(lam, zener_method, ode_rtol) if needed else (1.0, 0.0, skipped_tau0)
+        else:
+            e_ze, d_ze, tau0 = _zener_where_needed(lam, needed, zener_method, ode_rtol, skipped_tau0)
+    elif "e_ze" in need:  # e_ze alone: no deficit, no contact time where the method can skip them
+        e_ze = ((zener_restitution_only(lam, zener_method, ode_rtol) if needed else 1.0) if scalar
+                else _zener_restitution_where_needed(lam, needed, zener_method, ode_rtol))
 
     # T tau0 = inf where not moving (v = 0): replaced by 0
-    t_contact = ((contact_duration(T, tau0) if v > 0.0 else 0.0) if scalar
-                 else where(_moving(v), contact_duration(T, tau0), 0.0))
+    if every or "t_contact" in need:
+        t_contact = ((contact_duration(T, tau0) if v > 0.0 else 0.0) if scalar
+                     else where(_moving(v), contact_duration(T, tau0), 0.0))
 
     # --- Fusion, Eqs. (17)-(20)
-    e = apparent_restitution(e_ep, e_ze)
-    ratio = mass_ratio(e_ze, d_ze)
+    if every or "e" in need:
+        e = apparent_restitution(e_ep, e_ze)
+    if every or "mass_ratio" in need:
+        ratio = mass_ratio(e_ze, d_ze)
 
     # --- The monitors of the assumptions (sections 3 and 4): where Zener was skipped or off, the half-space
     # contact is its own reference
-    delay = ((wave_delay(tau0, tau0_half_space) if needed else 1.0) if scalar
-             else where(needed, wave_delay(tau0, tau0_half_space), 1.0))
-    echo = edge_echo_ratio_from_time(echo_time, t_contact)
+    if every or "wave_delay" in need:
+        delay = ((wave_delay(tau0, tau0_half_space) if needed else 1.0) if scalar
+                 else where(needed, wave_delay(tau0, tau0_half_space), 1.0))
+    if every or "edge_echo" in need:
+        echo = edge_echo_ratio_from_time(echo_time, t_contact)
 
-    lambda_ok, vstar_ok = lambda_in_studied_range(lam), vstar_in_fit_range(V_star)
-    values = (e, e * v, e_ep, V_c, V_star, eps_y, e_ze, lam, tau0, T, t_contact, m_a,
-              plate_mass_from_ratio(m_a, ratio), ratio, plate_velocity_after_impact(v, e_ep, d_ze), delay, echo,
-              e_ep < 1.0, needed, lambda_ok, vstar_ok, e < 0.0, tau0 < math.inf, waves_concurrent(delay),
-              edge_clear(echo))
-    if scalar:  # every value is already a Python float or bool (math-module paths; the tests check it)
-        return values + (lambda_ok and vstar_ok,)
+    lambda_ok = lambda_in_studied_range(lam) if every or "lambda_in_range" in need else None
+    vstar_ok = vstar_in_fit_range(V_star) if every or "vstar_in_range" in need else None
+    if every:
+        values = (e, e * v, e_ep, V_c, V_star, eps_y, e_ze, lam, tau0, T, t_contact, m_a,
+                  plate_mass_from_ratio(m_a, ratio), ratio, plate_velocity_after_impact(v, e_ep, d_ze), delay, echo,
+                  e_ep < 1.0, needed, lambda_ok, vstar_ok, e < 0.0, tau0 < math.inf, waves_concurrent(delay),
+                  edge_clear(echo))
+        if scalar:  # every value is already a Python float or bool (math-module paths; the tests check it)
+            return values + (lambda_ok and vstar_ok,)
+        shape = np.broadcast_shapes(v.shape, shape)
+        values = tuple(_own_array(value, shape, bool if name in _FLAGS else float)
+                       for name, value in zip(_FIELD_NAMES, values))
+        return values + (_both(values[_LAMBDA_OK_AT], values[_VSTAR_OK_AT]),)
+    steps = dict(v=v, e=e, e_ep=e_ep, V_c=V_c, V_star=V_star, eps_y=eps_y, e_ze=e_ze, d_ze=d_ze, lam=lam, tau0=tau0, T=T,
+                 t_contact=t_contact, m_a=m_a, mass_ratio=ratio, wave_delay=delay, edge_echo=echo,
+                 plate_waves_used=needed, lambda_in_range=lambda_ok, vstar_in_range=vstar_ok)
+    out = {name: _DERIVED[name](steps) if name in _DERIVED else steps[name] for name in want.names}
+    if scalar:
+        return out
     shape = np.broadcast_shapes(v.shape, shape)
-    values = tuple(_own_array(value, shape, bool if name in _FLAGS else float)
-                   for name, value in zip(_FIELD_NAMES, values))
-    return values + (_both(values[_LAMBDA_OK_AT], values[_VSTAR_OK_AT]),)
+    return {name: _own_array(value, shape, float if name in _REALS else bool) for name, value in out.items()}
+
+
+#: The record's values that are not a step of :func:`_pipeline` of their own, from its steps (by name), for
+#: ``impact(outputs=...)``: the expressions of the whole record's, evaluated only where asked.
+_DERIVED = {
+    "v_rebound": lambda s: s["e"] * s["v"], "m_eff": lambda s: plate_mass_from_ratio(s["m_a"], s["mass_ratio"]),
+    "v_plate": lambda s: plate_velocity_after_impact(s["v"], s["e_ep"], s["d_ze"]),
+    "plasticity_used": lambda s: s["e_ep"] < 1.0, "e_negative": lambda s: s["e"] < 0.0,
+    "contact_ends": lambda s: s["tau0"] < math.inf, "concurrent": lambda s: waves_concurrent(s["wave_delay"]),
+    "edge_clear": lambda s: edge_clear(s["edge_echo"]), "valid": lambda s: _both(s["lambda_in_range"], s["vstar_in_range"]),
+}
+
+
+def output_dependencies(name: str) -> frozenset:
+    """The outputs of :data:`RECORD` that :func:`impact` computes to give ``name`` (itself included);
+    ValueError for a name not in :data:`RECORD`."""
+    return dependencies(name, RECORD)
+
+
+def _wanted(outputs) -> Wanted:
+    """``impact(outputs=...)`` checked: one name, or a sequence of names (each kept once, in order)."""
+    try:
+        names = (outputs,) if isinstance(outputs, str) else tuple(dict.fromkeys(outputs))
+    except TypeError:  # not a sequence of names
+        raise ValueError(f"outputs = {outputs!r:.60} is not a name or a sequence of names of {RECORD}") from None
+    return wanted(names, RECORD)
 
 
 #: tau0 [1] of each Zener method at lambda = 0: what ``plate_waves="auto"`` reports where it skips
@@ -494,22 +563,7 @@ _TAU0_AT_LAMBDA0 = {"exact": TAU0_HERTZ, "ode": TAU0_HERTZ, "paper_fit": zener_p
 
 _FLAGS = frozenset(f.name for f in fields(ImpactResult) if f.type == "Flag")
 _FIELD_NAMES = tuple(f.name for f in fields(ImpactResult))
-
-
-def _own_array(x, shape, dtype):
-    """``x`` as an array of ``shape`` and ``dtype`` that no other field or input shares.
-
-    A temporary that already is one is used as is (copying 1e5-element results cost as
-    much as computing them); anything else (scalars, views) is broadcast and copied. Every value
-    the pipeline hands over is a fresh temporary or a scalar, never an input and never the same
-    object twice (tests/physics/test_model_contract.py checks that no field shares memory with an input
-    or another field, in every effect mode), so an owned array of the right kind is safe to keep.
-    """
-    if x.__class__ is np.ndarray and x.shape == shape and x.dtype == dtype and x.flags.owndata:
-        return x
-    if np.ndim(x) == 0:  # a value shared by every case (a material term, a flag): one fill
-        return np.full(shape, x, dtype=dtype)
-    return np.broadcast_to(x, shape).astype(dtype)
+_REALS = frozenset(RECORD_REALS)
 
 
 def _material_terms(sphere_E, sphere_nu, sphere_Sy, sphere_rho, sphere_d, plate_E, plate_nu, plate_Sy,
@@ -537,58 +591,3 @@ _material_terms_cached = lru_cache(maxsize=64)(_material_terms)
 def _float_or_array(x):
     """A scalar input as a Python float, anything else as a float array."""
     return float(x) if is_scalar(x) else np.asarray(x, dtype=float)
-
-
-def _skip_small_loss(e_ep, tolerance):
-    """``plasticity="auto"`` on arrays: e_ep = 1 where the plastic loss 1 - e_ep is below ``tolerance``, in
-    place (e_ep is a fresh result of Eq. 7 or 8, no one else's), by one comparison with
-    :func:`_loss_threshold`: the same cases as 1 - e_ep < tolerance, without the array of 1 - e_ep."""
-    if np.ndim(e_ep) == 0:
-        return where(1.0 - e_ep < tolerance, 1.0, e_ep)
-    threshold = _loss_threshold(tolerance)
-    np.copyto(e_ep, 1.0, where=(e_ep > threshold) if threshold is not None else np.subtract(1.0, e_ep) < tolerance)
-    return e_ep
-
-
-@lru_cache(maxsize=8)
-def _loss_threshold(tolerance):
-    """The largest float below or at 1 - ``tolerance`` (exactly, not rounded to nearest), or None for a
-    tolerance above 1/2. For e_ep in [1/2, 1], 1 - e_ep is exact (Sterbenz), so the floating-point
-    1 - e_ep < tolerance holds exactly where e_ep > 1 - tolerance, i.e. where e_ep exceeds this float;
-    below 1/2 neither holds (1 - e_ep > 1/2 >= tolerance, and the threshold is >= 1/2); e_ep never exceeds 1."""
-    if not 0.0 <= tolerance <= 0.5:
-        return None
-    exact = Fraction(1) - Fraction(tolerance)
-    threshold = float(exact)  # rounded to nearest: one step down if that went up
-    return threshold if Fraction(threshold) <= exact else math.nextafter(threshold, -math.inf)
-
-
-def _moving(v):
-    """v > 0 [m/s], an impact at all, of an array: one True when every speed is positive (the masks it
-    selects by then cost nothing), else the mask."""
-    if v.size and v.min() > 0.0:  # min propagates NaN: not > 0, and the mask decides
-        return True
-    return v > 0.0
-
-
-def _waves_needed(lam, tolerance):
-    """Where ``plate_waves="auto"`` computes Zener on arrays: ZENER_SLOPE_BOUND * lambda >= ``tolerance``;
-    one True when the smallest lambda passes (the product is non-decreasing in lambda, so then every case
-    does), else the mask."""
-    lam = np.asarray(lam)
-    if lam.size and ZENER_SLOPE_BOUND * lam.min() >= tolerance:
-        return True
-    return ZENER_SLOPE_BOUND * lam >= tolerance
-
-
-def _zener_where_needed(lam, needed, method, rtol, skipped_tau0):
-    """(e_ze, 1 - e_ze, tau0) of arrays, computed only where the plate-wave effect is needed;
-    (1, 0, ``skipped_tau0``) elsewhere."""
-    lam = np.asarray(lam)  # float already: Eq. (12) of float arrays
-    needed = np.broadcast_to(needed, lam.shape)
-    if needed.all():  # elementwise methods: same values as the masked evaluation, no gather/scatter
-        return zener_solution(lam, method, rtol)
-    e_ze, d_ze, tau0 = np.ones(lam.shape), np.zeros(lam.shape), np.full(lam.shape, skipped_tau0)
-    if needed.any():
-        e_ze[needed], d_ze[needed], tau0[needed] = zener_solution(lam[needed], method, rtol)
-    return e_ze, d_ze, tau0

@@ -18,14 +18,14 @@ import numpy as np
 from ._num import exp, expm1, is_scalar, minimum, sqrt, where
 from .quantities import si_only, with_units
 from .jgm import reduced_modulus
-from .zener_exact import zener_exact_solution
+from .zener_exact import zener_exact_restitution, zener_exact_solution
 from .zener_ode import solve_zener_ode
 
 __all__ = [
     "ZENER_METHODS", "LAMBDA_STUDIED_MAX", "lambda_in_studied_range", "TAU0_HERTZ", "plate_wave_speed", "inelasticity_parameter",
     "lambda_material_factor", "lambda_speed_factor", "lambda_from_root", "hertz_stiffness", "time_scale",
     "time_scale_factor", "time_scale_from_root", "zener_paper_fit", "zener_paper_fit_deficit", "zener_linear",
-    "zener_linear_deficit", "zener_linear_fit", "zener_ode", "zener_restitution", "zener_solution",
+    "zener_linear_deficit", "zener_linear_fit", "zener_ode", "zener_restitution", "zener_restitution_only", "zener_solution",
     "contact_duration", "WAVE_DELAY_LIMIT", "wave_delay", "waves_concurrent", "dilatational_wave_speed",
     "dilatational_slowness", "edge_echo_time", "edge_echo_ratio", "edge_echo_ratio_from_time", "edge_clear",
 ]
@@ -226,7 +226,12 @@ def zener_paper_fit(lam):
     tau0 ~ 3e304) beyond it, where the formula would overflow (the result is far outside
     the fit's range and flagged there anyway); it stays finite and non-decreasing.
     """
-    return exp(-1.68374 * lam), 3.215 * exp(0.318 * minimum(lam, _PAPER_FIT_LAMBDA_CAP) ** 1.5)
+    return _paper_fit_restitution(lam), 3.215 * exp(0.318 * minimum(lam, _PAPER_FIT_LAMBDA_CAP) ** 1.5)
+
+
+def _paper_fit_restitution(lam):
+    """e_ze = exp(-1.68374 lambda) [1], Eq. (13)."""
+    return exp(-1.68374 * lam)
 
 
 def zener_paper_fit_deficit(lam):
@@ -313,6 +318,16 @@ def zener_solution(lam, method: str = "exact", rtol: float = 1e-10):
         e, tau0 = zener_ode(lam, rtol=rtol)
         return e, 1.0 - e, tau0
     raise ValueError(f"zener_method = {method!r} is not one of {ZENER_METHODS}")
+
+
+def zener_restitution_only(lam, method: str = "exact", rtol: float = 1e-10):
+    """e_ze [1] alone for Zener's parameter lambda [1] by ``method``: :func:`zener_solution`'s first value,
+    by the same operations, without the contact time where the method can skip it (exact, paper_fit)."""
+    if method == "exact":
+        return zener_exact_restitution(lam)
+    if method == "paper_fit":
+        return _paper_fit_restitution(lam)
+    return zener_solution(lam, method, rtol)[0]
 
 
 def zener_restitution(lam, method: str = "exact", rtol: float = 1e-10):

@@ -176,7 +176,7 @@ def _scalar_general(lam):
 _BLOCK = 32768
 
 
-def _table_array(lam):
+def _table_array(lam, e_only=False):
     """(e_ze, 1 - e_ze, tau0) of an array 0 <= lambda <= LAMBDA_TABLE_MAX: the pieces of
     :func:`_table_scalar`, with one cell index and one local coordinate t shared by both cubics.
 
@@ -185,8 +185,9 @@ def _table_array(lam):
     q = t (a1 + t (a2 + t a3)) the e_ze cubic is a0 + q and the deficit's is (1 - a0) - q, the same
     floating-point operations as Horner on the deficit's own pieces (negation is exact) and
     1 - a0 the same number as its column ``c0`` (both are that one subtraction). In place, in blocks
-    of :data:`_BLOCK` cases written into the three results."""
-    results = tuple(np.empty(np.shape(lam)) for _ in range(3))  # their own memory, in lambda's shape
+    of :data:`_BLOCK` cases written into the three results. ``e_only``: (e_ze,) alone, the same cubic
+    without the other two (what ``impact(outputs=("e",))`` needs)."""
+    results = tuple(np.empty(np.shape(lam)) for _ in range(1 if e_only else 3))  # their own memory, in lambda's shape
     flat = tuple(r.reshape(-1) for r in results)  # views, to write them block by block
     lam = np.ascontiguousarray(lam).reshape(-1)
     n = min(lam.size, _BLOCK)
@@ -194,13 +195,14 @@ def _table_array(lam):
     for start in range(0, lam.size, _BLOCK):
         stop = min(start + _BLOCK, lam.size)
         m = stop - start
-        _table_block(lam[start:stop], *(r[start:stop] for r in flat), t[:m], piece[:m], gathered[:m], q[:m])
+        e, deficit, tau0 = (r[start:stop] for r in flat) if not e_only else (flat[0][start:stop], None, None)
+        _table_block(lam[start:stop], e, deficit, tau0, t[:m], piece[:m], gathered[:m], q[:m])
     return results
 
 
 def _table_block(lam, e, deficit, tau0, t, piece, gathered, q):
     """One block of :func:`_table_array`: the three cubics of the cases ``lam`` into ``e``, ``deficit`` and
-    ``tau0``, with the block's buffers ``t``, ``piece``, ``gathered`` and ``q``."""
+    ``tau0`` (None: not computed), with the block's buffers ``t``, ``piece``, ``gathered`` and ``q``."""
     def gather(column, out=gathered):  # mode "clip": indices are in range, and no bounds pass is buffered
         return _COEF_COLS[column].take(piece, out=out, mode="clip")
 
@@ -214,9 +216,12 @@ def _table_block(lam, e, deficit, tau0, t, piece, gathered, q):
     q += gather(2)
     q *= t
     gather(1, e)
-    np.subtract(1.0, e, out=deficit)
-    deficit -= q
+    if deficit is not None:
+        np.subtract(1.0, e, out=deficit)
+        deficit -= q
     e += q
+    if tau0 is None:
+        return
     gather(12, tau0)
     for column in (11, 10, 9):
         tau0 *= t
@@ -280,6 +285,15 @@ def zener_exact(lam):
     """
     e, _, tau0 = zener_exact_solution(lam)
     return e, tau0
+
+
+def zener_exact_restitution(lam):
+    """e_ze [1] of the "exact" method alone: :func:`zener_exact_solution`'s first value, by the same
+    operations, without the deficit and tau0 where an array lies in the table."""
+    if (lam.__class__ is np.ndarray and lam.dtype == float and lam.ndim and lam.size
+            and 0.0 <= lam.min() and lam.max() <= LAMBDA_TABLE_MAX):
+        return _table_array(lam, e_only=True)[0]
+    return zener_exact_solution(lam)[0]
 
 
 def zener_exact_solution(lam):

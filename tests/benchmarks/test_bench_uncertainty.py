@@ -21,6 +21,8 @@ def test_quick_run_prints_both_sides_and_the_ratio_of_each_measurement(tmp_path)
         rf"^1\(c\) the same with --columns e, .* sweep command ({NUMBER}) s, plain impact process ({NUMBER}) s: "
         rf"({NUMBER})x \(goal <= 2x: (met|NOT met)\)",
         rf"^     wall: sweep command ({NUMBER}) s, plain impact process ({NUMBER}) s: ({NUMBER})x",
+        rf"^1\(d\) Monte Carlo of the speed, .*: sweep command ({NUMBER}) s, numpy floor process ({NUMBER}) s: "
+        rf"({NUMBER})x \(goal <= 1.5x: (met|NOT met)\); wall ({NUMBER}) s / ({NUMBER}) s = ({NUMBER})x",
         rf"^2\. .*--scheduler serial .*: wall ({NUMBER}) s \(goal <= 5 s: (met|NOT met)\).* model evaluation "
         rf"({NUMBER}) s, analysis ({NUMBER}) s: analysis / evaluation ({NUMBER})x",
         rf"^2\. .*LocalCluster of 2 workers .*: wall ({NUMBER}) s \(goal <= 5 s: (met|NOT met)\).* model evaluation "
@@ -37,3 +39,6 @@ def test_quick_run_prints_both_sides_and_the_ratio_of_each_measurement(tmp_path)
     for agree in re.findall(rf"agree to ({NUMBER})", out):
         assert float(agree) < 1e-12, out
     assert len(re.findall("agree to", out)) == 2, out
+    # against the numpy floor: the same draws, e by the paper's fit of Zener's COR (within 0.0136 of the exact)
+    within = re.search(rf"e's mean and percentiles within ({NUMBER}) of the floor's", out)
+    assert within and float(within.group(1)) <= 0.0136, out

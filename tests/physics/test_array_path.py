@@ -256,10 +256,10 @@ def test_exact_table_in_blocks_matches_the_scalar_evaluation():
 @pytest.mark.parametrize("tolerance", [0.0, 5e-324, 1e-17, 2.0 ** -53, 3e-16, 1e-6, 1e-3, 0.1, 0.25, 0.5])
 def test_auto_skip_of_small_losses_by_one_comparison_selects_what_the_subtraction_selects(tolerance):
     """The array mode skips a plastic loss below ``effect_tolerance`` by comparing e_ep with one threshold
-    (model._loss_threshold) instead of computing 1 - e_ep: on e_ep in [0, 1] (uniform, near 1 within a few
+    (_array_steps._loss_threshold) instead of computing 1 - e_ep: on e_ep in [0, 1] (uniform, near 1 within a few
     tolerances, and the floats next to the threshold) it selects exactly the cases 1.0 - e_ep < tolerance
     selects in floating point (a comparison of two exact decisions, not of two roundings)."""
-    from restitution.model import _loss_threshold
+    from restitution._array_steps import _loss_threshold
 
     threshold = _loss_threshold(tolerance)
     rng = np.random.default_rng(3)

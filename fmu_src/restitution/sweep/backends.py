@@ -146,18 +146,37 @@ class PackageBackend(Backend):
         from ..model import impact, published
 
         n = np.size(cases["v_approach"])
+        columns, fields, publish = _kept_outputs(outputs)
         out = None
         for sel, inputs, options in impact_groups(cases, np.flatnonzero(inputs_ok(cases))):
-            values = published(impact(**inputs, **options, validate=False).as_dict())
+            values = impact(**inputs, **options, validate=False, outputs=fields)  # the kept columns' work only
+            values = values.as_dict() if fields is None else values
+            values = published(values) if publish else values
             if out is None and np.size(sel) == n:  # the usual chunk, every case in one call: its arrays are the columns
-                out = {name: _column(values[field_name], n, vtype) for name, field_name, vtype in OUTPUTS}
+                out = {name: _column(values[field_name], n, vtype) for name, field_name, vtype in columns}
                 out["ok"] = np.ones(n, dtype=bool)
                 continue
             out = _empty_outputs(n) if out is None else out
-            for name, field_name, _t in OUTPUTS:
+            for name, field_name, _t in columns:
                 out[name][sel] = values[field_name]
             out["ok"][sel] = True
         return (_empty_outputs(n) if out is None else out), {"code": _own_fingerprint(), "pid": os.getpid()}
+
+
+def _kept_outputs(keep):
+    """(the rows of OUTPUTS a sweep keeping the columns ``keep`` (None: all) writes, impact()'s ``outputs=``
+    for them (None: all), whether :func:`~restitution.model.published` changes any of them); where it does,
+    the outputs it reads too (``contact_ends``, ``edge_echo``)."""
+    from ..model import ENDLESS
+
+    if keep is None:
+        return OUTPUTS, None, True
+    columns = tuple(row for row in OUTPUTS if row[0] in keep)
+    fields = [field for _name, field, _t in columns]
+    publish = not {*ENDLESS, "edge_echo"}.isdisjoint(fields)
+    if publish:
+        fields += [field for field in ("contact_ends", "edge_echo") if field not in fields]
+    return columns, tuple(fields), publish
 
 
 def _impact_input(column, sel) -> np.ndarray | float:

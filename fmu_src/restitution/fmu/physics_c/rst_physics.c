@@ -115,18 +115,28 @@ static double hertz_stiffness(double E_prime, double d) { return (4.0 / 3.0) * s
  * speed factor; m_a [kg], k [N/m^1.5]. */
 static double time_scale_per_speed(double m_a, double k) { return pow(m_a / k, 0.4); }
 
-/* `exact`, 0 <= lambda <= 100: the Hermite piece of the generated table (zener_exact._table_scalar). */
-static void zener_exact_table(double lam, double *e_ze, double *deficit, double *tau0)
+/* `exact`, 0 <= lambda <= 100: the Hermite piece of the generated table that holds lambda, and lambda's
+ * coordinate in it (*t); e_ze is the piece's first cubic in t (zener_exact._table_scalar). */
+static const double *zener_exact_piece(double lam, double *t)
 {
     double x = lam * RST_ZT_INV_H;
     int cell = (int)x;
     const double *c;
-    double t;
     if (cell >= RST_ZT_N_CELLS) /* unreachable for lambda <= 100; keeps the index inside the table */
         cell = RST_ZT_N_CELLS - 1;
     c = RST_ZT_PIECES[RST_ZT_CELL_PIECE[cell]];
-    t = x - c[0];
-    *e_ze = c[1] + t * (c[2] + t * (c[3] + t * c[4]));
+    *t = x - c[0];
+    return c;
+}
+
+static double zener_exact_restitution(const double *c, double t) { return c[1] + t * (c[2] + t * (c[3] + t * c[4])); }
+
+/* `exact`, 0 <= lambda <= 100: (e_ze, 1 - e_ze, tau0) by the three cubics of lambda's piece. */
+static void zener_exact_table(double lam, double *e_ze, double *deficit, double *tau0)
+{
+    double t;
+    const double *c = zener_exact_piece(lam, &t);
+    *e_ze = zener_exact_restitution(c, t);
     *deficit = c[5] + t * (c[6] + t * (c[7] + t * c[8]));
     *tau0 = c[9] + t * (c[10] + t * (c[11] + t * c[12]));
 }
@@ -293,51 +303,88 @@ void rst_impact_terms_of(const rst_impact_inputs *in, rst_impact_terms *terms)
     terms->skipped_tau0 = in->plate_waves == RST_EFFECT_AUTO ? terms->tau0_half_space : RST_TAU0_HERTZ;
 }
 
-/* restitution.model._pipeline for one impact at v [m/s], its parameter-only terms precomputed. */
-int rst_impact_with_terms(const rst_impact_terms *terms, double v, rst_impact_result *out)
+/* e_ze [1] alone by `method` (rst_zener_solution's first value by the same operations; without the
+ * deficit and tau0, which cost exp/expm1/pow in `paper_fit` and `linear`). */
+static void zener_restitution(double lam, int method, double *e_ze)
 {
-    double speed_factor, e_ep, lam, e_ze, deficit, tau0, e;
-    int needed, status;
+    double deficit, tau0;
+    if (method == RST_ZENER_PAPER_FIT)
+        *e_ze = num_exp(-1.68374 * lam);
+    else if (method == RST_ZENER_EXACT && lam <= RST_ZT_LAMBDA_MAX) {
+        double t;
+        const double *c = zener_exact_piece(lam, &t);
+        *e_ze = zener_exact_restitution(c, t);
+    } else
+        (void)rst_zener_solution(lam, method, e_ze, &deficit, &tau0);
+}
+
+/* restitution.model._pipeline's steps that e and v_rebound need, at v [m/s]: Eq. (8), lambda (Eq. 12),
+ * whether Zener is needed, e_ze, Eq. (20). */
+int rst_impact_primary_of(const rst_impact_terms *terms, double v, rst_impact_primary *p)
+{
+    if (terms->status != RST_PHYSICS_OK)
+        return terms->status;
+    p->v = v;
+    p->speed_factor = pow(v, 0.2); /* v^(1/5) [(m/s)^(1/5)]: lambda's (Eq. 12) and T's (Eq. 9) dependence on v */
+
+    /* JGM, Eqs. (1)-(8) */
+    p->V_star = v / terms->V_c;
+    if (terms->plasticity == RST_EFFECT_OFF) {
+        p->e_ep = 1.0;
+    } else {
+        p->e_ep = terms->restitution_model == RST_E45
+                      ? restitution_e45(p->V_star, terms->e45_log_factor, terms->e45_exponent)
+                      : restitution_e44(p->V_star);
+        if (terms->plasticity == RST_EFFECT_AUTO && 1.0 - p->e_ep < terms->effect_tolerance)
+            p->e_ep = 1.0;
+    }
+
+    /* Zener, Eqs. (12)-(13) */
+    p->lam = terms->lambda_per_v * p->speed_factor;
+    if (terms->plate_waves == RST_EFFECT_AUTO)
+        p->needed = RST_ZENER_SLOPE_BOUND * p->lam >= terms->effect_tolerance;
+    else
+        p->needed = terms->plate_waves == RST_EFFECT_ON;
+    if (p->needed)
+        zener_restitution(p->lam, terms->zener_method, &p->e_ze);
+    else
+        p->e_ze = 1.0;
+
+    /* Fusion, Eq. (20) */
+    p->e = apparent_restitution(p->e_ep, p->e_ze);
+    p->v_rebound = p->e * v;
+    p->valid = p->lam <= RST_LAMBDA_STUDIED_MAX && p->V_star <= RST_VSTAR_FIT_MAX;
+    return RST_PHYSICS_OK;
+}
+
+int rst_impact_edge_monitored(const rst_impact_terms *terms) { return !terms->unbounded; }
+
+/* The rest of restitution.model._pipeline from the primary steps `p` of rst_impact_primary_of: Zener's
+ * deficit and contact time, the time scale, the plate's motion, the monitors, the flags. */
+int rst_impact_finish(const rst_impact_terms *terms, const rst_impact_primary *p, rst_impact_result *out)
+{
+    double deficit, tau0, e_ze;
+    int status;
     if (terms->status != RST_PHYSICS_OK) {
         fail(out);
         return terms->status;
     }
-    speed_factor = pow(v, 0.2); /* v^(1/5) [(m/s)^(1/5)]: lambda's (Eq. 12) and T's (Eq. 9) dependence on v */
-
-    /* JGM, Eqs. (1)-(8) */
     out->eps_y = terms->eps_y;
     out->m_a = terms->m_a;
     out->V_c = terms->V_c;
-    out->V_star = v / terms->V_c;
-    if (terms->plasticity == RST_EFFECT_OFF) {
-        e_ep = 1.0;
-    } else {
-        e_ep = terms->restitution_model == RST_E45
-                   ? restitution_e45(out->V_star, terms->e45_log_factor, terms->e45_exponent)
-                   : restitution_e44(out->V_star);
-        if (terms->plasticity == RST_EFFECT_AUTO && 1.0 - e_ep < terms->effect_tolerance)
-            e_ep = 1.0;
-    }
-
-    /* Zener, Eqs. (9)-(13a) */
-    lam = terms->lambda_per_v * speed_factor;
-    if (terms->plate_waves == RST_EFFECT_AUTO)
-        needed = RST_ZENER_SLOPE_BOUND * lam >= terms->effect_tolerance;
-    else
-        needed = terms->plate_waves == RST_EFFECT_ON;
-    if (needed) {
-        status = rst_zener_solution(lam, terms->zener_method, &e_ze, &deficit, &tau0);
+    out->V_star = p->V_star;
+    if (p->needed) {
+        status = rst_zener_solution(p->lam, terms->zener_method, &e_ze, &deficit, &tau0);
         if (status != RST_PHYSICS_OK) { /* unreachable: terms->status vetted the method */
             fail(out);
             return status;
         }
     } else {
-        e_ze = 1.0;
         deficit = 0.0;
         tau0 = terms->skipped_tau0;
     }
-    if (v > 0.0) {
-        out->T = terms->time_per_v / speed_factor;
+    if (p->v > 0.0) {
+        out->T = terms->time_per_v / p->speed_factor;
         out->t_contact = out->T * tau0;
     } else {
         out->T = INFINITY;
@@ -345,29 +392,40 @@ int rst_impact_with_terms(const rst_impact_terms *terms, double v, rst_impact_re
     }
 
     /* Fusion, Eqs. (17)-(20) */
-    e = apparent_restitution(e_ep, e_ze);
-    out->e = e;
-    out->v_rebound = e * v;
-    out->e_ep = e_ep;
-    out->e_ze = e_ze;
-    out->lam = lam;
+    out->e = p->e;
+    out->v_rebound = p->v_rebound;
+    out->e_ep = p->e_ep;
+    out->e_ze = p->e_ze;
+    out->lam = p->lam;
     out->tau0 = tau0;
-    out->m_eff = equivalent_plate_mass(terms->m_a, e_ze, deficit);
-    out->mass_ratio = mass_ratio(e_ze, deficit);
-    out->v_plate = plate_velocity(v, e_ep, deficit);
-    out->plasticity_used = e_ep < 1.0;
-    out->plate_waves_used = needed;
-    out->lambda_in_range = lam <= RST_LAMBDA_STUDIED_MAX;
-    out->vstar_in_range = out->V_star <= RST_VSTAR_FIT_MAX;
-    out->e_negative = e < 0.0;
+    out->m_eff = equivalent_plate_mass(terms->m_a, p->e_ze, deficit);
+    out->mass_ratio = mass_ratio(p->e_ze, deficit);
+    out->v_plate = plate_velocity(p->v, p->e_ep, deficit);
+    out->plasticity_used = p->e_ep < 1.0;
+    out->plate_waves_used = p->needed;
+    out->lambda_in_range = p->lam <= RST_LAMBDA_STUDIED_MAX;
+    out->vstar_in_range = p->V_star <= RST_VSTAR_FIT_MAX;
+    out->e_negative = p->e < 0.0;
     out->contact_ends = tau0 < INFINITY;
     /* monitors (model._pipeline): the half-space contact is its own reference where Zener was skipped */
-    out->wave_delay = needed ? tau0 / terms->tau0_half_space : 1.0;
+    out->wave_delay = p->needed ? tau0 / terms->tau0_half_space : 1.0;
     out->edge_echo = edge_echo_ratio(terms->unbounded, terms->echo_time, out->t_contact);
     out->concurrent = out->wave_delay <= RST_WAVE_DELAY_LIMIT;
     out->edge_clear = out->edge_echo >= 1.0;
     out->valid = out->lambda_in_range && out->vstar_in_range;
     return RST_PHYSICS_OK;
+}
+
+/* restitution.model._pipeline for one impact at v [m/s], its parameter-only terms precomputed. */
+int rst_impact_with_terms(const rst_impact_terms *terms, double v, rst_impact_result *out)
+{
+    rst_impact_primary p;
+    int status = rst_impact_primary_of(terms, v, &p);
+    if (status != RST_PHYSICS_OK) {
+        fail(out);
+        return status;
+    }
+    return rst_impact_finish(terms, &p, out);
 }
 
 int rst_impact(const rst_impact_inputs *in, rst_impact_result *out)

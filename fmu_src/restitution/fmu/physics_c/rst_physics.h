@@ -17,6 +17,9 @@
 #define rst_impact_terms_of RST_PREFIXED(rst_impact_terms_of)
 #define rst_impact_with_terms RST_PREFIXED(rst_impact_with_terms)
 #define rst_zener_solution RST_PREFIXED(rst_zener_solution)
+#define rst_impact_primary_of RST_PREFIXED(rst_impact_primary_of)
+#define rst_impact_finish RST_PREFIXED(rst_impact_finish)
+#define rst_impact_edge_monitored RST_PREFIXED(rst_impact_edge_monitored)
 #endif
 
 #ifdef __cplusplus
@@ -82,6 +85,32 @@ void rst_impact_terms_of(const rst_impact_inputs *in, rst_impact_terms *terms);
 /* One impact at approach speed v [m/s] >= 0 with the terms of rst_impact_terms_of; RST_PHYSICS_OK, or
  * terms->status with every real output NaN and every flag 0. */
 int rst_impact_with_terms(const rst_impact_terms *terms, double v, rst_impact_result *out);
+
+/* One impact in two parts, for a host that reads e and v_rebound at every step and the rest seldom:
+ * rst_impact_primary_of computes what e and v_rebound need (JGM's e_ep, lambda, Zener's e_ze alone),
+ * rst_impact_finish the rest of the record from it. Together they are rst_impact_with_terms (which
+ * calls them): the same operations, the same values. */
+typedef struct {
+    double v;            /* [m/s] the approach speed */
+    double speed_factor; /* [(m/s)^(1/5)] v^(1/5) */
+    double V_star;       /* [1] v / V_c */
+    double e_ep;         /* [1] Eq. (7) or (8), after the effect mode */
+    double lam;          /* [1] Eq. (12) */
+    double e_ze;         /* [1] Zener's COR (1 where skipped) */
+    double e;            /* [1] Eq. (20) */
+    double v_rebound;    /* [m/s] e v */
+    int needed;          /* Zener computed (plate_waves_used) */
+    int valid;           /* lambda <= 1.5 and V* <= 1000 */
+} rst_impact_primary;
+
+/* The primary steps at v [m/s]; RST_PHYSICS_OK or terms->status (then `p` is not filled). */
+int rst_impact_primary_of(const rst_impact_terms *terms, double v, rst_impact_primary *p);
+
+/* The whole record from the primary steps; RST_PHYSICS_OK, or terms->status with every real NaN. */
+int rst_impact_finish(const rst_impact_terms *terms, const rst_impact_primary *p, rst_impact_result *out);
+
+/* Does the edge-echo monitor depend on the speed (a bounded plate)? 0: edge_echo is +inf, edge_clear 1. */
+int rst_impact_edge_monitored(const rst_impact_terms *terms);
 
 /* Evaluate the model: rst_impact_terms_of then rst_impact_with_terms at in->v; RST_PHYSICS_OK, or an
  * error code with every real output NaN and every flag 0. */

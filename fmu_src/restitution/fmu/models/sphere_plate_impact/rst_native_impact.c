@@ -120,23 +120,53 @@ static void refresh_terms(rst_impact_cache *cache, double *values)
     cache->fresh = 1;
 }
 
-int rst_impact_evaluate_cached(rst_impact_cache *cache, double *values, char *message, size_t size)
+/* An error code of the physics as the message says it; every output invalidated. */
+static int refuse(const rst_impact_terms *t, int status, double *values, char *message, size_t size)
 {
-    rst_impact_result r;
-    int status, finite, k;
+    if (status == RST_PHYSICS_UNSUPPORTED)
+        snprintf(message, size, "%s", ODE_REFUSED);
+    else
+        snprintf(message, size, "invalid code: restitution_model = %d, zener_method = %d, plasticity = %d, "
+                 "plate_waves = %d", t->restitution_model, t->zener_method, t->plasticity, t->plate_waves);
+    invalidate(values);
+    return status;
+}
+
+/* A Real output that is not finite (every published one is): named in `message`, every output invalidated. */
+static int nonfinite(double *values, char *message, size_t size)
+{
+    int k = first_nonfinite(values);
+    double bad = values[REAL_OUTPUTS[k >= 0 ? k : 0]];
+    snprintf(message, size, "non-finite output %s = %s", RST_SPHEREPLATEIMPACT_VARIABLES[REAL_OUTPUTS[k >= 0 ? k : 0]].name,
+             isnan(bad) ? "nan" : bad > 0 ? "inf" : "-inf");
+    invalidate(values);
+    return RST_IMPACT_NONFINITE;
+}
+
+int rst_impact_evaluate_primary(rst_impact_cache *cache, double *values, rst_impact_primary *primary, char *message,
+                                size_t size)
+{
+    int status;
     if (!cache->fresh)
         refresh_terms(cache, values);
-    status = rst_impact_with_terms(&cache->terms, values[VR(V_APPROACH)], &r);
-    if (status != RST_PHYSICS_OK) {
-        const rst_impact_terms *t = &cache->terms;
-        if (status == RST_PHYSICS_UNSUPPORTED)
-            snprintf(message, size, "%s", ODE_REFUSED);
-        else
-            snprintf(message, size, "invalid code: restitution_model = %d, zener_method = %d, plasticity = %d, "
-                     "plate_waves = %d", t->restitution_model, t->zener_method, t->plasticity, t->plate_waves);
-        invalidate(values);
-        return status;
-    }
+    status = rst_impact_primary_of(&cache->terms, values[VR(V_APPROACH)], primary);
+    if (status != RST_PHYSICS_OK)
+        return refuse(&cache->terms, status, values, message, size);
+    values[VR(E)] = primary->e;
+    values[VR(V_REBOUND)] = primary->v_rebound;
+    if (!isfinite(primary->e) || !isfinite(primary->v_rebound))
+        return nonfinite(values, message, size);
+    return RST_PHYSICS_OK;
+}
+
+int rst_impact_evaluate_rest(const rst_impact_cache *cache, const rst_impact_primary *primary, double *values,
+                             char *message, size_t size)
+{
+    rst_impact_result r;
+    int status, finite;
+    status = rst_impact_finish(&cache->terms, primary, &r);
+    if (status != RST_PHYSICS_OK)
+        return refuse(&cache->terms, status, values, message, size);
     /* the record as restitution.model.published publishes it: tau0, t_contact and the wave delay read 0
      * where the contact never ends, the edge echo (+inf for an unbounded plate) is capped */
     if (!r.contact_ends)
@@ -153,14 +183,16 @@ int rst_impact_evaluate_cached(rst_impact_cache *cache, double *values, char *me
     RST_SPHEREPLATEIMPACT_REAL_OUTPUTS(FINITE)
 #undef PUBLISH
 #undef FINITE
-    if (!finite && (k = first_nonfinite(values)) >= 0) {
-        double bad = values[REAL_OUTPUTS[k]];
-        snprintf(message, size, "non-finite output %s = %s", RST_SPHEREPLATEIMPACT_VARIABLES[REAL_OUTPUTS[k]].name,
-                 isnan(bad) ? "nan" : bad > 0 ? "inf" : "-inf");
-        invalidate(values);
-        return RST_IMPACT_NONFINITE;
-    }
+    if (!finite && first_nonfinite(values) >= 0)
+        return nonfinite(values, message, size);
     return RST_PHYSICS_OK;
+}
+
+int rst_impact_evaluate_cached(rst_impact_cache *cache, double *values, char *message, size_t size)
+{
+    rst_impact_primary primary;
+    int status = rst_impact_evaluate_primary(cache, values, &primary, message, size);
+    return status != RST_PHYSICS_OK ? status : rst_impact_evaluate_rest(cache, &primary, values, message, size);
 }
 
 int rst_impact_evaluate(double *values, char *message, size_t size)

@@ -15,6 +15,8 @@
 #define rst_impact_accept RST_PREFIXED(rst_impact_accept)
 #define rst_impact_evaluate RST_PREFIXED(rst_impact_evaluate)
 #define rst_impact_evaluate_cached RST_PREFIXED(rst_impact_evaluate_cached)
+#define rst_impact_evaluate_primary RST_PREFIXED(rst_impact_evaluate_primary)
+#define rst_impact_evaluate_rest RST_PREFIXED(rst_impact_evaluate_rest)
 #endif
 
 #include <stddef.h>
@@ -48,5 +50,15 @@ typedef struct {
  * calculated parameters <body>.used.*) and recomputes the terms; then evaluates at the store's
  * v_approach. Same results, return codes and messages as rst_impact_evaluate. */
 int rst_impact_evaluate_cached(rst_impact_cache *cache, double *values, char *message, size_t size);
+
+/* rst_impact_evaluate_cached in two parts, for a front that publishes what a host reads:
+ * rst_impact_evaluate_primary writes e and v_rebound (and the calculated parameters where the cache was
+ * stale) and keeps in `primary` what the rest needs; rst_impact_evaluate_rest, with the same cache and
+ * `primary`, writes every other output. The two in turn are rst_impact_evaluate_cached (which calls them):
+ * the same values, return codes and messages, the checks of finiteness split between them. */
+int rst_impact_evaluate_primary(rst_impact_cache *cache, double *values, rst_impact_primary *primary, char *message,
+                                size_t size);
+int rst_impact_evaluate_rest(const rst_impact_cache *cache, const rst_impact_primary *primary, double *values,
+                             char *message, size_t size);
 
 #endif

@@ -1,6 +1,7 @@
 /* The native SpherePlateImpact FMU: the C front (cfront/rst_front.h) bound to the native backend
  * (rst_native_impact.h). The front checks every call and value; this file only decides when to
- * evaluate: lazily, when an output is read or a step taken after an input or parameter changed; and
+ * evaluate: lazily, when an output is read or a step taken after an input or parameter changed (e and
+ * v_rebound then; the other outputs on their first read after it, or where a departure is to be logged); and
  * when the parameter-only terms must be recomputed: after anything but v_approach was set, a reset or
  * a restored FMU state (a run of impacts at changing speeds pays only for the speed-dependent work).
  * The same holds for model exchange, where the model has no states and no events. */
@@ -14,6 +15,8 @@
 
 typedef struct {
     int stale;         /* an input or parameter changed since the last evaluation */
+    int rest_stale;    /* the outputs other than e and v_rebound are not computed yet for the last evaluation */
+    rst_impact_primary primary; /* the last evaluation's steps that e and v_rebound needed (the rest starts there) */
     rst_impact_cache cache; /* the parameter-only terms; stale (fresh = 0) after anything but v_approach changed */
     int failed;        /* the last evaluation failed: outputs are NaN/false */
     unsigned int warned; /* the conditions of log_departures logged since instantiation or reset (bits) */
@@ -81,6 +84,30 @@ static void log_departures(rst_instance *inst, impact_backend *b)
     }
 }
 
+/* The outputs besides e and v_rebound, on their first read after an evaluation (a step reads e and
+ * v_rebound alone at the cost of those two). */
+static void evaluate_rest(rst_instance *inst, impact_backend *b)
+{
+    char message[256], inputs[1024];
+    if (!b->rest_stale)
+        return;
+    b->rest_stale = 0;
+    b->failed = rst_impact_evaluate_rest(&b->cache, &b->primary, rst_store(inst), message, sizeof message) != 0;
+    if (b->failed) {
+        describe_inputs(inst, inputs, sizeof inputs);
+        rst_log(inst, RST_ERROR, "evaluation failed for %s: %s", inputs, message);
+    }
+}
+
+/* Does the step need the rest now, to log a departure not logged yet? */
+static int departure_to_log(const impact_backend *b)
+{
+    enum { LAMBDA = 1, V_STAR = 2, NEGATIVE = 4, EDGE = 8 };
+    return (!b->primary.valid && (b->warned & (LAMBDA | V_STAR)) != (LAMBDA | V_STAR))
+           || (b->primary.e < 0.0 && !(b->warned & NEGATIVE))
+           || (rst_impact_edge_monitored(&b->cache.terms) && !(b->warned & EDGE));
+}
+
 static void evaluate(rst_instance *inst)
 {
     impact_backend *b = (impact_backend *)rst_backend(inst);
@@ -88,12 +115,15 @@ static void evaluate(rst_instance *inst)
     if (!b->stale)
         return;
     b->stale = 0;
-    b->failed = rst_impact_evaluate_cached(&b->cache, rst_store(inst), message, sizeof message) != 0;
+    b->failed = rst_impact_evaluate_primary(&b->cache, rst_store(inst), &b->primary, message, sizeof message) != 0;
+    b->rest_stale = !b->failed;
     if (b->failed) {
         describe_inputs(inst, inputs, sizeof inputs);
         rst_log(inst, RST_ERROR, "evaluation failed for %s: %s", inputs, message);
-    } else if (!OUT(VALID) || !OUT(MONITOR_EDGE_CLEAR) || OUT(E_NEGATIVE)) {
-        log_departures(inst, b);
+    } else if (departure_to_log(b)) {
+        evaluate_rest(inst, b);
+        if (!b->failed && (!OUT(VALID) || !OUT(MONITOR_EDGE_CLEAR) || OUT(E_NEGATIVE)))
+            log_departures(inst, b);
     }
 }
 
@@ -147,9 +177,13 @@ static rst_status exit_initialization(rst_instance *inst)
 static rst_status get_outputs(rst_instance *inst, rst_type type, const rst_vr vr[], size_t n,
                               double values[])
 {
+    impact_backend *b = (impact_backend *)rst_backend(inst);
     size_t i;
     (void)type;
     evaluate(inst);
+    for (i = 0; i < n && b->rest_stale; i++)
+        if (vr[i] != RST_SPHEREPLATEIMPACT_VR_E && vr[i] != RST_SPHEREPLATEIMPACT_VR_V_REBOUND)
+            evaluate_rest(inst, b);
     for (i = 0; i < n; i++)
         values[i] = rst_store(inst)[vr[i]];
     return RST_OK;
