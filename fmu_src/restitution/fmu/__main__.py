@@ -10,6 +10,7 @@ from pathlib import Path
 from ..options import ArgumentParser
 from .build import FMUS, BuildError, build_all, default_fmu_dir
 from .build.progress import stderr_line
+from .ssp.check import check_ssp
 
 #: The command's name in its usage line and its errors, however it was started.
 PROG = "restitution fmu"
@@ -20,7 +21,8 @@ def main(argv=None) -> int:
                                      description="Build and validate the project's FMUs.")
     commands = parser.add_subparsers(dest="command", required=True)
     build = commands.add_parser("build", help=f"build {', '.join(f'{m}.fmu' for m in FMUS)} (pythonfmu) and their "
-                                              "native FMI 2.0 and 3.0 twins, for every platform")
+                                              "native FMI 2.0 and 3.0 twins, for every platform, and the SSPs of the native pair "
+                                              "(ssp/BallOnPlate.ssp: SSP 1.0, FMI 2.0; ssp/BallOnPlate-SSP2.ssp: SSP 2.0, FMI 3.0)")
     build.add_argument("--out", type=Path, default=None,
                        help=f"output directory (default: {default_fmu_dir()})")
     build.add_argument("--python-hosts-only", action="store_true",
@@ -28,9 +30,10 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     out = args.out if args.out is not None else default_fmu_dir()
     try:
-        for fmu in build_all(out, standalone=not args.python_hosts_only, log=stderr_line):
-            print(f"built {fmu} (fmpy validation: 0 problems)")
-    except BuildError as exc:
+        for product in build_all(out, standalone=not args.python_hosts_only, log=stderr_line):
+            checked = "fmpy validation: 0 problems" if product.suffix == ".fmu" else check_ssp(product)
+            print(f"built {product} ({checked})")
+    except (BuildError, ValueError) as exc:
         print(f"{PROG}: error: {exc}", file=sys.stderr)
         return 2
     return 0
