@@ -52,20 +52,12 @@ SSC = "http://ssp-standard.org/SSP1/SystemStructureCommon"
 
 
 @pytest.fixture(scope="module")
-def ssps(tmp_path_factory):
+def ssps(host_native_fmus):
     """{"1.0": BallOnPlate.ssp, "2.0": BallOnPlate-SSP2.ssp} from this platform's native FMUs."""
-    from restitution.fmu.build.compile import NativeBuildSkipped
-    from restitution.fmu.build.native import build_native_one
     from restitution.fmu.ssp import write_ssps
 
-    out = tmp_path_factory.mktemp("ssp_build")
-    try:
-        for version, folder in (("2.0", "linux64"), ("3.0", "x86_64-linux")):
-            for model in ("BouncingBall", "SpherePlateImpact"):
-                build_native_one(model, out, fmi_version=version, folders=(folder,))
-    except NativeBuildSkipped as exc:
-        pytest.skip(f"native FMUs not built here: {exc}")
-    written = write_ssps(out)
+    written = write_ssps(host_native_fmus)
+    out = host_native_fmus
     return {"1.0": out / "ssp" / "BallOnPlate.ssp", "2.0": out / "ssp" / "BallOnPlate-SSP2.ssp", "out": out,
             "written": written}
 
@@ -245,31 +237,12 @@ def test_custom_set_equals_the_preset_pair(ssps):
     np.testing.assert_allclose(custom["e_applied"][:N], preset["e_applied"][:N], rtol=1e-14)
 
 
-def codes_copy(ssp: Path, out: Path, impact_set: str) -> Path:
-    """A copy of ``ssp`` whose SSV enumerations are Integer codes (the FMU's values of the items) and whose
-    impact component is bound to ``impact_set``: what libcosim 0.0.6 and ecos 0.7.2 can read."""
-    ssd_ns = "http://ssp-standard.org/SSP1/SystemStructureDescription"
+def codes_copy(ssps, out: Path) -> Path:
+    """BallOnPlate.ssp bound to CASE with every Enumeration written as its Integer code (the FMU's value of
+    the item): what libcosim 0.0.6 and ecos 0.7.2 can read."""
+    from restitution.fmu.ssp import build_ssp
 
-    def change(name, data):
-        if name.endswith(".ssv"):
-            root = ET.fromstring(data)
-            items = {(e.get("name"), i.get("name")): i.get("value") for e in root.iter(f"{{{SSC}}}Enumeration")
-                     for i in e}
-            for p in root.iter(f"{{{SSV}}}Parameter"):
-                (typed,) = list(p)
-                if typed.tag == f"{{{SSV}}}Enumeration":
-                    p.remove(typed)
-                    ET.SubElement(p, f"{{{SSV}}}Integer", value=items[(typed.get("name"), typed.get("value"))])
-            return ET.tostring(root, xml_declaration=True, encoding="UTF-8")
-        if name == "SystemStructure.ssd":
-            root = ET.fromstring(data)
-            for c in root.iter(f"{{{ssd_ns}}}Component"):
-                if c.get("name") == "impact":
-                    c.find(f".//{{{ssd_ns}}}ParameterBinding").set("source", f"resources/{impact_set}.ssv")
-            return ET.tostring(root, xml_declaration=True, encoding="UTF-8")
-        return data
-
-    return _rewrite(ssp, out, change)
+    return build_ssp("1.0", ssps["out"] / "fmi2", out, impact_set=CASE, enumeration_codes=True)
 
 
 LIBCOSIM_CHILD = textwrap.dedent('''
@@ -318,7 +291,7 @@ def test_libcosim_runs_the_ssp(ssps, tmp_path):
                           timeout=300)
     # libcosim 0.0.6 cannot read <ssv:Enumeration>: its SSP parser aborts (the SSP is valid: test above)
     assert proc.returncode != 0 and "ssp_parser.cpp" in proc.stderr, proc.stderr[-2000:]
-    cfg.update(ssp=str(codes_copy(ssps["1.0"], tmp_path / "codes.ssp", CASE)), dir=str(tmp_path / "codes"),
+    cfg.update(ssp=str(codes_copy(ssps, tmp_path / "codes.ssp")), dir=str(tmp_path / "codes"),
                record=RECORD)
     proc = subprocess.run([sys.executable, "-c", LIBCOSIM_CHILD, json.dumps(cfg)], capture_output=True, text=True,
                           timeout=300)
@@ -391,7 +364,7 @@ def test_ecos_runs_the_ssp(ssps, ecos, tmp_path):
 
     proc = simulate(ssps["1.0"], tmp_path / "as_shipped")
     assert "Unknown XML node in ssv:Parameter" in proc.stdout + proc.stderr  # ecos 0.7.2 reads no Enumeration
-    ssp = codes_copy(ssps["1.0"], tmp_path / "codes.ssp", CASE)
+    ssp = codes_copy(ssps, tmp_path / "codes.ssp")
     proc = simulate(ssp, tmp_path / "codes")
     assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-2000:]
     lines = (tmp_path / "codes" / "codes.csv").read_text().splitlines()

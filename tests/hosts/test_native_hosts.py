@@ -42,13 +42,13 @@ import sys
 import textwrap
 import zipfile
 from pathlib import Path
-from xml.sax.saxutils import quoteattr
 
 import numpy as np
 import pytest
 
 import restitution as r
 from restitution.agreement import EPS, tolerances
+from restitution.fmu.ssp import CONNECTIONS  # the SSP's: ball.v_approach -> impact.v_approach, impact.e -> ball.e
 from restitution.cosim import CosimResult, ball_bounces, bounce, impact_fmu_parameters, package_rebound
 
 from fmu_platforms import binary_folders, skip_unless_built
@@ -221,11 +221,7 @@ def test_libcosim_native_pair_agrees_with_the_pythonfmu_pair(libcosim_runs, syst
 
 
 # --- 2. ecos (the ecospy wheel's command-line engine) ------------------------------------------------
-SSD_NS = ('xmlns:ssc="http://ssp-standard.org/SSP1/SystemStructureCommon" '
-          'xmlns:ssd="http://ssp-standard.org/SSP1/SystemStructureDescription" '
-          'xmlns:ssv="http://ssp-standard.org/SSP1/SystemStructureParameterValues"')
 PARAMETER_SET = "initialValues"
-CONNECTIONS = (("ball", "v_approach", "impact", "v_approach"), ("impact", "e", "ball", "e"))
 #: Compared with the fmpy run, every communication point: all the ball's outputs and its COR input, the
 #: impact FMU's input and outputs the bounces depend on.
 ECOS_COMPARED = {
@@ -237,47 +233,14 @@ ECOS_COMPARED = {
 CSV_RESOLUTION = 5e-7  # ecos writes every value with 6 decimals
 
 
-def _component(name, fmu_name, connectors, parameters):
-    lines = [f'      <ssd:Component name={quoteattr(name)} source={quoteattr("resources/" + fmu_name)}>',
-             "        <ssd:Connectors>"]
-    for connector, kind in connectors:
-        lines.append(f'          <ssd:Connector name={quoteattr(connector)} kind="{kind}"><ssc:Real/></ssd:Connector>')
-    lines += ["        </ssd:Connectors>", "        <ssd:ParameterBindings><ssd:ParameterBinding><ssd:ParameterValues>",
-              f'          <ssv:ParameterSet version="1.0" name="{PARAMETER_SET}"><ssv:Parameters>']
-    for parameter, value in parameters.items():
-        typed = f'<ssv:Integer value="{value}"/>' if isinstance(value, int) else f'<ssv:Real value="{value!r}"/>'
-        lines.append(f"            <ssv:Parameter name={quoteattr(parameter)}>{typed}</ssv:Parameter>")
-    lines += ["          </ssv:Parameters></ssv:ParameterSet>",
-              "        </ssd:ParameterValues></ssd:ParameterBinding></ssd:ParameterBindings>",
-              "      </ssd:Component>"]
-    return lines
-
-
 def write_ssp(path: Path, ball_fmu: Path, impact_fmu: Path, impact_params: dict, step: float) -> Path:
-    """An SSP 1.0 archive: SystemStructure.ssd (the two components, their parameters as the parameter set
-    PARAMETER_SET, the two connections, the step as OSP's FixedStepAlgorithm annotation) and the FMUs
-    in resources/."""
-    lines = ['<?xml version="1.0" encoding="UTF-8"?>',
-             f'<ssd:SystemStructureDescription {SSD_NS} name="BallOnPlate" version="1.0">',
-             '  <ssd:System name="BallOnPlate">', "    <ssd:Elements>"]
-    lines += _component("ball", "BouncingBall.fmu", [("v_approach", "output"), ("e", "input")], BALL)
-    lines += _component("impact", "SpherePlateImpact.fmu", [("v_approach", "input"), ("e", "output")], impact_params)
-    lines += ["    </ssd:Elements>", "    <ssd:Connections>"]
-    for start, start_c, end, end_c in CONNECTIONS:
-        lines.append(f'      <ssd:Connection startElement="{start}" startConnector="{start_c}" endElement="{end}" '
-                     f'endConnector="{end_c}"/>')
-    lines += ["    </ssd:Connections>", "  </ssd:System>",
-              '  <ssd:DefaultExperiment startTime="0"><ssd:Annotations>'
-              '<ssc:Annotation type="com.opensimulationplatform"><osp:Algorithm '
-              'xmlns:osp="http://opensimulationplatform.com/SSP/OSPAnnotations">'
-              f'<osp:FixedStepAlgorithm baseStepSize="{step!r}"/></osp:Algorithm></ssc:Annotation>'
-              "</ssd:Annotations></ssd:DefaultExperiment>",
-              "</ssd:SystemStructureDescription>"]
-    with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as z:
-        z.writestr("SystemStructure.ssd", "\n".join(lines) + "\n")
-        z.write(ball_fmu, "resources/BouncingBall.fmu")
-        z.write(impact_fmu, "resources/SpherePlateImpact.fmu")
-    return path
+    """An SSP 1.0 archive (restitution.fmu.ssp.inline_ssp): SystemStructure.ssd with the two components,
+    their parameters as the inline parameter set PARAMETER_SET (Enumerations as Integer codes, which ecos
+    reads), the two connections, the step as OSP's FixedStepAlgorithm annotation; the FMUs in resources/."""
+    from restitution.fmu.ssp import inline_ssp
+
+    return inline_ssp(path, {"ball": ball_fmu, "impact": impact_fmu}, {"ball": BALL, "impact": impact_params},
+                      step, set_name=PARAMETER_SET)
 
 
 @pytest.fixture(scope="module")

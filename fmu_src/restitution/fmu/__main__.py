@@ -27,13 +27,35 @@ def main(argv=None) -> int:
                        help=f"output directory (default: {default_fmu_dir()})")
     build.add_argument("--python-hosts-only", action="store_true",
                        help="skip the pythonfmu guard (the C checks of every FMI call, and the loader for plain C hosts; the FMUs then need a Python host)")
+    compat = commands.add_parser("compat", help="write the compatibility information of the native FMUs (FMI "
+                                                 "Cross-Check format: FMU, _in.csv, _ref.csv, _ref.opt, ReadMe.txt "
+                                                 "per model, FMI version and interface) into --out")
+    compat.add_argument("--out", type=Path, required=True, help="output directory (DIR/fmus/...)")
+    compat.add_argument("--fmus", type=Path, default=None,
+                        help=f"where the built FMUs are, fmi2/ and fmi3/ (default: {default_fmu_dir()})")
     args = parser.parse_args(argv)
+    if args.command == "compat":
+        return _compat(args)
     out = args.out if args.out is not None else default_fmu_dir()
     try:
         for product in build_all(out, standalone=not args.python_hosts_only, log=stderr_line):
             checked = "fmpy validation: 0 problems" if product.suffix == ".fmu" else check_ssp(product)
             print(f"built {product} ({checked})")
     except (BuildError, ValueError) as exc:
+        print(f"{PROG}: error: {exc}", file=sys.stderr)
+        return 2
+    return 0
+
+
+def _compat(args) -> int:
+    """``restitution fmu compat``: one line per model folder written; one line on stderr and exit 2 on error."""
+    from ..output_files import OutputPathError
+    from .compat import write_compat
+
+    try:
+        for folder in write_compat(args.out, args.fmus if args.fmus is not None else default_fmu_dir()):
+            print(f"wrote {folder}")
+    except (FileNotFoundError, OutputPathError, OSError) as exc:
         print(f"{PROG}: error: {exc}", file=sys.stderr)
         return 2
     return 0

@@ -86,11 +86,18 @@ BALL_SET = ParameterSet("ball", "BouncingBall: drop height, gravity, contact mod
                         {"h0": 0.3, "g": 9.80665, "contact_mode": 1, "v_min": 0.1})
 
 
-def _parameter(parent, name, value, variable, float_type, int_type, units, enumerations):
-    """One ``<ssv:Parameter>`` typed as ``variable`` (an fmpy variable of the FMU it sets)."""
+def _parameter(parent, name, value, variable, float_type, int_type, units, enumerations, codes):
+    """One ``<ssv:Parameter>`` typed as ``variable`` (an fmpy variable of the FMU it sets); ``codes``:
+    an Enumeration as its Integer code instead of its item's name."""
     element = ET.SubElement(parent, tag("ssv", "Parameter"), name=name)
     enumeration = enumeration_items(variable)
-    if enumeration is not None:
+    if enumeration is not None and codes:
+        type_name, items = enumeration
+        code = items[value] if isinstance(value, str) else int(value)
+        if code not in items.values():
+            raise ValueError(f"{name} = {value!r}: not an item of {type_name} ({', '.join(items)})")
+        ET.SubElement(element, tag("ssv", int_type), value=str(code))
+    elif enumeration is not None:
         type_name, items = enumeration
         item = value if isinstance(value, str) else {v: k for k, v in items.items()}[int(value)]
         if item not in items:
@@ -114,9 +121,10 @@ def _parameter(parent, name, value, variable, float_type, int_type, units, enume
         raise ValueError(f"{name}: parameters of type {variable.type} are not written")
 
 
-def parameter_set_element(pset: ParameterSet, variables: dict, version: str):
+def parameter_set_element(pset: ParameterSet, variables: dict, version: str, enumeration_codes: bool = False):
     """The ``<ssv:ParameterSet>`` element of ``pset`` for SSP ``version``, typed by ``variables`` ({name:
-    fmpy variable} of the FMU it sets)."""
+    fmpy variable} of the FMU it sets). ``enumeration_codes``: Enumerations as Integer codes, for the hosts
+    that read no ``<ssv:Enumeration>`` (libcosim 0.0.6, ecos 0.7.2: docs/ssp.md)."""
     _fmi, float_type = check_version(version)
     int_type = "Integer" if version == "1.0" else "Int32"
     root = ET.Element(tag("ssv", "ParameterSet"), version=version, name=pset.name, description=pset.description)
@@ -125,12 +133,13 @@ def parameter_set_element(pset: ParameterSet, variables: dict, version: str):
     for name, value in pset.values.items():
         if name not in variables:
             raise KeyError(f"parameter set {pset.name}: the FMU has no variable {name!r}")
-        _parameter(parameters, name, value, variables[name], float_type, int_type, units, enumerations)
+        _parameter(parameters, name, value, variables[name], float_type, int_type, units, enumerations,
+                   enumeration_codes)
     enumerations_element(root, "ssv", enumerations)
     units_element(root, "ssv", units)
     return root
 
 
-def write_parameter_set(pset: ParameterSet, variables: dict, version: str) -> bytes:
+def write_parameter_set(pset: ParameterSet, variables: dict, version: str, enumeration_codes: bool = False) -> bytes:
     """The SSV file of ``pset`` (see :func:`parameter_set_element`)."""
-    return to_bytes(parameter_set_element(pset, variables, version))
+    return to_bytes(parameter_set_element(pset, variables, version, enumeration_codes))
