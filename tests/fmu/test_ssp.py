@@ -25,9 +25,6 @@ from __future__ import annotations
 import importlib.util
 import json
 import math
-import os
-import shutil
-import stat
 import subprocess
 import sys
 import textwrap
@@ -333,28 +330,13 @@ def _check_run_with_default_materials(column: dict, resolution: float):
 
 @pytest.fixture(scope="module")
 def ecos(tmp_path_factory):
-    """ecospy's ``ecos`` engine, made executable, with libtbb.so.12 from the system or the tbb wheel."""
-    spec = importlib.util.find_spec("ecospy")  # not imported: that would load libecosc.so into pytest
-    if spec is None or not spec.submodule_search_locations:
-        pytest.skip("ecospy not installed")
-    shipped = Path(next(iter(spec.submodule_search_locations))) / "binaries" / "ecos"
-    if not shipped.is_file():
-        pytest.skip(f"ecospy has no Linux ecos binary at {shipped}")
-    exe = tmp_path_factory.mktemp("ecos") / "ecos"
-    shutil.copy(shipped, exe)
-    exe.chmod(exe.stat().st_mode | stat.S_IXUSR)
-    env = dict(os.environ)
-    wheel_lib = Path(sys.prefix) / "lib"
-    if (wheel_lib / "libtbb.so.12").exists():
-        env["LD_LIBRARY_PATH"] = os.pathsep.join(filter(None, [str(wheel_lib), env.get("LD_LIBRARY_PATH")]))
-    probe = subprocess.run([str(exe), "--version"], capture_output=True, text=True, timeout=60, env=env)
-    if probe.returncode != 0 and "libtbb" in probe.stderr:
-        pytest.skip("ecos needs libtbb.so.12 (pip install tbb, or apt-get install libtbb12)")
-    return exe, env
+    from ecos_engine import ecos_engine
+
+    return ecos_engine(tmp_path_factory.mktemp("ecos"))
 
 
 def test_ecos_runs_the_ssp(ssps, ecos, tmp_path):
-    exe, env = ecos
+    exe, env = ecos.exe, ecos.env
 
     def simulate(ssp, cwd):  # ecos applies the parameter sets of the name it is given only
         cwd.mkdir()

@@ -35,8 +35,6 @@ import json
 import math
 import os
 import re
-import shutil
-import stat
 import subprocess
 import sys
 import textwrap
@@ -245,31 +243,20 @@ def write_ssp(path: Path, ball_fmu: Path, impact_fmu: Path, impact_params: dict,
 
 @pytest.fixture(scope="module")
 def ecos_exe(tmp_path_factory):
-    """The wheel's ``ecos`` binary, copied and made executable (the wheel installs it without the x bit)."""
-    spec = importlib.util.find_spec("ecospy")  # not imported: that would load libecosc.so into pytest
-    if spec is None or not spec.submodule_search_locations:
-        pytest.skip("ecospy not installed (pip install ecospy==0.7.2; in the dev extra)")
-    shipped = Path(next(iter(spec.submodule_search_locations))) / "binaries" / "ecos"
-    if not shipped.is_file():
-        pytest.skip(f"ecospy has no Linux ecos binary at {shipped}")
-    exe = tmp_path_factory.mktemp("ecos") / "ecos"
-    shutil.copy(shipped, exe)
-    exe.chmod(exe.stat().st_mode | stat.S_IXUSR)
-    probe = subprocess.run([str(exe), "--version"], capture_output=True, text=True, timeout=60)
-    if probe.returncode != 0 and "libtbb" in probe.stderr:
-        pytest.skip("ecos needs libtbb.so.12 (Debian: apt-get install libtbb12; build_scripts/system_packages.sh)")
-    assert probe.returncode == 0 and probe.stdout.strip() == "v0.7.2", probe.stdout + probe.stderr
-    return exe
+    """The wheel's ``ecos`` engine and its environment (tests/ecos_engine.py)."""
+    from ecos_engine import ecos_engine
+
+    return ecos_engine(tmp_path_factory.mktemp("ecos"))
 
 
-def run_ecos(exe: Path, ssp: Path, step: float, stop: float, cwd: Path, log: list | None = None) -> dict:
+def run_ecos(ecos, ssp: Path, step: float, stop: float, cwd: Path, log: list | None = None) -> dict:
     """``ecos simulate`` in a child process; the CSV it writes ({column: values}, column = "instance::variable");
     its output is appended to ``log`` when given."""
     assert round(stop / step) >= 10, "ecos divides by numSteps / 10: fewer than 10 steps crash it (SIGFPE)"
     cwd.mkdir(parents=True, exist_ok=True)
-    proc = subprocess.run([str(exe), "simulate", "--path", str(ssp), "--stepSize", repr(step), "--stopTime", repr(stop),
-                           "--parameterSet", PARAMETER_SET, "--logLevel", "warn"],
-                          cwd=cwd, capture_output=True, text=True, timeout=300)
+    proc = subprocess.run([str(ecos.exe), "simulate", "--path", str(ssp), "--stepSize", repr(step), "--stopTime",
+                           repr(stop), "--parameterSet", PARAMETER_SET, "--logLevel", "warn"],
+                          cwd=cwd, capture_output=True, text=True, timeout=300, env=ecos.env)
     assert proc.returncode == 0, f"ecos exited {proc.returncode}\n{proc.stdout[-2000:]}\n{proc.stderr[-2000:]}"
     if log is not None:
         log.append(proc.stdout + proc.stderr)
