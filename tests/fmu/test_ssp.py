@@ -25,6 +25,7 @@ from __future__ import annotations
 import importlib.util
 import json
 import math
+import shutil
 import subprocess
 import sys
 import textwrap
@@ -353,3 +354,13 @@ def test_ecos_runs_the_ssp(ssps, ecos, tmp_path):
     header = [c.strip().rsplit("[", 1)[0] for c in lines[0].split(",")]
     data = np.array([[float(x) for x in line.split(",")] for line in lines[1:] if line.strip()])
     _check_run_with_default_materials({name: data[:, i] for i, name in enumerate(header)}, resolution=5e-7)
+
+
+def test_an_ssp_whose_fmus_are_missing_is_skipped_with_a_line(ssps, tmp_path):
+    """A build without FMI 3.0 FMUs (no compiler for them) writes the SSP 1.0 archive only, and says why."""
+    from restitution.fmu.ssp import write_ssps
+
+    shutil.copytree(ssps["out"] / "fmi2", tmp_path / "fmi2")
+    lines = []
+    assert write_ssps(tmp_path, log=lines.append) == [tmp_path / "ssp" / "BallOnPlate.ssp"]
+    assert lines == ["warning: BallOnPlate-SSP2.ssp (SSP 2.0) not written: no fmi3/ FMUs"]
