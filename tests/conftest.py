@@ -81,6 +81,23 @@ def fmi3_ball_fmu(built_fmus) -> Path:
     return _built_native(built_fmus, "fmi3", "BouncingBall")
 
 
+@pytest.fixture(scope="session")
+def host_native_fmus(tmp_path_factory) -> Path:
+    """A folder with the native FMUs for this machine's platform only (gcc, seconds: no zig): fmi2/ (linux64)
+    and fmi3/ (x86_64-linux) BouncingBall.fmu and SpherePlateImpact.fmu. Skips where they cannot be built."""
+    from restitution.fmu.builders.compile import NativeBuildSkipped
+    from restitution.fmu.builders.native import build_native_one
+
+    out = tmp_path_factory.mktemp("host_native")
+    try:
+        for version, folder in (("2.0", "linux64"), ("3.0", "x86_64-linux")):
+            for model in ("BouncingBall", "SpherePlateImpact"):
+                build_native_one(model, out, fmi_version=version, folders=(folder,))
+    except NativeBuildSkipped as exc:
+        pytest.skip(f"native FMUs not built here: {exc}")
+    return out
+
+
 def _implementation(built_fmus, model, which) -> Path:
     """``model``.fmu as ``which``: "python" (pythonfmu), "fmi2" (FMI 2.0 C) or "fmi3" (FMI 3.0 C)."""
     return built_fmus / f"{model}.fmu" if which == "python" else _built_native(built_fmus, which, model)

@@ -35,20 +35,18 @@ import json
 import math
 import os
 import re
-import shutil
-import stat
 import subprocess
 import sys
 import textwrap
 import zipfile
 from pathlib import Path
-from xml.sax.saxutils import quoteattr
 
 import numpy as np
 import pytest
 
 import restitution as r
 from restitution.agreement import EPS, tolerances
+from restitution.fmu.ssp import CONNECTIONS  # the SSP's: ball.v_approach -> impact.v_approach, impact.e -> ball.e
 from restitution.cosim import CosimResult, ball_bounces, bounce, impact_fmu_parameters, package_rebound
 
 from fmu_platforms import binary_folders, skip_unless_built
@@ -221,11 +219,7 @@ def test_libcosim_native_pair_agrees_with_the_pythonfmu_pair(libcosim_runs, syst
 
 
 # --- 2. ecos (the ecospy wheel's command-line engine) ------------------------------------------------
-SSD_NS = ('xmlns:ssc="http://ssp-standard.org/SSP1/SystemStructureCommon" '
-          'xmlns:ssd="http://ssp-standard.org/SSP1/SystemStructureDescription" '
-          'xmlns:ssv="http://ssp-standard.org/SSP1/SystemStructureParameterValues"')
 PARAMETER_SET = "initialValues"
-CONNECTIONS = (("ball", "v_approach", "impact", "v_approach"), ("impact", "e", "ball", "e"))
 #: Compared with the fmpy run, every communication point: all the ball's outputs and its COR input, the
 #: impact FMU's input and outputs the bounces depend on.
 ECOS_COMPARED = {
@@ -237,76 +231,32 @@ ECOS_COMPARED = {
 CSV_RESOLUTION = 5e-7  # ecos writes every value with 6 decimals
 
 
-def _component(name, fmu_name, connectors, parameters):
-    lines = [f'      <ssd:Component name={quoteattr(name)} source={quoteattr("resources/" + fmu_name)}>',
-             "        <ssd:Connectors>"]
-    for connector, kind in connectors:
-        lines.append(f'          <ssd:Connector name={quoteattr(connector)} kind="{kind}"><ssc:Real/></ssd:Connector>')
-    lines += ["        </ssd:Connectors>", "        <ssd:ParameterBindings><ssd:ParameterBinding><ssd:ParameterValues>",
-              f'          <ssv:ParameterSet version="1.0" name="{PARAMETER_SET}"><ssv:Parameters>']
-    for parameter, value in parameters.items():
-        typed = f'<ssv:Integer value="{value}"/>' if isinstance(value, int) else f'<ssv:Real value="{value!r}"/>'
-        lines.append(f"            <ssv:Parameter name={quoteattr(parameter)}>{typed}</ssv:Parameter>")
-    lines += ["          </ssv:Parameters></ssv:ParameterSet>",
-              "        </ssd:ParameterValues></ssd:ParameterBinding></ssd:ParameterBindings>",
-              "      </ssd:Component>"]
-    return lines
-
-
 def write_ssp(path: Path, ball_fmu: Path, impact_fmu: Path, impact_params: dict, step: float) -> Path:
-    """An SSP 1.0 archive: SystemStructure.ssd (the two components, their parameters as the parameter set
-    PARAMETER_SET, the two connections, the step as OSP's FixedStepAlgorithm annotation) and the FMUs
-    in resources/."""
-    lines = ['<?xml version="1.0" encoding="UTF-8"?>',
-             f'<ssd:SystemStructureDescription {SSD_NS} name="BallOnPlate" version="1.0">',
-             '  <ssd:System name="BallOnPlate">', "    <ssd:Elements>"]
-    lines += _component("ball", "BouncingBall.fmu", [("v_approach", "output"), ("e", "input")], BALL)
-    lines += _component("impact", "SpherePlateImpact.fmu", [("v_approach", "input"), ("e", "output")], impact_params)
-    lines += ["    </ssd:Elements>", "    <ssd:Connections>"]
-    for start, start_c, end, end_c in CONNECTIONS:
-        lines.append(f'      <ssd:Connection startElement="{start}" startConnector="{start_c}" endElement="{end}" '
-                     f'endConnector="{end_c}"/>')
-    lines += ["    </ssd:Connections>", "  </ssd:System>",
-              '  <ssd:DefaultExperiment startTime="0"><ssd:Annotations>'
-              '<ssc:Annotation type="com.opensimulationplatform"><osp:Algorithm '
-              'xmlns:osp="http://opensimulationplatform.com/SSP/OSPAnnotations">'
-              f'<osp:FixedStepAlgorithm baseStepSize="{step!r}"/></osp:Algorithm></ssc:Annotation>'
-              "</ssd:Annotations></ssd:DefaultExperiment>",
-              "</ssd:SystemStructureDescription>"]
-    with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as z:
-        z.writestr("SystemStructure.ssd", "\n".join(lines) + "\n")
-        z.write(ball_fmu, "resources/BouncingBall.fmu")
-        z.write(impact_fmu, "resources/SpherePlateImpact.fmu")
-    return path
+    """An SSP 1.0 archive (restitution.fmu.ssp.inline_ssp): SystemStructure.ssd with the two components,
+    their parameters as the inline parameter set PARAMETER_SET (Enumerations as Integer codes, which ecos
+    reads), the two connections, the step as OSP's FixedStepAlgorithm annotation; the FMUs in resources/."""
+    from restitution.fmu.ssp import inline_ssp
+
+    return inline_ssp(path, {"ball": ball_fmu, "impact": impact_fmu}, {"ball": BALL, "impact": impact_params},
+                      step, set_name=PARAMETER_SET)
 
 
 @pytest.fixture(scope="module")
 def ecos_exe(tmp_path_factory):
-    """The wheel's ``ecos`` binary, copied and made executable (the wheel installs it without the x bit)."""
-    spec = importlib.util.find_spec("ecospy")  # not imported: that would load libecosc.so into pytest
-    if spec is None or not spec.submodule_search_locations:
-        pytest.skip("ecospy not installed (pip install ecospy==0.7.2; in the dev extra)")
-    shipped = Path(next(iter(spec.submodule_search_locations))) / "binaries" / "ecos"
-    if not shipped.is_file():
-        pytest.skip(f"ecospy has no Linux ecos binary at {shipped}")
-    exe = tmp_path_factory.mktemp("ecos") / "ecos"
-    shutil.copy(shipped, exe)
-    exe.chmod(exe.stat().st_mode | stat.S_IXUSR)
-    probe = subprocess.run([str(exe), "--version"], capture_output=True, text=True, timeout=60)
-    if probe.returncode != 0 and "libtbb" in probe.stderr:
-        pytest.skip("ecos needs libtbb.so.12 (Debian: apt-get install libtbb12; build_scripts/system_packages.sh)")
-    assert probe.returncode == 0 and probe.stdout.strip() == "v0.7.2", probe.stdout + probe.stderr
-    return exe
+    """The wheel's ``ecos`` engine and its environment (tests/ecos_engine.py)."""
+    from ecos_engine import ecos_engine
+
+    return ecos_engine(tmp_path_factory.mktemp("ecos"))
 
 
-def run_ecos(exe: Path, ssp: Path, step: float, stop: float, cwd: Path, log: list | None = None) -> dict:
+def run_ecos(ecos, ssp: Path, step: float, stop: float, cwd: Path, log: list | None = None) -> dict:
     """``ecos simulate`` in a child process; the CSV it writes ({column: values}, column = "instance::variable");
     its output is appended to ``log`` when given."""
     assert round(stop / step) >= 10, "ecos divides by numSteps / 10: fewer than 10 steps crash it (SIGFPE)"
     cwd.mkdir(parents=True, exist_ok=True)
-    proc = subprocess.run([str(exe), "simulate", "--path", str(ssp), "--stepSize", repr(step), "--stopTime", repr(stop),
-                           "--parameterSet", PARAMETER_SET, "--logLevel", "warn"],
-                          cwd=cwd, capture_output=True, text=True, timeout=300)
+    proc = subprocess.run([str(ecos.exe), "simulate", "--path", str(ssp), "--stepSize", repr(step), "--stopTime",
+                           repr(stop), "--parameterSet", PARAMETER_SET, "--logLevel", "warn"],
+                          cwd=cwd, capture_output=True, text=True, timeout=300, env=ecos.env)
     assert proc.returncode == 0, f"ecos exited {proc.returncode}\n{proc.stdout[-2000:]}\n{proc.stderr[-2000:]}"
     if log is not None:
         log.append(proc.stdout + proc.stderr)

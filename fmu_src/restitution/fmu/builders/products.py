@@ -27,9 +27,13 @@ SCOPES = ("all", "model")
 
 def build_all(out_dir: Path, standalone: bool = True, log=None) -> list[Path]:
     """Build every FMU of the project into ``out_dir``: the pythonfmu ones, then the native ones into
-    ``out_dir/fmi2`` and ``out_dir/fmi3``, every platform (:func:`~restitution.fmu.builders.plan.full_plan`).
-    ``log``: the build's lines and warnings (default stderr)."""
-    return run(full_plan(), out_dir, standalone=standalone, log=log)
+    ``out_dir/fmi2`` and ``out_dir/fmi3``, every platform (:func:`~restitution.fmu.builders.plan.full_plan`),
+    then the SSPs of the native ones into ``out_dir/ssp`` (:func:`restitution.fmu.ssp.write_ssps`).
+    ``log``: the build's lines and warnings (default stderr). Returns the FMUs, then the SSPs."""
+    from ..ssp import write_ssps
+
+    fmus = run(full_plan(), out_dir, standalone=standalone, log=log)
+    return fmus + write_ssps(out_dir, log=log if log is not None else stderr_line)
 
 
 def _checkout_dist() -> Path | None:
