@@ -15,7 +15,7 @@ import pytest
 PACKAGE = Path(__file__).resolve().parents[2] / "fmu_src" / "restitution"
 FMU = PACKAGE / "fmu"
 #: The layer of each part of restitution.fmu (a subpackage, or a module at its top); higher imports lower.
-LAYERS = {"table": 0, "physics_c": 1, "pythonfmu_guard": 1, "models": 1, "describe": 2, "builders": 3, "__init__": 4, "__main__": 4}
+LAYERS = {"table": 0, "physics_c": 1, "pythonfmu_guard": 1, "models": 1, "describe": 2, "ssp": 2, "compat": 2, "builders": 3, "__init__": 4, "__main__": 4}
 
 
 def _imports(path: Path, package: str) -> set[str]:
