@@ -222,6 +222,41 @@ void rst_ball_do_step(double *values, double current_time, double step_size)
     update_outputs(values, end);
 }
 
+double rst_ball_step_to_contact(double *values, double current_time, double step_size, int event_mode)
+{
+    double g = AT(G), end = current_time + step_size;
+    int wait = event_mode || AT(CONTACT_MODE) == RST_BOUNCINGBALL_CONTACT_MODE_WAIT;
+    if (AT(IN_CONTACT) != 0.0) /* the COR for the pending contact arrived at this point */
+        rebound(values, current_time);
+    if (AT(AT_REST) == 0.0) {
+        /* flight_end, as in rst_ball_do_step: the contact that ends the current flight */
+        double v_start = AT(FLIGHT_V_START);
+        double v_hit = sqrt(v_start * v_start + 2.0 * g * AT(FLIGHT_H_START));
+        double t_hit = AT(FLIGHT_T_START) + (v_start + v_hit) / g;
+        if (t_hit <= end) { /* (a NaN is no contact) */
+            t_hit = t_hit >= current_time ? t_hit : current_time; /* (a flight shorter than a rounding) */
+            impact(values, t_hit, v_hit, 1.0);
+            if (!wait)
+                rebound(values, t_hit);
+            update_outputs(values, t_hit);
+            return t_hit;
+        }
+    }
+    update_outputs(values, end);
+    return end;
+}
+
+int rst_ball_contact_pending(const double *values) { return AT(IN_CONTACT) != 0.0; }
+
+int rst_ball_contact_update(double *values, double t)
+{
+    if (AT(IN_CONTACT) == 0.0)
+        return 0;
+    rebound(values, t);
+    update_outputs(values, t);
+    return 1;
+}
+
 void rst_ball_states_changed(double *values)
 {
     if (AT(AT_REST) != 0.0) { /* at rest the ball stays on the plate whatever a solver hands back */
