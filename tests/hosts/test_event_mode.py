@@ -28,23 +28,6 @@ V_MIN = 0.1  # [m/s]
 PAIR = ("s2/al6061", 1.0)  # the paper's Table 3 materials, plate as thick as the ball
 
 
-@pytest.fixture(scope="module")
-def host_fmi3(tmp_path_factory):
-    """The native FMI 3.0 BouncingBall.fmu and SpherePlateImpact.fmu of the current sources, built for this
-    machine's platform only (seconds; the session's built_fmus builds every platform)."""
-    from fmpy import platform_tuple
-
-    from restitution.fmu.build.compile import NativeBuildSkipped
-    from restitution.fmu.build.native import build_native_one
-
-    out = tmp_path_factory.mktemp("fmi3_host")
-    try:
-        return {model: build_native_one(model, out, fmi_version="3.0", folders=(platform_tuple,), log=lambda _l: None)
-                for model in ("BouncingBall", "SpherePlateImpact")}
-    except NativeBuildSkipped as exc:
-        pytest.skip(f"native FMI 3.0 FMUs not built here: {exc}")
-
-
 def package_cor(v: float) -> float:
     """The package's COR for approach speed v [m/s] (restitution.impact), the same materials as the FMU."""
     return r.impact(v, **params_for(*PAIR)).e

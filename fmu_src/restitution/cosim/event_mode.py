@@ -32,7 +32,8 @@ import numpy as np
 
 from .fmu import FmiStatusError, FmuInstance, _Fmi3
 
-__all__ = ["EventModeInstance", "StepEnd", "EventModeBounces", "event_mode_bounce", "BALL_AT_CONTACT"]
+__all__ = ["EventModeInstance", "StepEnd", "EventModeBounces", "event_mode_bounce", "drop_contacts",
+           "check_event_ball_fmu", "BALL_AT_CONTACT"]
 
 #: What the master reads from the ball after each event update (its record of the contact).
 BALL_AT_CONTACT = ("t_impact", "v_impact", "t_rebound", "v_rebound", "e_applied", "at_rest")
@@ -220,3 +221,52 @@ def event_mode_bounce(ball: EventModeInstance, rebound, step_size: float, stop_t
     return EventModeBounces(t_impact=data[:, 0], v_impact=data[:, 1], e_set=np.array(e_set, dtype=float),
                             e_applied=data[:, 4], v_rebound=data[:, 3], outputs=outputs, stop_reason=stop,
                             steps=steps, early_returns=early, step_size=step_size)
+
+
+def drop_contacts(ball: EventModeInstance, rebound, drop_height: float, gravity: float, v_min: float,
+                  step_size: float, max_bounces: int = 100_000, advance=None, interrupt=None):
+    """One drop through ``ball`` in event mode, in the form of
+    :func:`~restitution.cosim.bouncing.impact_sequence`: ``([(t, v_approach, out), ...], stop_reason)``,
+    ``out = rebound(v_approach)`` at each contact (its ``"e"`` is set on the ball there). The ball is reset
+    and released from rest at ``drop_height`` [m] at t = 0 under ``gravity`` [m/s2], at rest once it
+    would rebound slower than ``v_min`` [m/s]. ``advance(t, dt)``, if given, is called before each contact
+    for the flight that ends there (to step the impact FMU across it, as impact_sequence does)."""
+    ball.reset(parameters={"h0": drop_height, "g": gravity, "v_min": v_min})
+    last = [0.0]
+
+    def at_contact(v):
+        if advance is not None:
+            advance(last[0], ball.time - last[0])
+        last[0] = ball.time
+        out = rebound(v)
+        if any(math.isnan(x) for x in out.values() if x.__class__ is float):
+            values = ", ".join(f"{k} = {x!r}" for k, x in out.items() if x.__class__ is float)
+            raise ValueError(f"rebound at v_approach = {v!r} m/s gave {values} (t = {ball.time!r} s): "
+                             "the impact model rejected its inputs (see its log)")
+        return out
+
+    run = event_mode_bounce(ball, at_contact, step_size, max_bounces=max_bounces, interrupt=interrupt)
+    events = list(zip(run.t_impact.tolist(), run.v_impact.tolist(), run.outputs))
+    return events, run.stop_reason
+
+
+def check_event_ball_fmu(path, option: str = "--ball-fmu"):
+    """``path`` if it is an FMI 3.0 BouncingBall FMU that offers event mode and early return; else ValueError,
+    one line naming ``option`` and the path."""
+    from pathlib import Path
+
+    path = Path(path)
+    if not path.is_file():
+        raise ValueError(f"{option} {path}: {'not a file' if path.exists() else 'no such file'}")
+    try:
+        from fmpy import read_model_description
+
+        md = read_model_description(str(path))
+    except Exception as exc:  # noqa: BLE001 - whatever the archive is, it is not an FMU we can read
+        raise ValueError(f"{option} {path}: not an FMU ({type(exc).__name__}: {exc})") from None
+    cs = md.coSimulation
+    if md.modelName != "BouncingBall" or not md.fmiVersion.startswith("3") or cs is None or not cs.hasEventMode \
+            or not cs.mightReturnEarlyFromDoStep:
+        raise ValueError(f"{option} {path}: not an FMI 3.0 BouncingBall FMU with event mode and early return "
+                         f"({md.modelName}, FMI {md.fmiVersion})")
+    return path

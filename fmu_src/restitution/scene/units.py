@@ -23,12 +23,13 @@ class UnitError(ValueError):
 
 
 #: SI unit of each kind of quantity (what the loader converts to; shown in messages).
-QUANTITIES = {"length": "m", "pressure": "Pa", "density": "kg/m3", "speed": "m/s", "acceleration": "m/s2"}
+QUANTITIES = {"length": "m", "pressure": "Pa", "density": "kg/m3", "speed": "m/s", "acceleration": "m/s2",
+              "time": "s"}
 #: Units named in the messages as examples of each kind (any unit pint knows of that kind works).
 EXAMPLES = {"length": "m, cm, mm, um, in", "pressure": "Pa, kPa, MPa, GPa", "density": "kg/m3, g/cm3",
-            "speed": "m/s, cm/s, mm/s, km/h", "acceleration": "m/s2"}
+            "speed": "m/s, cm/s, mm/s, km/h", "acceleration": "m/s2", "time": "s, ms, us"}
 _EXAMPLE_VALUE = {"length": "3.18 mm", "pressure": "69 GPa", "density": "2700 kg/m3", "speed": "0.1 m/s",
-                  "acceleration": "9.81 m/s2"}
+                  "acceleration": "9.81 m/s2", "time": "1 ms"}
 
 # ASCII digits only: float() would take "٣.١٨" (Arabic-Indic digits) as 3.18. The unit is what follows,
 # from its first to its last non-blank character: written greedily, since a lazy ".*?" before "\s*$" made
