@@ -326,3 +326,45 @@ def test_with_both_flags_off_the_ball_steps_bit_for_bit_as_before(host_fmi3, bef
         for step in (1e-3, 1e-2):
             old, new = _ball_run(before, contact_mode, step), _ball_run(now, contact_mode, step)
             assert new == old, (contact_mode, step)  # lists of floats: == is bit identity (no NaN outputs)
+
+
+def _fmusim() -> str:
+    """The Reference FMUs' fmusim: $RESTITUTION_FMUSIM, else `fmusim` on PATH; skips naming the tool."""
+    import shutil
+
+    found = os.environ.get("RESTITUTION_FMUSIM") or shutil.which("fmusim")
+    if not found or not os.access(found, os.X_OK):
+        pytest.skip("fmusim (the Modelica Reference FMUs' simulator, built from their public sources) not found: "
+                    "put it on PATH or name it in RESTITUTION_FMUSIM")
+    return found
+
+
+def test_fmusim_runs_the_ball_with_early_return_and_event_mode(host_fmi3, tmp_path):
+    """fmusim, an independent strict FMI 3.0 host, runs BouncingBall with --early-return-allowed and
+    --event-mode-used (its e a constant 0.8, no impact FMU: fmusim runs one FMU): it records a row at each
+    contact instant, where t_impact is that instant, and every contact is at the ballistic time for
+    e = 0.8 to 1e-12 relative (fmusim writes 16 significant digits). Its log shows the calling sequence:
+    early returns with eventHandlingNeeded, then fmi3EnterEventMode, fmi3UpdateDiscreteStates,
+    fmi3EnterStepMode."""
+    import csv
+
+    out, calls = tmp_path / "out.csv", tmp_path / "calls.log"
+    run = subprocess.run([_fmusim(), "--interface-type", "cs", "--early-return-allowed", "--event-mode-used",
+                          "--start-value", "e", "0.8", "--stop-time", "3", "--output-interval", "0.1",
+                          "--output-file", str(out), "--log-fmi-calls", "--fmi-log-file", str(calls),
+                          str(host_fmi3["BouncingBall"])], capture_output=True, text=True, timeout=120)
+    assert run.returncode == 0, run.stdout[-2000:] + run.stderr[-2000:]
+    with open(out, newline="", encoding="utf-8") as f:
+        rows = [{k: float(v) for k, v in row.items()} for row in csv.DictReader(f)]
+    expected = ballistic_contacts(H0, G, V_MIN, lambda _v: 0.8)
+    contacts = sorted({row["t_impact"] for row in rows if row["t_impact"] >= 0.0})
+    assert len(contacts) == len(expected) and expected[-1][0] < 3.0  # the ball came to rest inside the run
+    for t, (t_ref, _v, _e) in zip(contacts, expected):
+        assert t == pytest.approx(t_ref, rel=1e-12)
+        assert any(row["time"] == t for row in rows)  # a row at the contact instant itself
+    log = calls.read_text(encoding="utf-8")
+    early = [line for line in log.splitlines() if line.startswith("fmi3DoStep") and "earlyReturn=1" in line]
+    assert len(early) == len(contacts) and all("eventHandlingNeeded=1" in line for line in early)
+    assert log.count("fmi3EnterEventMode() -> OK") == len(contacts)
+    assert log.count("fmi3EnterStepMode() -> OK") == len(contacts) + 1  # and once after initialization
+    assert "-> Error" not in log and "-> Fatal" not in log
