@@ -67,14 +67,10 @@ class _Fmi3Events(_Fmi3):
 
     @staticmethod
     def stepper(slave):
-        from ctypes import byref, c_bool, c_double
-
-        do_step, component = slave.fmi3DoStep, slave.component
-        event, terminate, early, last = c_bool(), c_bool(), c_bool(), c_double()
-        out = (byref(event), byref(terminate), byref(early), byref(last))
+        call, (event, terminate, early, last) = _Fmi3.step_call(slave)
 
         def step(t, h, no_state_before):
-            do_step(component, t, h, no_state_before, *out)
+            call(t, h, no_state_before)
             if terminate.value:
                 raise FmiStatusError(f"fmi3DoStep({t!r}, {h!r}) asked to terminate at {last.value!r} s", 2)
             return StepEnd(last.value, early.value, event.value)
