@@ -73,8 +73,11 @@ rst_status front_enter_event_mode(void *c, const char *function)
 {
     ENTER(function, RST_MODE_CONTINUOUS | RST_MODE_STEP_COMPLETE)
     if (!inst->model_exchange && !inst->event_mode_used) {
-        rst_log(inst, RST_ERROR, "%s: this co-simulation instance was instantiated with eventModeUsed = false; "
-                "it has no event mode", function);
+        if (strcmp(inst->api->prefix, "fmi3") != 0) /* FMI 2.0 co-simulation has no event mode at all */
+            only_model_exchange(inst, function);
+        else
+            rst_log(inst, RST_ERROR, "%s: this co-simulation instance was instantiated with eventModeUsed = "
+                    "false; it has no event mode", function);
         LEAVE(RST_ERROR);
     }
     inst->mode = RST_MODE_EVENT;
