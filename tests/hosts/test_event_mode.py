@@ -80,7 +80,7 @@ def test_contacts_are_at_the_ballistic_times_with_the_cor_of_their_own_speed(pai
     assert run.early_returns == len(run.t_impact) - on_grid
 
 
-def test_a_master_without_events_is_late_or_stale_where_this_one_is_not(pair, host_fmi3):
+def test_a_master_without_events_meets_the_plate_late(pair, host_fmi3):
     """The reason for event mode, measured: the same drop through the FMI 3.0 ball without the flags (the
     wait contact mode, 10 ms steps) meets the plate a second time later than the ballistic flight, by
     up to a step (the first rebound waits for the next communication point); the event-mode run does
