@@ -46,6 +46,23 @@ def ball_fmu(built_fmus) -> Path:
     return built_fmus / "BouncingBall.fmu"
 
 
+@pytest.fixture(scope="session")
+def host_fmi3(tmp_path_factory):
+    """The native FMI 3.0 BouncingBall.fmu and SpherePlateImpact.fmu of the current sources, built for this
+    machine's platform only (seconds; the session's built_fmus builds every platform)."""
+    from fmpy import platform_tuple
+
+    from restitution.fmu.builders.compile import NativeBuildSkipped
+    from restitution.fmu.builders.native import build_native_one
+
+    out = tmp_path_factory.mktemp("fmi3_host")
+    try:
+        return {model: build_native_one(model, out, fmi_version="3.0", folders=(platform_tuple,), log=lambda _l: None)
+                for model in ("BouncingBall", "SpherePlateImpact")}
+    except NativeBuildSkipped as exc:
+        pytest.skip(f"native FMI 3.0 FMUs not built here: {exc}")
+
+
 #: The folder of each native FMU of the build: FMI 2.0 and FMI 3.0.
 NATIVE_FOLDERS = {"fmi2": "FMI 2.0", "fmi3": "FMI 3.0"}
 

@@ -55,6 +55,9 @@
  *                             fmi2/3GetNominalsOfContinuousStates into an array of exactly N elements (or
  *                             NULL); prints STATES | DERIVATIVES | INDICATORS | NOMINALS <slot> <N values>
  *   enter_event S | enter_ct S   fmi2/3EnterEventMode | fmi2/3EnterContinuousTimeMode
+ * FMI 3.0 co-simulation with event mode (enter_event and update_discrete as above):
+ *   instantiate_ev NAME       fmi3InstantiateCoSimulation(loggingOn, eventModeUsed, earlyReturnAllowed)
+ *   enter_step S              fmi3EnterStepMode
  *   update_discrete S [null]  fmi2NewDiscreteStates | fmi3UpdateDiscreteStates (null: NULL eventInfo / every
  *                             out-argument NULL); prints DISCRETE (below)
  *   completed_step S [null]   fmi2/3CompletedIntegratorStep(noSetFMUStatePriorToCurrentPoint = true) (null: NULL
@@ -398,10 +401,11 @@ int main(int argc, char **argv)
         int n = split(line, tok, MAX_TOKENS), known = 1;
         if (n == 0 || tok[0][0] == '#') continue;
         const char *cmd = tok[0];
-        if (!strcmp(cmd, "instantiate") || !strcmp(cmd, "instantiate_me")) {
+        if (!strcmp(cmd, "instantiate") || !strcmp(cmd, "instantiate_me") || !strcmp(cmd, "instantiate_ev")) {
             if (n < 2 || nslots == MAX_SLOTS) return 1;
             snprintf(slot_name[nslots], MAX_NAME, "%s", tok[1]);
-            inst[nslots] = instantiate_kind(cmd[11] == '_' ? "model_exchange" : "", nslots, &known);
+            inst[nslots] = instantiate_kind(!strcmp(cmd, "instantiate_me") ? "model_exchange"
+                                            : !strcmp(cmd, "instantiate_ev") ? "events" : "", nslots, &known);
             if (!inst[nslots]) {
                 printf("INSTANTIATE_FAILED\n");
                 return 3;
@@ -499,6 +503,14 @@ int main(int argc, char **argv)
         } else if (!strcmp(cmd, "set_time") && a) {
             need_me_functions();
             report(cmd, s, set_time(c, strtod(a, NULL)));
+        } else if (!strcmp(cmd, "enter_step")) {
+#if FMI_VERSION == 3
+            need_me_functions();
+            report(cmd, s, enter_step_mode3(c));
+#else
+            fprintf(stderr, "fmi_script_host: FMI 2.0 has no enter_step\n");
+            return 1;
+#endif
         } else if (!strcmp(cmd, "enter_event") || !strcmp(cmd, "enter_ct")) {
             need_me_functions();
             report(cmd, s, (cmd[6] == 'e' ? enter_event_mode : enter_continuous_time_mode)(c));

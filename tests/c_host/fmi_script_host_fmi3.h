@@ -106,7 +106,7 @@ static Instance instantiate_kind(const char *kind, int slot, int *known)
     const char *name = slot_name[slot], *guid = token;
     void *environment = slot_name[slot];
     Logger3T log = logger;
-    bool event_mode = false;
+    bool event_mode = false, early_return = false;
     VR required[1] = {0};
     size_t n_required = 0;
     *known = 1;
@@ -116,6 +116,7 @@ static Instance instantiate_kind(const char *kind, int slot, int *known)
     else if (!strcmp(kind, "null_guid")) guid = NULL;
     else if (!strcmp(kind, "wrong_guid_no_logger")) guid = "{00000000-0000-0000-0000-000000000000}", log = NULL;
     else if (!strcmp(kind, "event_mode")) event_mode = true;
+    else if (!strcmp(kind, "events")) event_mode = early_return = true; /* instantiate_ev: both, legitimately */
     else if (!strcmp(kind, "intermediate_update")) n_required = 1;
     else if (!strcmp(kind, "model_exchange")) return instantiate_me(name, guid, resources, false, true, environment, log);
     else if (!strcmp(kind, "scheduled_execution"))
@@ -124,8 +125,8 @@ static Instance instantiate_kind(const char *kind, int slot, int *known)
         *known = 0;
         return NULL;
     }
-    return instantiate_cs(name, guid, resources, false, true, event_mode, false, required, n_required, environment,
-                          log, NULL);
+    return instantiate_cs(name, guid, resources, false, true, event_mode, early_return, required, n_required,
+                          environment, log, NULL);
 }
 
 static Status setup(int s, Instance c, double t0)
@@ -176,6 +177,7 @@ typedef Status (*UpdateDiscrete3T)(Instance, bool *, bool *, bool *, bool *, boo
 typedef Status (*CompletedStep3T)(Instance, bool, bool *, bool *);
 static UpdateDiscrete3T update_discrete3;
 static CompletedStep3T completed_step3;
+static InstanceOnlyT enter_step_mode3; /* co-simulation with event mode: event mode -> step mode */
 static void me_functions(void)
 {
     enter_event_mode = (InstanceOnlyT)me_sym("fmi3EnterEventMode");
@@ -188,6 +190,7 @@ static void me_functions(void)
     get_vector[VEC_NOMINALS] = (GetVectorT)me_sym("fmi3GetNominalsOfContinuousStates");
     update_discrete3 = (UpdateDiscrete3T)me_sym("fmi3UpdateDiscreteStates");
     completed_step3 = (CompletedStep3T)me_sym("fmi3CompletedIntegratorStep");
+    enter_step_mode3 = (InstanceOnlyT)me_sym("fmi3EnterStepMode");
 }
 /* fmi3UpdateDiscreteStates; null_args: every out-argument NULL */
 static Status update_discrete(Instance c, int null_args, EventUpdate *u)

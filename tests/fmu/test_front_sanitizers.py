@@ -259,9 +259,10 @@ def _run(host, unpacked, model, script, leaks: bool, guid: str):
                           input="\n".join(script) + "\n", capture_output=True, text=True, timeout=600)
 
 
-def _assert_clean(proc, script, kinds, model_exchange=False):
+def _assert_clean(proc, script, kinds, model_exchange=False, event_mode=False):
     """The run was clean and went to its end, nothing was fatal, and every bad instantiation of
-    ``kinds`` returned NULL, but model exchange where the FMU offers it (``model_exchange``)."""
+    ``kinds`` returned NULL, but model exchange where the FMU offers it (``model_exchange``) and FMI 3.0's
+    event mode where it declares hasEventMode (``event_mode``)."""
     report = proc.stderr[-6000:]
     assert proc.returncode == 0, f"exit {proc.returncode}\n{report}"
     for marker in ("ERROR: AddressSanitizer", "runtime error:", "ERROR: LeakSanitizer"):
@@ -271,8 +272,8 @@ def _assert_clean(proc, script, kinds, model_exchange=False):
     assert not any(s[3] == "Fatal" for s in statuses)
     bad = [line for line in proc.stdout.splitlines() if line.startswith("BAD_INSTANCE")]
     # every bad instantiation refused; model exchange is no bad argument where the FMU offers it
-    expected = {f"BAD_INSTANCE {kind} {'NONNULL' if kind == 'model_exchange' and model_exchange else 'NULL'}"
-                for kind in kinds}
+    offered = {"model_exchange": model_exchange, "event_mode": event_mode}
+    expected = {f"BAD_INSTANCE {kind} {'NONNULL' if offered.get(kind) else 'NULL'}" for kind in kinds}
     assert set(bad) == expected and len(bad) == len(kinds), bad
 
 
@@ -292,13 +293,62 @@ def test_native_fmu_hostile_calls_under_sanitizers(built_fmus, hosts, genuine_st
     me_script = _hostile_me_script(model, fmi)
     script += me_script
     proc = _run(hosts[fmi.version], unpacked, model, script, leaks=True, guid=fmi.token)
-    _assert_clean(proc, script, BAD_INSTANTIATIONS[fmi.version], model_exchange=True)
+    _assert_clean(proc, script, BAD_INSTANTIATIONS[fmi.version], model_exchange=True,
+                  event_mode=_has_event_mode(fmu))
     assert proc.stdout.startswith(f"INFO {fmi.version}.0 "), proc.stdout[:200]
     # the genuine state (serialized by another instance) restores; a damaged one never does
     statuses = [line.split() for line in proc.stdout.splitlines() if line.startswith("STATUS deserialize")]
     assert [s[3] for s in statuses if s[1] == "deserialize" and s[2] in ("0", "1")] == ["OK", "OK"], statuses
     assert all(s[3] == "Error" for s in statuses if s[1] == "deserialize_file"), statuses
     _assert_model_exchange(proc.stdout, me_script, model, fmi)
+
+
+def _has_event_mode(fmu) -> bool:
+    from fmpy import read_model_description
+
+    cs = read_model_description(str(fmu)).coSimulation
+    return bool(cs is not None and cs.hasEventMode)
+
+
+def _event_mode_script(e_vr: int, t_contact: float) -> list[str]:
+    """FMI 3.0 co-simulation with event mode and early return on slot 0, out of sequence and in sequence:
+    initialization ends in event mode (a step, continuous-time mode, setTime, a NULL update refused), the
+    update and step mode; step mode twice and an update there refused; the first step ends at the contact;
+    a step that skips it refused; event mode, e set, a state taken there, the update, step mode, the next
+    step; the event-mode state restored and handled again; terminated and freed with its state held."""
+    return ["instantiate_ev ev", "setup 0 0.0", "enter_init 0", "exit_init 0",
+            "step 0 0.0 0.1", "enter_ct 0", "set_time 0 1.0", "update_discrete 0 null", "update_discrete 0",
+            "enter_step 0", "enter_step 0", "update_discrete 0",
+            "step 0 0.0 1.0", "step 0 1.0 0.1",
+            "enter_event 0", f"set_real 0 {e_vr} 0.5", "get_state 0", "serialize 0", "update_discrete 0",
+            "enter_step 0", f"step 0 {t_contact!r} 1.0",
+            "set_state 0", "update_discrete 0", "enter_step 0", "deserialize 0", "set_state 0",
+            "terminate 0", "free 0"]
+
+
+def test_event_mode_calls_under_sanitizers(host_fmi3, hosts, tmp_path):
+    """FMI 3.0 BouncingBall with eventModeUsed and earlyReturnAllowed (host_fmi3: this platform's build, its
+    sources recompiled with the sanitizers) through _event_mode_script: clean under ASan, UBSan and LSan;
+    each call out of sequence an Error, each legal one OK; the step returns early at the free-fall time
+    with the event pending (eventHandlingNeeded 1, earlyReturn 1)."""
+    model = "BouncingBall"
+    fmu = host_fmi3[model]
+    fmi = interface(fmu)
+    unpacked = _sanitized_native(fmu, model, tmp_path / "fmu")
+    rows = {v.name: v for v in variables(model)}
+    t_contact = math.sqrt(2 * rows["h0"].start / rows["g"].start)
+    script = _event_mode_script(rows["e"].vr, t_contact)
+    proc = _run(hosts[3], unpacked, model, script, leaks=True, guid=fmi.token)
+    _assert_clean(proc, script, ())
+    statuses = [line.split()[1:] for line in proc.stdout.splitlines() if line.startswith("STATUS ")]
+    got = [(command, status) for command, _slot, status in statuses]
+    errors = {"step": 2, "enter_ct": 1, "set_time": 1, "update_discrete": 2, "enter_step": 1}  # refused calls
+    for command, n in errors.items():
+        assert sum(1 for c, st in got if c == command and st == "Error") == n, (command, got)
+    assert sum(1 for _c, st in got if st == "Error") == sum(errors.values()), got
+    stepped = [line.split() for line in proc.stdout.splitlines() if line.startswith("STEPPED ")]
+    assert [s[2:5] for s in stepped] == [["1", "0", "1"], ["1", "0", "1"]]
+    assert float(stepped[0][5]) == pytest.approx(t_contact, rel=1e-15)
 
 
 def _assert_model_exchange(stdout, script, model, fmi):

@@ -190,16 +190,26 @@ class _Fmi3:
         slave.enterInitializationMode(startTime=start_time)
 
     @staticmethod
-    def stepper(slave):
+    def step_call(slave):
+        """fmi3DoStep as ``step(t, h, no_state_before)``, its out-arguments in ``out``: eventHandlingNeeded,
+        terminateSimulation, earlyReturn, lastSuccessfulTime (ctypes values, allocated once)."""
         from ctypes import byref, c_bool, c_double
 
         do_step, component = slave.fmi3DoStep, slave.component
-        event, terminate, early, last = c_bool(), c_bool(), c_bool(), c_double()
-        out = (byref(event), byref(terminate), byref(early), byref(last))
+        out = (c_bool(), c_bool(), c_bool(), c_double())
+        refs = tuple(byref(x) for x in out)
 
         def step(t, h, no_state_before):
-            do_step(component, t, h, no_state_before, *out)
-            if terminate.value or early.value:  # never with fmi3OK from this project's FMUs
+            do_step(component, t, h, no_state_before, *refs)
+        return step, out
+
+    @staticmethod
+    def stepper(slave):
+        call, (_event, terminate, early, last) = _Fmi3.step_call(slave)
+
+        def step(t, h, no_state_before):
+            call(t, h, no_state_before)
+            if terminate.value or early.value:  # never without earlyReturnAllowed (restitution.cosim.event_mode)
                 raise FmiStatusError(f"fmi3DoStep({t!r}, {h!r}) returned early at {last.value!r} s "
                                      f"(terminateSimulation = {terminate.value})", 2)
         return step

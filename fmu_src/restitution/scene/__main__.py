@@ -2,7 +2,7 @@
 ``restitution-scene``, which show the same name).
 
     check FILE...                      load and check scene files, print what they contain
-    run FILE [--out DIR] [--all-on] [--zener-method M] [--fmu PATH] [--rebuild] [--no-plot]
+    run FILE [--out DIR] [--all-on] [--zener-method M] [--fmu PATH] [--ball-fmu PATH] [--rebuild] [--no-plot]
                                        simulate a scene; write DIR/<stem>.csv, <stem>_summary.csv, <stem>.png;
                                        exit status 3 when a drop stops at its bounce limit still bouncing,
                                        74 on an I/O error writing them (ENOSPC, EIO, ...)
@@ -58,6 +58,18 @@ def _fmu(args) -> Path:
         raise UsageError(str(exc)) from None
 
 
+def _ball_fmu(args) -> Path:
+    """The FMI 3.0 BouncingBall.fmu of ``simulation.master = "event_mode"``, checked (or built) before
+    anything is written."""
+    from .runner import ensure_ball_fmu
+
+    try:
+        return ensure_ball_fmu(args.ball_fmu, rebuild=args.rebuild,
+                               log=lambda text: print(text, file=sys.stderr))
+    except ValueError as exc:  # --ball-fmu PATH that is not one, or none could be built here
+        raise UsageError(str(exc)) from None
+
+
 def _run(args) -> int:
     require("restitution scene run", {"fmpy": "scene", **({} if args.no_plot else {"matplotlib": "scene"})})
     from .results import DropWriter
@@ -73,8 +85,9 @@ def _run(args) -> int:
         if path is not None:
             check_output(path)
     check_outputs({"the drops' table": table, "the summary": summary, "the plot": plot},
-                  {"FILE": args.file, "--fmu": args.fmu})
+                  {"FILE": args.file, "--fmu": args.fmu, "--ball-fmu": args.ball_fmu})
     fmu = _fmu(args)
+    ball_fmu = _ball_fmu(args) if scene.simulation.master == "event_mode" else None
     # Each finished drop is on disk (fsynced) before the next starts; the CSV is kept with the drops
     # that finished, whatever stops the run, except on an I/O error (writing it or the summary): then
     # both files that were there before stay as they were.
@@ -82,7 +95,7 @@ def _run(args) -> int:
         try:
             result = run_scene(scene, fmu=fmu, effects="all_on" if args.all_on else "scene",
                                zener_method=args.zener_method, progress=False if args.no_progress else None,
-                               on_drop=writer.write)
+                               on_drop=writer.write, ball_fmu=ball_fmu)
         except SceneInterrupted as exc:
             exc.result.write_summary_csv(summary)
             print(f"interrupted: {len(exc.result.drops)} of {exc.n_drops} drops finished and written to {table} "
@@ -157,6 +170,8 @@ def main(argv=None) -> int:
     p.add_argument("file", type=Path)
     p.add_argument("--out", type=Path, default=None, help="output directory (default scene-results/<stem>)")
     p.add_argument("--fmu", type=Path, default=None, help="FMU to use (default: build or reuse dist/)")
+    p.add_argument("--ball-fmu", type=Path, default=None,
+                   help='FMI 3.0 BouncingBall.fmu for simulation.master = "event_mode" (default: dist/fmi3/)')
     p.add_argument("--rebuild", action="store_true", help="rebuild dist/SpherePlateImpact.fmu first")
     p.add_argument("--all-on", action="store_true", help="every effect on (the reference run)")
     p.add_argument("--zener-method", choices=("exact", "paper_fit", "linear", "ode"), default=None)

@@ -23,6 +23,8 @@ reference; every key not marked optional is required)::
     gravity = "9.80665 m/s2"
     v_min = "0.1 m/s"                         # the ball rests when it rebounds slower than this
     max_bounces = 10000
+    master = "closed_form"                    # closed_form | event_mode (FMI 3.0 BouncingBall.fmu, event mode)
+    communication_step = "1 ms"               # event_mode: the master's communication step
 
     [materials.soft_polymer]                  # optional: named custom materials
     E = "10 GPa"
@@ -67,7 +69,7 @@ from ..zener import ZENER_METHODS
 from .units import QUANTITIES, UnitError, parse_quantity, split_quantity
 
 __all__ = ["SceneError", "Scene", "BallSpec", "PlateSpec", "ModelSpec", "SimulationSpec", "Drop",
-           "OUTPUTS", "load_scene", "parse_scene", "resolve_material"]
+           "OUTPUTS", "MASTERS", "load_scene", "parse_scene", "resolve_material"]
 
 #: Outputs a scene may request -> what they are.
 OUTPUTS = {
@@ -121,11 +123,19 @@ class ModelSpec:
     plate_waves: str = "auto"
 
 
+#: How a drop is simulated: the runner's own flight in closed form with SpherePlateImpact.fmu at each
+#: impact, or the native FMI 3.0 BouncingBall.fmu co-simulated with it in event mode with early return
+#: (restitution.cosim.event_mode). Both find each impact at its exact instant.
+MASTERS = ("closed_form", "event_mode")
+
+
 @dataclass(frozen=True)
 class SimulationSpec:
     gravity: float = 9.80665  #: [m/s2]
     v_min: float = 0.1  #: [m/s] rest threshold on the rebound speed
     max_bounces: int = 10_000
+    master: str = "closed_form"  #: one of MASTERS
+    communication_step: float = 1e-3  #: [s] the event-mode master's communication step
 
 
 @dataclass(frozen=True)
@@ -348,7 +358,7 @@ def _material(ctx, value, where, custom) -> Material:
 
 _TOP = {"scene": "table: name, description", "outputs": "optional table: requested, tolerance",
         "model": "optional table: effect_tolerance, zener_method, restitution_model, plasticity, plate_waves",
-        "simulation": "optional table: gravity, v_min, max_bounces",
+        "simulation": "optional table: gravity, v_min, max_bounces, master, communication_step",
         "materials": "optional table of named materials", "plates": "array of tables [[plates]]",
         "balls": "array of tables [[balls]]"}
 _SCENE = {"name": "the scene's title", "description": "free text"}
@@ -358,7 +368,8 @@ _MODEL = {"effect_tolerance": "a number >= 0", "zener_method": " | ".join(ZENER_
           "restitution_model": " | ".join(RESTITUTION_MODELS), "plasticity": " | ".join(EFFECT_MODES),
           "plate_waves": " | ".join(EFFECT_MODES)}
 _SIMULATION = {"gravity": 'an acceleration, e.g. "9.81 m/s2"', "v_min": 'a speed, e.g. "0.1 m/s"',
-               "max_bounces": "an integer, 1 ... 100000"}
+               "max_bounces": "an integer, 1 ... 100000", "master": " | ".join(MASTERS),
+               "communication_step": 'a time, e.g. "1 ms" (master = "event_mode")'}
 #: Largest simulation.max_bounces: bounds the time and memory of a drop whose ball never rests.
 MAX_BOUNCES = 100_000
 _PLATE = {"name": "a unique name", "material": "a material name or table", "thickness": 'a length, e.g. "3.18 mm"'}
@@ -407,7 +418,10 @@ def parse_scene(data: dict, source: str = "<scene>", path: Path | None = None) -
                                                   f"{MAX_BOUNCES} (a ball that never rests stops there)")
     simulation = SimulationSpec(gravity=_quantity(ctx, s, "simulation", "gravity", "acceleration", default=d.gravity),
                                 v_min=_quantity(ctx, s, "simulation", "v_min", "speed", default=d.v_min),
-                                max_bounces=max_bounces)
+                                max_bounces=max_bounces,
+                                master=_choice(ctx, s, "simulation", "master", MASTERS, d.master),
+                                communication_step=_quantity(ctx, s, "simulation", "communication_step", "time",
+                                                             default=d.communication_step))
 
     custom: dict[str, Material] = {}
     materials = data.get("materials", {})

@@ -1,4 +1,5 @@
-"""Run a scene through SpherePlateImpact.fmu with an event-exact fmpy master.
+"""Run a scene through SpherePlateImpact.fmu with an event-exact fmpy master (``simulation.master =
+"event_mode"``: the FMI 3.0 BouncingBall.fmu co-simulated with it in event mode, below).
 
 Each drop (ball, plate, drop height) is a bouncing-ball simulation: free flight in closed
 form, impact instants located exactly, and the FMU asked for the rebound **only at impact
@@ -23,6 +24,12 @@ The effect modes are the scene's (default ``auto``), with ``plate_waves = on`` w
 contact durations are requested (a skipped Zener evaluation would report the Hertz
 half-space duration). ``effects="all_on"`` runs the same scene with every effect on, the
 reference the report compares against.
+
+With ``simulation.master = "event_mode"`` the flight is not the runner's: each drop co-simulates the
+native FMI 3.0 BouncingBall.fmu with the FMU (:mod:`restitution.cosim.event_mode`) on a grid of
+``simulation.communication_step``; the ball returns from each step at the contact instant, and in
+event mode the FMU is asked for the rebound at that contact's speed (its ``e`` is read whether or not
+``cor`` was requested: the ball needs it). The impacts are the same, within roundings.
 """
 from __future__ import annotations
 
@@ -40,7 +47,7 @@ from ..cosim.interrupt import DeferredInterrupt
 from .loader import Drop, Scene, SceneError
 from .results import READ_FLAGS, READ_OUTPUTS, VALIDITY, DropResult, SceneResult, apex_heights
 
-__all__ = ["SceneInterrupted", "run_scene", "ensure_fmu", "open_instance", "drop_parameters"]
+__all__ = ["SceneInterrupted", "run_scene", "ensure_fmu", "ensure_ball_fmu", "open_instance", "drop_parameters"]
 
 class SceneInterrupted(KeyboardInterrupt):
     """An interrupted scene run: ``result`` holds the drops that finished."""
@@ -67,6 +74,24 @@ def ensure_fmu(fmu=None, rebuild: bool = False, log=None) -> Path:
     return build_default_fmu(rebuild=rebuild, log=log)
 
 
+def ensure_ball_fmu(ball_fmu=None, rebuild: bool = False, log=None) -> Path:
+    """Path of the FMI 3.0 BouncingBall.fmu the event-mode master runs (``simulation.master =
+    "event_mode"``): ``ball_fmu`` as given (ValueError, one line naming --ball-fmu, unless it is one with
+    event mode), else ``fmi3/BouncingBall.fmu`` beside the default FMUs, built with them where missing or
+    stale (:func:`restitution.fmu.default_fmu`)."""
+    from ..cosim.event_mode import check_event_ball_fmu
+
+    if ball_fmu is not None:
+        return check_event_ball_fmu(ball_fmu)
+    from ..cosim.fmu import build_default_fmu
+
+    path = build_default_fmu(rebuild=rebuild, log=log).parent / "fmi3" / "BouncingBall.fmu"
+    if not path.is_file():
+        raise ValueError(f"no native FMI 3.0 BouncingBall.fmu could be built here (it needs a C compiler): "
+                         f"give --ball-fmu PATH, or use simulation.master = \"closed_form\"")
+    return check_event_ball_fmu(path)
+
+
 def open_instance(fmu_path):
     """One FmuInstance reused for every drop of a scene (parameters are set per drop)."""
     from ..cosim import FmuInstance
@@ -87,8 +112,28 @@ def drop_parameters(scene: Scene, drop: Drop, plasticity: str, plate_waves: str,
 
 # --- the master ----------------------------------------------------------------------------------
 
+def _contacts(instance, ball, scene: Scene, drop: Drop, rebound):
+    """The impacts of one drop, ``([(t, v_approach, out), ...], stop_reason)``: the closed-form flight, or
+    (``ball``: an event-mode BouncingBall instance) the co-simulation in event mode, where the ball is
+    given SpherePlateImpact's e at each contact (read here whether or not the scene asked for it)."""
+    sim = scene.simulation
+    if ball is None:
+        return impact_sequence(rebound, drop.drop_height, sim.gravity, sim.v_min, sim.max_bounces,
+                               advance=instance.do_step)  # flights need no evaluation (inputs unchanged)
+    from ..cosim.event_mode import drop_contacts
+
+    get_e = instance.reader("e")
+
+    def rebound_with_e(v):
+        out = rebound(v)
+        out.setdefault("e", get_e()[0])
+        return out
+    return drop_contacts(ball, rebound_with_e, drop.drop_height, sim.gravity, sim.v_min, sim.communication_step,
+                         sim.max_bounces, advance=instance.do_step)
+
+
 def _run_drop(instance, scene: Scene, drop: Drop, params: dict, read_names, read_cols,
-              interrupt: DeferredInterrupt | None = None) -> DropResult:
+              interrupt: DeferredInterrupt | None = None, ball=None) -> DropResult:
     sim = scene.simulation
     g, v_min = sim.gravity, sim.v_min
     # Reset, then set the parameters and the first impact's speed in initialization mode: the
@@ -124,8 +169,7 @@ def _run_drop(instance, scene: Scene, drop: Drop, params: dict, read_names, read
         return out
 
     try:
-        events, stop = impact_sequence(rebound, drop.drop_height, g, v_min, sim.max_bounces,
-                                       advance=instance.do_step)  # flights need no evaluation (inputs unchanged)
+        events, stop = _contacts(instance, ball, scene, drop, rebound)
     except ValueError as exc:
         raise RuntimeError(f"{drop.label}: {exc}; FMU log: {instance.last_message()}") from exc
     times = [t for t, _, _ in events]
@@ -177,7 +221,8 @@ def _rejected(scene: Scene, drop: Drop, message: str) -> SceneError:
 
 
 def run_scene(scene: Scene, fmu=None, *, effects: str = "scene", zener_method: str | None = None,
-              instance=None, progress: bool | None = None, rebuild: bool = False, on_drop=None) -> SceneResult:
+              instance=None, progress: bool | None = None, rebuild: bool = False, on_drop=None,
+              ball_fmu=None) -> SceneResult:
     """Simulate every drop of ``scene`` through the FMU.
 
     ``effects``: ``"scene"`` (the scene's modes, auto by default, see :meth:`Scene.effect_modes`)
@@ -187,7 +232,9 @@ def run_scene(scene: Scene, fmu=None, *, effects: str = "scene", zener_method: s
     ``progress``: None or True: in a terminal, a bar once the run has taken a second; always a
     final line on stderr with the drops done; False: nothing. ``on_drop``: called with each
     :class:`DropResult` as soon as its drop finishes (e.g. :meth:`DropWriter.write`). An
-    interrupt raises :class:`SceneInterrupted` with the finished drops.
+    interrupt raises :class:`SceneInterrupted` with the finished drops. ``simulation.master = "event_mode"``:
+    each drop is the FMI 3.0 BouncingBall.fmu (``ball_fmu``, else :func:`ensure_ball_fmu`'s) co-simulated
+    with the FMU in event mode with early return (:mod:`restitution.cosim.event_mode`).
     """
     if effects == "scene":
         plasticity, plate_waves = scene.effect_modes()
@@ -205,7 +252,19 @@ def run_scene(scene: Scene, fmu=None, *, effects: str = "scene", zener_method: s
     fmu_path = None
     if own:
         fmu_path = ensure_fmu(fmu, rebuild=rebuild)
+    ball_path = ensure_ball_fmu(ball_fmu, rebuild=rebuild and own) if scene.simulation.master == "event_mode" else None
+    if own:
         instance = open_instance(fmu_path)
+    ball = None
+    if ball_path is not None:
+        from ..cosim.event_mode import EventModeInstance
+
+        try:
+            ball = EventModeInstance(ball_path, "scene-ball")
+        except BaseException:
+            if own:
+                instance.close()
+            raise
     drops = scene.drops()
     results = []
     start = time.perf_counter()
@@ -220,7 +279,7 @@ def run_scene(scene: Scene, fmu=None, *, effects: str = "scene", zener_method: s
             for drop in drops:
                 interrupt.check()
                 params = drop_parameters(scene, drop, plasticity, plate_waves, method)
-                done = _run_drop(instance, scene, drop, params, read_names, read_cols, interrupt)
+                done = _run_drop(instance, scene, drop, params, read_names, read_cols, interrupt, ball)
                 results.append(done)
                 if on_drop is not None:
                     on_drop(done)
@@ -237,6 +296,8 @@ def run_scene(scene: Scene, fmu=None, *, effects: str = "scene", zener_method: s
     finally:
         if own:
             instance.close()
+        if ball is not None:
+            ball.close()
     _final_line(bar, progress, scene, method, results, len(drops), start, "done")
     return result()
 

@@ -8,6 +8,8 @@
  * updates the discrete states there until no further update is needed, enters continuous-time mode,
  * integrates (time, states, derivatives, indicators), and comes back to event mode at an event.
  * Wrong modes and arguments are refused with an error and change nothing, as everywhere in the front.
+ * FMI 3.0 co-simulation with eventModeUsed shares the event mode and its update (fmi3EnterEventMode from
+ * step mode, fmi3UpdateDiscreteStates, fmi3EnterStepMode back); everything else here is model exchange's.
  */
 #include "rst_front_internal.h"
 
@@ -65,9 +67,19 @@ static rst_status read_vector(rst_instance *inst, const char *function, const un
     return RST_OK;
 }
 
+/* Model exchange: from continuous-time mode. FMI 3.0 co-simulation: from step mode, where the host asked
+ * for event mode at instantiation. */
 rst_status front_enter_event_mode(void *c, const char *function)
 {
-    ENTER(function, RST_MODE_CONTINUOUS)
+    ENTER(function, RST_MODE_CONTINUOUS | RST_MODE_STEP_COMPLETE)
+    if (!inst->model_exchange && !inst->event_mode_used) {
+        if (strcmp(inst->api->prefix, "fmi3") != 0) /* FMI 2.0 co-simulation has no event mode at all */
+            only_model_exchange(inst, function);
+        else
+            rst_log(inst, RST_ERROR, "%s: this co-simulation instance was instantiated with eventModeUsed = "
+                    "false; it has no event mode", function);
+        LEAVE(RST_ERROR);
+    }
     inst->mode = RST_MODE_EVENT;
     LEAVE(RST_OK);
 }
@@ -75,7 +87,22 @@ rst_status front_enter_event_mode(void *c, const char *function)
 rst_status front_enter_continuous_time_mode(void *c, const char *function)
 {
     ENTER(function, RST_MODE_EVENT)
+    if (!only_model_exchange(inst, function))
+        LEAVE(RST_ERROR);
     inst->mode = RST_MODE_CONTINUOUS;
+    LEAVE(RST_OK);
+}
+
+/* FMI 3.0 co-simulation: event mode -> step mode (the next fmi3DoStep starts at the event's time). */
+rst_status front_enter_step_mode(void *c, const char *function)
+{
+    ENTER(function, RST_MODE_EVENT)
+    if (inst->model_exchange) {
+        rst_log(inst, RST_ERROR, "%s: this instance is a model-exchange instance (co-simulation only; model "
+                "exchange leaves event mode with fmi3EnterContinuousTimeMode)", function);
+        LEAVE(RST_ERROR);
+    }
+    inst->mode = RST_MODE_STEP_COMPLETE;
     LEAVE(RST_OK);
 }
 
@@ -105,6 +132,8 @@ rst_status front_set_time(void *c, const char *function, double time)
 {
     char text[40];
     ENTER(function, ME_MODES)
+    if (!only_model_exchange(inst, function)) /* a co-simulation instance in event mode */
+        LEAVE(RST_ERROR);
     if (!isfinite(time)) {
         rst_format_double(time, text, sizeof text);
         rst_log(inst, RST_ERROR, "%s: time = %s must be finite", function, text);

@@ -236,7 +236,8 @@ fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint, fmi2R
                       fmi2Boolean noSetFMUStatePriorToCurrentPoint)
 {
     (void)noSetFMUStatePriorToCurrentPoint;
-    return (fmi2Status)front_do_step(c, "fmi2DoStep", currentCommunicationPoint, communicationStepSize, NULL);
+    return (fmi2Status)front_do_step(c, "fmi2DoStep", currentCommunicationPoint, communicationStepSize, NULL,
+                                     NULL);
 }
 
 fmi2Status fmi2CancelStep(fmi2Component c)

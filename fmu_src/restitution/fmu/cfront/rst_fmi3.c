@@ -3,9 +3,11 @@
  * and back. What FMI 3.0 alone has lives here: the independent variable `time` (value reference
  * n_variables, after the table), Enumerations got and set with the Int64 functions, the instantiation
  * token and resource path, the experiment given to fmi3EnterInitializationMode, fmi3DoStep's and
- * fmi3UpdateDiscreteStates' out-arguments. The FMU has no co-simulation event mode, clocks,
- * intermediate updates or configuration mode and is not offered for scheduled execution: those
- * functions exist (a host may look them up) and refuse with a message. */
+ * fmi3UpdateDiscreteStates' out-arguments, and co-simulation's event mode and early return for a model
+ * that offers them (rst_model.do_step_to_event: eventModeUsed and earlyReturnAllowed are honoured; the
+ * other models refuse eventModeUsed and never return early). The FMU has no clocks, intermediate
+ * updates or configuration mode and is not offered for scheduled execution: those functions exist (a
+ * host may look them up) and refuse with a message. */
 #include "rst_front_internal.h"
 
 #include <math.h>
@@ -121,18 +123,25 @@ fmi3Instance fmi3InstantiateCoSimulation(fmi3String instanceName, fmi3String ins
                                          fmi3IntermediateUpdateCallback intermediateUpdate)
 {
     rst_instance *inst;
-    (void)earlyReturnAllowed, (void)requiredIntermediateVariables, (void)intermediateUpdate; /* never returns early */
+    int events = RST_MODEL.do_step_to_event != NULL; /* hasEventMode and mightReturnEarlyFromDoStep */
+    (void)requiredIntermediateVariables, (void)intermediateUpdate; /* refused below where asked for */
     inst = new_instance("fmi3InstantiateCoSimulation", instanceName, loggingOn, instanceEnvironment, logMessage);
     if (inst == NULL)
         return NULL;
-    if (eventModeUsed || nRequiredIntermediateVariables > 0) {
-        rst_log(inst, RST_ERROR, "fmi3InstantiateCoSimulation: %s is not provided by %s (hasEventMode = false, "
-                "providesIntermediateUpdate = false); not instantiated",
-                eventModeUsed ? "event mode" : "intermediate update", inst->model->identifier);
+    if ((eventModeUsed && !events) || nRequiredIntermediateVariables > 0) {
+        rst_log(inst, RST_ERROR, "fmi3InstantiateCoSimulation: %s is not provided by %s (%s = false); not "
+                "instantiated", nRequiredIntermediateVariables > 0 ? "intermediate update" : "event mode",
+                inst->model->identifier,
+                nRequiredIntermediateVariables > 0 ? "providesIntermediateUpdate" : "hasEventMode");
         front_discard_instance(inst);
         return NULL;
     }
-    return instantiate(inst, "fmi3InstantiateCoSimulation", instantiationToken, resourcePath, visible, 0);
+    inst = instantiate(inst, "fmi3InstantiateCoSimulation", instantiationToken, resourcePath, visible, 0);
+    if (inst != NULL && events) { /* (a model without events ignores earlyReturnAllowed: it never returns early) */
+        inst->event_mode_used = eventModeUsed != 0;
+        inst->early_return_allowed = earlyReturnAllowed != 0;
+    }
+    return inst;
 }
 
 fmi3Instance fmi3InstantiateModelExchange(fmi3String instanceName, fmi3String instantiationToken,
@@ -187,7 +196,7 @@ fmi3Status fmi3ExitInitializationMode(fmi3Instance instance)
     return (fmi3Status)front_exit_initialization(instance, "fmi3ExitInitializationMode");
 }
 
-/* model exchange; a co-simulation instance has no event mode (hasEventMode = false) and is refused */
+/* model exchange, and co-simulation instantiated with eventModeUsed (the others are refused) */
 fmi3Status fmi3EnterEventMode(fmi3Instance instance)
 {
     return (fmi3Status)front_enter_event_mode(instance, "fmi3EnterEventMode");
@@ -327,28 +336,33 @@ fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 currentCommunicationPoi
                       fmi3Boolean *terminateSimulation, fmi3Boolean *earlyReturn, fmi3Float64 *lastSuccessfulTime)
 {
     rst_status status;
+    rst_step_end end;
     (void)noSetFMUStatePriorToCurrentPoint;
     if (eventHandlingNeeded == NULL || terminateSimulation == NULL || earlyReturn == NULL ||
         lastSuccessfulTime == NULL)
-        return (fmi3Status)front_refuse(instance, "fmi3DoStep", ANY_MODE, "eventHandlingNeeded, terminateSimulation, "
-                                        "earlyReturn and lastSuccessfulTime must not be NULL");
-    /* front_do_step writes lastSuccessfulTime where the step ran (its start after a discard) */
+        return (fmi3Status)front_refuse(instance, "fmi3DoStep", ANY_MODE | RST_MODE_EVENT, "eventHandlingNeeded, "
+                                        "terminateSimulation, earlyReturn and lastSuccessfulTime must not be NULL");
+    /* front_do_step writes lastSuccessfulTime where the step ran: its end, the event it returned early at,
+     * its start after a discard */
+    end.reached = currentCommunicationPoint + communicationStepSize;
+    end.event_pending = 0;
     status = front_do_step(instance, "fmi3DoStep", currentCommunicationPoint, communicationStepSize,
-                           lastSuccessfulTime);
+                           lastSuccessfulTime, &end);
     if (status < RST_ERROR) {
-        *eventHandlingNeeded = fmi3False;
-        *earlyReturn = fmi3False; /* every step runs to its end */
+        /* an event waiting for the host's event mode (eventModeUsed only); early: it ended before t + h
+         * (earlyReturnAllowed only) */
+        *eventHandlingNeeded = status <= RST_WARNING && end.event_pending;
+        *earlyReturn = status <= RST_WARNING && end.reached < currentCommunicationPoint + communicationStepSize;
         /* a discarded step leaves the instance unable to step on (fmi3Terminate, fmi3Reset or fmi3SetFMUState) */
         *terminateSimulation = status == RST_DISCARD;
     }
     return (fmi3Status)status;
 }
 
+/* co-simulation instantiated with eventModeUsed: event mode -> step mode */
 fmi3Status fmi3EnterStepMode(fmi3Instance instance)
 {
-    return (fmi3Status)front_refuse(instance, "fmi3EnterStepMode", ANY_MODE,
-                                    "not provided (hasEventMode = false: the FMU enters step mode on "
-                                    "fmi3ExitInitializationMode)");
+    return (fmi3Status)front_enter_step_mode(instance, "fmi3EnterStepMode");
 }
 
 fmi3Status fmi3GetOutputDerivatives(fmi3Instance instance, const fmi3ValueReference valueReferences[],
@@ -471,8 +485,8 @@ fmi3Status fmi3SetShiftFraction(fmi3Instance instance, const fmi3ValueReference 
 
 fmi3Status fmi3EvaluateDiscreteStates(fmi3Instance instance)
 {
-    return (fmi3Status)front_refuse(instance, "fmi3EvaluateDiscreteStates", ANY_MODE,
-                                    "not provided (hasEventMode = false)");
+    return (fmi3Status)front_refuse(instance, "fmi3EvaluateDiscreteStates", ANY_MODE | RST_MODE_EVENT,
+                                    "not provided (providesEvaluateDiscreteStates = false)");
 }
 
 fmi3Status fmi3UpdateDiscreteStates(fmi3Instance instance, fmi3Boolean *discreteStatesNeedUpdate,

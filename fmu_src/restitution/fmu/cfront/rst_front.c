@@ -5,7 +5,10 @@
  *
  * Which call is allowed in which mode follows the co-simulation state machine of FMI 2.0 (section
  * 4.2.4), which FMI 3.0's restricts to the same transitions for an FMU without event mode,
- * intermediate updates or configuration mode. A call that is not allowed, or whose arguments are
+ * intermediate updates or configuration mode; an FMI 3.0 co-simulation instance whose host asked for
+ * event mode (eventModeUsed, a model with do_step_to_event) adds FMI 3.0's event mode: initialization
+ * ends there, fmi3EnterStepMode leaves it, fmi3EnterEventMode enters it from step mode, and only there
+ * fmi3UpdateDiscreteStates runs. A call that is not allowed, or whose arguments are
  * wrong, returns an error with a log message and changes nothing: the instance stays in its mode and
  * keeps its values (more forgiving than the standards, which let an importer give up on an instance
  * after any error). A backend that reports RST_ERROR puts the instance into the error mode (reset,
@@ -32,6 +35,7 @@ rst_mode rst_mode_of(const rst_instance *inst) { return inst->mode; }
 double rst_start_time(const rst_instance *inst) { return inst->has_start ? inst->start_time : 0.0; }
 const char *rst_fmi_prefix(const rst_instance *inst) { return inst->api->prefix; }
 int rst_is_model_exchange(const rst_instance *inst) { return inst->model_exchange; }
+int rst_event_mode_used(const rst_instance *inst) { return inst->event_mode_used; }
 
 /* The mode as messages name it; `buffer` holds the text of the modes that name a function. */
 const char *front_mode_name(const rst_instance *inst, rst_mode mode, char *buffer, size_t size)
@@ -323,8 +327,9 @@ rst_status front_exit_initialization(void *c, const char *function)
     if (inst->model->exit_initialization != NULL)
         status = front_backend_status(inst, inst->model->exit_initialization(inst));
     if (status < RST_ERROR) {
-        /* co-simulation steps from here; model exchange starts with an event (FMI 2.0 and 3.0) */
-        inst->mode = inst->model_exchange ? RST_MODE_EVENT : RST_MODE_STEP_COMPLETE;
+        /* co-simulation steps from here; model exchange starts with an event (FMI 2.0 and 3.0), and so
+         * does FMI 3.0 co-simulation with eventModeUsed (the host leaves it with fmi3EnterStepMode) */
+        inst->mode = inst->model_exchange || inst->event_mode_used ? RST_MODE_EVENT : RST_MODE_STEP_COMPLETE;
         inst->has_time = inst->has_start;
         inst->next_time = inst->start_time;
         inst->last_time = inst->start_time;
@@ -367,9 +372,22 @@ rst_status front_refuse(void *c, const char *function, unsigned int modes, const
     LEAVE(RST_ERROR);
 }
 
-rst_status front_do_step(void *c, const char *function, double t, double h, double *last_successful_time)
+/* The backend's step: do_step, or do_step_to_event where the host asked for events (FMI 3.0); `end` says
+ * where the step ended and whether an event waits for the host. */
+static rst_status backend_step(rst_instance *inst, double t, double h, rst_step_end *end)
+{
+    end->reached = t + h;
+    end->event_pending = 0;
+    if (inst->model->do_step_to_event != NULL && (inst->early_return_allowed || inst->event_mode_used))
+        return inst->model->do_step_to_event(inst, t, h, inst->early_return_allowed, inst->event_mode_used, end);
+    return inst->model->do_step != NULL ? inst->model->do_step(inst, t, h) : RST_OK;
+}
+
+rst_status front_do_step(void *c, const char *function, double t, double h, double *last_successful_time,
+                         rst_step_end *step_end)
 {
     rst_status status = RST_OK;
+    rst_step_end end;
     char t_text[40], h_text[40], want[40];
     ENTER(function, RST_MODE_STEP_COMPLETE)
     if (!isfinite(t) || !isfinite(h) || !(h > 0.0) || !isfinite(t + h)) {
@@ -390,13 +408,18 @@ rst_status front_do_step(void *c, const char *function, double t, double h, doub
             LEAVE(RST_ERROR);
         }
     }
-    if (inst->model->do_step != NULL)
-        status = front_backend_status(inst, inst->model->do_step(inst, t, h));
+    status = front_backend_status(inst, backend_step(inst, t, h, &end));
     inst->last_step_status = status;
     if (status <= RST_WARNING) {
+        /* an early return ends the step at the event (t <= reached < t + h): the next step starts there */
+        double reached = end.reached >= t && end.reached < t + h ? end.reached : t + h;
         inst->has_time = 1;
-        inst->next_time = t + h;
-        inst->last_time = t + h;
+        inst->next_time = reached;
+        inst->last_time = reached;
+        if (step_end != NULL) {
+            step_end->reached = reached;
+            step_end->event_pending = end.event_pending != 0;
+        }
     } else if (status == RST_DISCARD) {
         inst->mode = RST_MODE_STEP_FAILED;
         inst->last_time = t;

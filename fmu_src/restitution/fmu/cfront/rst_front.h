@@ -28,6 +28,7 @@
 #define RST_MODEL RST_PREFIXED(RST_MODEL)
 #define rst_fmi_prefix RST_PREFIXED(rst_fmi_prefix)
 #define rst_is_model_exchange RST_PREFIXED(rst_is_model_exchange)
+#define rst_event_mode_used RST_PREFIXED(rst_event_mode_used)
 #define rst_time RST_PREFIXED(rst_time)
 #define rst_store RST_PREFIXED(rst_store)
 #define rst_backend RST_PREFIXED(rst_backend)
@@ -58,9 +59,17 @@ typedef struct {
     double next_event_time;          /* [s] */
 } rst_event_update;
 
+/* How an FMI 3.0 co-simulation step that may end at an event ended (rst_model.do_step_to_event). */
+typedef struct {
+    double reached;      /* [s] the time the step reached: its end, or the event where it returned early */
+    int event_pending;   /* an event at `reached` waits for the host's event mode (eventModeUsed) */
+} rst_step_end;
+
 /* The co-simulation and model-exchange modes, as bits (sets of modes describe where a call is allowed). FMI 2.0's
- * stepInProgress and stepCanceled never occur (every step here is synchronous), nor FMI 3.0's event
- * and intermediate-update modes (not offered). RST_MODE_STEP_FAILED: a step returned a discard. */
+ * stepInProgress and stepCanceled never occur (every step here is synchronous), nor FMI 3.0's
+ * intermediate-update mode (not offered). RST_MODE_STEP_FAILED: a step returned a discard. RST_MODE_EVENT
+ * is model exchange's event mode and, for an FMI 3.0 co-simulation instance of a model with
+ * co-simulation events whose host asked for them (eventModeUsed), co-simulation's event mode. */
 typedef enum {
     RST_MODE_INSTANTIATED = 1,
     RST_MODE_INITIALIZATION = 2,
@@ -69,7 +78,7 @@ typedef enum {
     RST_MODE_TERMINATED = 16,
     RST_MODE_ERROR = 32,
     RST_MODE_FATAL = 64, /* latched: every later call returns an error without reaching the backend */
-    RST_MODE_EVENT = 128,      /* model exchange: event mode */
+    RST_MODE_EVENT = 128,      /* model exchange, and FMI 3.0 co-simulation with eventModeUsed: event mode */
     RST_MODE_CONTINUOUS = 256  /* model exchange: continuous-time mode */
 } rst_mode;
 
@@ -130,6 +139,15 @@ typedef struct {
      * state (> 0, finite) from the store, in the state vector's order. NULL: 1 for every state. A model
      * whose nominals move reports nominals_changed from its event update. */
     void (*nominals)(rst_instance *inst, double nominals[]);
+    /* FMI 3.0 co-simulation events (a model that offers them: hasEventMode and mightReturnEarlyFromDoStep;
+     * the front refuses eventModeUsed for the others and never returns early for them). When the host
+     * asked for event mode or allowed early return at instantiation, fmi3DoStep runs this hook instead
+     * of do_step: the step from `t` over `h` (checked as for do_step) ends at the first event inside it
+     * when `early_return`, and an event that `event_mode` leaves to the host is reported pending (the
+     * host then enters event mode at end->reached; update_discrete_states handles it there, in a
+     * co-simulation instance). With neither flag do_step runs, as for every other host. */
+    rst_status (*do_step_to_event)(rst_instance *inst, double t, double h, int early_return, int event_mode,
+                                   rst_step_end *end);
 } rst_model;
 
 /* The model-exchange vectors of a glue's RST_MODEL, from its generated interface header. */
@@ -148,6 +166,7 @@ rst_mode rst_mode_of(const rst_instance *inst);
 double rst_start_time(const rst_instance *inst); /* from fmi2SetupExperiment or fmi3EnterInitializationMode (0 before) */
 const char *rst_fmi_prefix(const rst_instance *inst); /* "fmi2" or "fmi3": FMI function names in messages */
 int rst_is_model_exchange(const rst_instance *inst);    /* instantiated for model exchange */
+int rst_event_mode_used(const rst_instance *inst);      /* FMI 3.0 co-simulation: the host asked for event mode */
 double rst_time(const rst_instance *inst); /* [s] the current time: start, end of the last step, or set (ME) */
 /* Log through the host's logger: RST_WARNING and worse always (they say why a call failed);
  * RST_OK messages only when the host enabled debug logging for logAll. */

@@ -54,6 +54,7 @@
 #define front_do_step RST_PREFIXED(front_do_step)
 #define front_refuse RST_PREFIXED(front_refuse)
 #define front_enter_event_mode RST_PREFIXED(front_enter_event_mode)
+#define front_enter_step_mode RST_PREFIXED(front_enter_step_mode)
 #define front_enter_continuous_time_mode RST_PREFIXED(front_enter_continuous_time_mode)
 #define front_update_discrete_states RST_PREFIXED(front_update_discrete_states)
 #define front_completed_integrator_step RST_PREFIXED(front_completed_integrator_step)
@@ -140,6 +141,10 @@ struct rst_instance {
     const rst_model *model;
     const rst_api *api;
     int model_exchange; /* instantiated for model exchange (else co-simulation) */
+    /* FMI 3.0 co-simulation, as the host instantiated it: event mode used (initialization ends in event
+     * mode, an event inside a step waits for the host there), early return allowed (a step ends at the
+     * first event inside it). Both 0 for FMI 2.0 and model exchange. */
+    int event_mode_used, early_return_allowed;
     char *name;
     void (*host_logger)(void); /* the host's logger, of the version layer's type (api->emit casts it back) */
     void *environment;         /* what the host passes back to its logger */
@@ -253,8 +258,11 @@ rst_status front_enter_initialization(void *c, const char *function, const rst_e
 rst_status front_exit_initialization(void *c, const char *function);
 rst_status front_terminate(void *c, const char *function);
 rst_status front_reset(void *c, const char *function);
-/* `last_successful_time`: NULL, or where the end of the last successful step goes (FMI 3.0) */
-rst_status front_do_step(void *c, const char *function, double t, double h, double *last_successful_time);
+/* `last_successful_time`: NULL, or where the end of the last successful step goes (FMI 3.0: the event
+ * where the step returned early); `step_end`: NULL (FMI 2.0), or where FMI 3.0's eventHandlingNeeded and
+ * earlyReturn go (.event_pending, and .reached < t + h) */
+rst_status front_do_step(void *c, const char *function, double t, double h, double *last_successful_time,
+                         rst_step_end *step_end);
 /* A call this FMU does not provide, or whose arguments the version layer found wrong, in one of
  * `modes`: logs "<function>: <why>" and returns an error. */
 rst_status front_refuse(void *c, const char *function, unsigned int modes, const char *why);
@@ -271,6 +279,8 @@ rst_status front_set_debug_logging(void *c, const char *function, int logging_on
 
 /* Model exchange (rst_exchange.c). */
 rst_status front_enter_event_mode(void *c, const char *function);
+/* FMI 3.0 co-simulation with event mode: event mode -> step mode */
+rst_status front_enter_step_mode(void *c, const char *function);
 rst_status front_enter_continuous_time_mode(void *c, const char *function);
 rst_status front_update_discrete_states(void *c, const char *function, rst_event_update *result);
 rst_status front_completed_integrator_step(void *c, const char *function, int *enter_event_mode, int *terminate);

@@ -13,7 +13,8 @@
 /* Serialized layout version (see front_serialize); 2: the interface is recorded. Only this one is read. */
 #define RST_STATE_FORMAT 2u
 
-/* The modes a state of each interface may hold (exactly one of them). */
+/* The modes a state of each interface may hold (exactly one of them); co-simulation also event mode
+ * where the instance was instantiated with eventModeUsed (FMI 3.0). */
 #define CS_STATE_MODES (RST_MODE_INSTANTIATED | RST_MODE_INITIALIZATION | RST_MODE_STEP_COMPLETE | \
                         RST_MODE_STEP_FAILED | RST_MODE_TERMINATED | RST_MODE_ERROR)
 #define ME_STATE_MODES (RST_MODE_INSTANTIATED | RST_MODE_INITIALIZATION | ME_MODES | RST_MODE_TERMINATED | \
@@ -138,7 +139,8 @@ static int check_snapshot(rst_instance *inst, const char *function, const rst_st
                 inst->model_exchange ? "model exchange" : "co-simulation");
         return 0;
     }
-    modes = inst->model_exchange ? ME_STATE_MODES : CS_STATE_MODES;
+    modes = inst->model_exchange ? ME_STATE_MODES
+                                 : CS_STATE_MODES | (inst->event_mode_used ? (unsigned int)RST_MODE_EVENT : 0u);
     if (s->mode == 0 || (s->mode & (s->mode - 1u)) != 0 || (s->mode & modes) == 0) {
         rst_log(inst, RST_ERROR, "%s: the state's mode word 0x%x is not one mode of the %s state machine",
                 function, s->mode, inst->model_exchange ? "model-exchange" : "co-simulation");

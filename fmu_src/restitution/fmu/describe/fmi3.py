@@ -31,14 +31,15 @@ from ..table import Table, Variable
 from .common import (GENERATION_TOOL, PARAMETER_CAUSALITIES, limit_text, log_categories, model_attributes,
                      start_text, unit_definitions, xml_text)
 
-__all__ = ["model_description", "build_description", "enumeration_type", "TIME_NAME", "ELEMENTS"]
+__all__ = ["model_description", "build_description", "co_simulation", "enumeration_type", "TIME_NAME", "ELEMENTS"]
 
 #: The independent variable every FMI 3.0 FMU must have (its value reference: ``len(table)``).
 TIME_NAME = "time"
 TIME_UNIT = "s"
 #: The co-simulation capabilities of the native front. Each flag is spelled out, false ones too, so a
 #: reader sees what the FMU does not offer without knowing the schema's defaults: no event mode, no
-#: intermediate update, no early return (fmi3DoStep always completes the step or fails).
+#: early return (fmi3DoStep always completes the step or fails), no intermediate update (and so no
+#: early return after one).
 CO_SIMULATION = {
     "canHandleVariableCommunicationStepSize": "true",
     "canGetAndSetFMUState": "true",
@@ -46,9 +47,21 @@ CO_SIMULATION = {
     "needsExecutionTool": "false",
     "canBeInstantiatedOnlyOncePerProcess": "false",
     "hasEventMode": "false",
+    "mightReturnEarlyFromDoStep": "false",
     "providesIntermediateUpdate": "false",
     "canReturnEarlyAfterIntermediateUpdate": "false",
 }
+#: The models whose native glue offers co-simulation events (rst_model.do_step_to_event): event mode
+#: (eventModeUsed) and early return at each event (earlyReturnAllowed), each contact of BouncingBall
+#: located in closed form. Still no intermediate update, hence no canReturnEarlyAfterIntermediateUpdate.
+EVENT_MODELS = frozenset({"BouncingBall"})
+
+
+def co_simulation(model: str) -> dict[str, str]:
+    """The ``<CoSimulation>`` capability flags of ``model``'s native FMI 3.0 FMU."""
+    if model in EVENT_MODELS:
+        return {**CO_SIMULATION, "hasEventMode": "true", "mightReturnEarlyFromDoStep": "true"}
+    return dict(CO_SIMULATION)
 #: What the native front offers for model exchange (the same binary as co-simulation): no completed
 #: integrator step needed (no step events), no discrete-state evaluation without an update.
 MODEL_EXCHANGE = {
@@ -166,7 +179,7 @@ def model_description(model: str, instantiation_token: str | None = None) -> str
     root = ET.Element("fmiModelDescription", {
         "fmiVersion": "3.0", **model_attributes(table, "instantiationToken", token, GENERATION_TOOL)})
     ET.SubElement(root, "ModelExchange", {"modelIdentifier": model, **MODEL_EXCHANGE})
-    ET.SubElement(root, "CoSimulation", {"modelIdentifier": model, **CO_SIMULATION})
+    ET.SubElement(root, "CoSimulation", {"modelIdentifier": model, **co_simulation(model)})
     root.append(unit_definitions(table, extra=(TIME_UNIT,)))
     types = _type_definitions(table)
     if types is not None:

@@ -51,6 +51,15 @@ static double flight_duration(double h_start, double v_start, double g)
     return (v_start + sqrt(v_start * v_start + 2.0 * g * h_start)) / g;
 }
 
+/* flight_end: the contact that ends the current free flight, at time *t_hit [s] with approach speed
+ * *v_hit [m/s], under gravity g [m/s2]. */
+static void flight_end(const double *values, double g, double *t_hit, double *v_hit)
+{
+    double v_start = AT(FLIGHT_V_START);
+    *v_hit = sqrt(v_start * v_start + 2.0 * g * AT(FLIGHT_H_START));
+    *t_hit = AT(FLIGHT_T_START) + (v_start + *v_hit) / g;
+}
+
 /* contact_indicator: the height [m] the ball reaches before it falls, h + max(v, 0)^2/(2 g), evaluated
  * as written wherever that is finite. Departure, for states a host may set (any finite h and v): where
  * v * v or the sum overflows, the apex term is v'^2 with v' = v / sqrt(2 g) (no overflow for the
@@ -199,10 +208,8 @@ void rst_ball_do_step(double *values, double current_time, double step_size)
     if (AT(IN_CONTACT) != 0.0) /* the COR for the pending contact arrived at this point */
         rebound(values, current_time);
     if (AT(AT_REST) == 0.0) {
-        /* flight_end: the contact that ends the current flight */
-        double v_start = AT(FLIGHT_V_START);
-        double v_hit = sqrt(v_start * v_start + 2.0 * g * AT(FLIGHT_H_START));
-        double t_hit = AT(FLIGHT_T_START) + (v_start + v_hit) / g;
+        double t_hit, v_hit;
+        flight_end(values, g, &t_hit, &v_hit);
         if (t_hit <= limit) { /* (a NaN is no contact) */
             impact(values, t_hit, v_hit, 1.0);
             if (!wait) {
@@ -220,6 +227,39 @@ void rst_ball_do_step(double *values, double current_time, double step_size)
         }
     }
     update_outputs(values, end);
+}
+
+double rst_ball_step_to_contact(double *values, double current_time, double step_size, int event_mode)
+{
+    double g = AT(G), end = current_time + step_size;
+    int wait = event_mode || AT(CONTACT_MODE) == RST_BOUNCINGBALL_CONTACT_MODE_WAIT;
+    if (AT(IN_CONTACT) != 0.0) /* the COR for the pending contact arrived at this point */
+        rebound(values, current_time);
+    if (AT(AT_REST) == 0.0) {
+        double t_hit, v_hit;
+        flight_end(values, g, &t_hit, &v_hit);
+        if (t_hit <= end) { /* (a NaN is no contact) */
+            t_hit = t_hit >= current_time ? t_hit : current_time; /* (a flight shorter than a rounding) */
+            impact(values, t_hit, v_hit, 1.0);
+            if (!wait)
+                rebound(values, t_hit);
+            update_outputs(values, t_hit);
+            return t_hit;
+        }
+    }
+    update_outputs(values, end);
+    return end;
+}
+
+int rst_ball_contact_pending(const double *values) { return AT(IN_CONTACT) != 0.0; }
+
+int rst_ball_contact_update(double *values, double t)
+{
+    if (AT(IN_CONTACT) == 0.0)
+        return 0;
+    rebound(values, t);
+    update_outputs(values, t);
+    return 1;
 }
 
 void rst_ball_states_changed(double *values)

@@ -13,6 +13,9 @@
 #define rst_ball_clear RST_PREFIXED(rst_ball_clear)
 #define rst_ball_initialize RST_PREFIXED(rst_ball_initialize)
 #define rst_ball_do_step RST_PREFIXED(rst_ball_do_step)
+#define rst_ball_step_to_contact RST_PREFIXED(rst_ball_step_to_contact)
+#define rst_ball_contact_pending RST_PREFIXED(rst_ball_contact_pending)
+#define rst_ball_contact_update RST_PREFIXED(rst_ball_contact_update)
 #define rst_ball_states_changed RST_PREFIXED(rst_ball_states_changed)
 #define rst_ball_update_derivatives RST_PREFIXED(rst_ball_update_derivatives)
 #define rst_ball_contact_event RST_PREFIXED(rst_ball_contact_event)
@@ -29,6 +32,22 @@ void rst_ball_initialize(double *values, double start_time);
 
 /* fmi2DoStep from `current_time` [s] over `step_size` [s]: locates every contact inside the step. */
 void rst_ball_do_step(double *values, double current_time, double step_size);
+
+/* FMI 3.0 co-simulation with early return: the step from `current_time` [s] over `step_size` [s] ends at
+ * the first contact inside it (closed form, no time tolerance: a contact after the end belongs to a
+ * later step), and returns the time it reached (that contact, or the end). A contact still pending at
+ * `current_time` (the ball waiting at the plate) rebounds first, with the COR on the input. At the
+ * contact: with `event_mode` the ball waits at the plate for the host's event mode
+ * (rst_ball_contact_update); without, contact_mode decides: wait (it waits for the next step, which
+ * starts at the contact) or immediate (it rebounds at once with the COR on the input). */
+double rst_ball_step_to_contact(double *values, double current_time, double step_size, int event_mode);
+
+/* The ball waits at the plate for the COR: a contact is pending. */
+int rst_ball_contact_pending(const double *values);
+
+/* FMI 3.0 co-simulation event mode at time `t` [s]: a pending contact rebounds with the COR on the input
+ * (or comes to rest) at `t`; returns 1 when it did, 0 when no contact was pending. */
+int rst_ball_contact_update(double *values, double t);
 
 /* der(h), der(v) and the contact indicator from the state in the store (they are not part of the FMU
  * state: recomputed after a state is restored). */
