@@ -112,8 +112,10 @@ def _cases(seed: int, n: int):
 def _build(sources: Path, out: Path, version: str) -> Path:
     """The native FMU of ``version`` from the package under ``sources`` (this platform's binary only), in a
     child interpreter that imports that package."""
-    code = ("import sys; sys.path.insert(0, sys.argv[1]); from pathlib import Path; "
-            "from restitution.fmu.builders.native import build_native_one; "
+    code = ("import sys; sys.path.insert(0, sys.argv[1]); from pathlib import Path\n"
+            "try:\n    from restitution.fmu.builders.native import build_native_one\n"
+            "except ImportError:  # the package before fmu/build/ was renamed fmu/builders/\n"
+            "    from restitution.fmu.build.native import build_native_one\n"
             "print(build_native_one('SpherePlateImpact', Path(sys.argv[2]), fmi_version=sys.argv[3], folders=[sys.argv[4]]))")
     done = subprocess.run([sys.executable, "-c", code, str(sources), str(out), version, HOST_FOLDER[version]],
                           capture_output=True, text=True, timeout=600)

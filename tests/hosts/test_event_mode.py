@@ -275,7 +275,7 @@ def before_events(tmp_path_factory) -> dict:
     with tarfile.open(fileobj=io.BytesIO(archive.stdout)) as tar:
         tar.extractall(out / "src", filter="data")
     script = ("import sys; from pathlib import Path; from fmpy import platform, platform_tuple\n"
-              "from restitution.fmu.builders.native import build_native_one\n"
+              "from restitution.fmu.build.native import build_native_one\n"
               "for version, folder in (('2.0', platform), ('3.0', platform_tuple)):\n"
               "    print(build_native_one('BouncingBall', Path(sys.argv[1]), fmi_version=version, folders=(folder,),"
               " log=lambda _l: None))\n")
