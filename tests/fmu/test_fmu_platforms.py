@@ -109,7 +109,7 @@ def test_platform_checker_finds_each_fault(fmi3_ball_fmu, tmp_path):
         "buildDescription.xml: platform 'x86_64-windoze' is not an FMI 3.0 platform tuple":
             dict(build_description=lambda xml: xml.replace("<BuildConfiguration ",
                                                            '<BuildConfiguration platform="x86_64-windoze" ')),
-        "buildDescription.xml: sources/rst_front.c missing": dict(drop=("sources/rst_front.c",)),
+        "buildDescription.xml: sources/rst_lifecycle.c missing": dict(drop=("sources/rst_lifecycle.c",)),
     }
     for i, (expected, change) in enumerate(cases.items()):
         doctored = _doctored(fmu, tmp_path / f"{i}.fmu", **change)

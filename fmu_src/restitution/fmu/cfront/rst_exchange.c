@@ -11,7 +11,7 @@
  * FMI 3.0 co-simulation with eventModeUsed shares the event mode and its update (fmi3EnterEventMode from
  * step mode, fmi3UpdateDiscreteStates, fmi3EnterStepMode back); everything else here is model exchange's.
  */
-#include "rst_front_internal.h"
+#include "rst_instance.h"
 
 #include <math.h>
 #include <stdio.h>

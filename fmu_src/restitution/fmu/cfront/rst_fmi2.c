@@ -1,9 +1,9 @@
 /* The FMI 2.0 layer of the front (co-simulation and model exchange): every fmi2 function, each a
- * translation of FMI 2.0's types into the core's (rst_front.c, rst_values.c, rst_exchange.c, rst_log.c, rst_state.c)
+ * translation of FMI 2.0's types into the core's (rst_lifecycle.c, rst_call.c, rst_values.c, rst_exchange.c, rst_log.c, rst_state.c)
  * and back. What FMI 2.0 alone has lives here: the host's memory callbacks, the fmuResourceLocation URI,
  * fmi2SetupExperiment, the co-simulation status queries, fmi2EventInfo and the '%' escaping its
  * printf-style logger needs. */
-#include "rst_front_internal.h"
+#include "rst_instance.h"
 
 #include <math.h>
 #include <stdio.h>

@@ -1,5 +1,5 @@
 /* The FMI 3.0 layer of the front (co-simulation and model exchange): every fmi3 function, each a
- * translation of FMI 3.0's types into the core's (rst_front.c, rst_values.c, rst_exchange.c, rst_log.c, rst_state.c)
+ * translation of FMI 3.0's types into the core's (rst_lifecycle.c, rst_call.c, rst_values.c, rst_exchange.c, rst_log.c, rst_state.c)
  * and back. What FMI 3.0 alone has lives here: the independent variable `time` (value reference
  * n_variables, after the table), Enumerations got and set with the Int64 functions, the instantiation
  * token and resource path, the experiment given to fmi3EnterInitializationMode, fmi3DoStep's and
@@ -8,7 +8,7 @@
  * other models refuse eventModeUsed and never return early). The FMU has no clocks, intermediate
  * updates or configuration mode and is not offered for scheduled execution: those functions exist (a
  * host may look them up) and refuse with a message. */
-#include "rst_front_internal.h"
+#include "rst_instance.h"
 
 #include <math.h>
 #include <stdio.h>

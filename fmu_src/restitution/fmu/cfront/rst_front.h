@@ -2,7 +2,7 @@
  * code runs, shared by the guard in front of pythonfmu (pythonfmu_guard/) and by the native FMUs
  * (models/<model>/rst_native_*_fmu.c), whatever the FMI version.
  *
- * The core (rst_front.c: life cycle, steps; rst_values.c: values; rst_log.c: messages; rst_state.c:
+ * The core (rst_lifecycle.c: life cycle, steps; rst_call.c: entering and leaving a call; rst_values.c: values; rst_log.c: messages; rst_state.c:
  * FMU states) knows no FMI version. It checks each call against the co-simulation state machine and
  * its arguments against the interface table (generated from the model's interface table): unknown
  * value references, wrong types, variables that may not be set in the current mode, values outside

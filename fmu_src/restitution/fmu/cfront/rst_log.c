@@ -1,6 +1,6 @@
 /* The front's messages: formatting values as Python's repr() does, log categories, delivery to the
  * host's logger (through the version layer's emit), fmi2SetDebugLogging and fmi3SetDebugLogging. */
-#include "rst_front_internal.h"
+#include "rst_instance.h"
 
 #include <math.h>
 #include <stdarg.h>

@@ -3,7 +3,7 @@
  * little-endian, the same bytes whatever the FMI version). Every state is checked before it is restored
  * or becomes a state (check_snapshot): exactly one mode of its interface, the instance's interface,
  * finite times, every Real finite and every input and parameter as a set call would check it. */
-#include "rst_front_internal.h"
+#include "rst_instance.h"
 
 #include <math.h>
 #include <stdint.h>

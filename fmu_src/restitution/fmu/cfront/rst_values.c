@@ -1,9 +1,9 @@
 /* The front's values: see rst_front.h. This file: the value store and the get and set calls of every
  * FMI version, with their checks (value references, types, what may be set in which mode, declared
  * ranges, counts); a set stores all its values or none. The instance's life cycle and steps are in
- * rst_front.c.
+ * rst_lifecycle.c.
  */
-#include "rst_front_internal.h"
+#include "rst_instance.h"
 
 #include <math.h>
 #include <stdio.h>

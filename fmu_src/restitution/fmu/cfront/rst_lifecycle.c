@@ -1,7 +1,10 @@
 /* The front's core: see rst_front.h. This file: the instance's life cycle and steps, for every FMI
- * version: entering and leaving a call, instantiation, the transitions of the state machine, the
- * co-simulation step (values and their checks: rst_values.c; messages: rst_log.c; FMU states:
- * rst_state.c; model exchange: rst_exchange.c; each version's entry points: rst_fmi2.c, rst_fmi3.c).
+ * version: instantiation, the transitions of the state machine, the co-simulation step (entering and
+ * leaving a call, the accessors and the mode checks: rst_call.c; values and their checks: rst_values.c;
+ * messages: rst_log.c; FMU states: rst_state.c; model exchange: rst_exchange.c; each version's entry
+ * points: rst_fmi2.c, rst_fmi3.c). The files of the core call downward only: this one calls the others,
+ * rst_state.c and rst_exchange.c call rst_values.c, and every one calls rst_call.c and rst_log.c, which
+ * call no other file of the core.
  *
  * Which call is allowed in which mode follows the co-simulation state machine of FMI 2.0 (section
  * 4.2.4), which FMI 3.0's restricts to the same transitions for an FMU without event mode,
@@ -14,7 +17,7 @@
  * after any error). A backend that reports RST_ERROR puts the instance into the error mode (reset,
  * restoring an FMU state or freeing the instance leave it); RST_FATAL latches it for good.
  */
-#include "rst_front_internal.h"
+#include "rst_instance.h"
 
 #include <float.h>
 #include <math.h>
@@ -24,97 +27,6 @@
 /* Relative tolerance of the step time check: an importer's t differs from the previous t + h by a
  * rounding or two; a skipped or repeated step differs by about h. */
 #define TIME_RTOL 1e-9
-
-/* ------------------------------------------------------------------------------------------------ */
-/* Accessors for backends                                                                           */
-/* ------------------------------------------------------------------------------------------------ */
-double *rst_store(rst_instance *inst) { return inst->store; }
-void *rst_backend(rst_instance *inst) { return inst->backend; }
-const char *rst_instance_name(const rst_instance *inst) { return inst->name; }
-rst_mode rst_mode_of(const rst_instance *inst) { return inst->mode; }
-double rst_start_time(const rst_instance *inst) { return inst->has_start ? inst->start_time : 0.0; }
-const char *rst_fmi_prefix(const rst_instance *inst) { return inst->api->prefix; }
-int rst_is_model_exchange(const rst_instance *inst) { return inst->model_exchange; }
-int rst_event_mode_used(const rst_instance *inst) { return inst->event_mode_used; }
-
-/* The mode as messages name it; `buffer` holds the text of the modes that name a function. */
-const char *front_mode_name(const rst_instance *inst, rst_mode mode, char *buffer, size_t size)
-{
-    switch (mode) {
-    case RST_MODE_INSTANTIATED: return "instantiated";
-    case RST_MODE_INITIALIZATION: return "initialization mode";
-    case RST_MODE_STEP_COMPLETE: return "step mode";
-    case RST_MODE_STEP_FAILED:
-        snprintf(buffer, size, "step failed (after %sDoStep returned %sDiscard)", inst->api->prefix,
-                 inst->api->prefix);
-        return buffer;
-    case RST_MODE_TERMINATED: return "terminated";
-    case RST_MODE_EVENT: return "event mode";
-    case RST_MODE_CONTINUOUS: return "continuous-time mode";
-    case RST_MODE_ERROR: return "error";
-    default: return "fatal error";
-    }
-}
-
-/* ------------------------------------------------------------------------------------------------ */
-/* Entering and leaving a call                                                                      */
-/* ------------------------------------------------------------------------------------------------ */
-#if defined(RST_LOCK_ATOMIC)
-/* The lock word is taken (1 or 2): mark it 2 (a thread waits: whoever gives it back wakes one) and wait
- * until the exchange finds it free. A waiter woken takes the word as 2, so the waiters still there are
- * woken in turn; a thread that takes a word freed in between (1) leaves it at 2 for the waiter it
- * skipped ahead of. */
-void front_lock_contended(rst_instance *inst)
-{
-    pthread_mutex_lock(&inst->lock);
-    while (__atomic_exchange_n(&inst->lock_word, 2, __ATOMIC_ACQUIRE) != 0)
-        pthread_cond_wait(&inst->waiters, &inst->lock);
-    pthread_mutex_unlock(&inst->lock);
-}
-
-/* A waiter marked the word 2 under `lock` before it waits, and waits without letting go of `lock` in
- * between, so taking `lock` here finds it waiting (or gone with the word): no wake-up is lost. */
-void front_wake_waiter(rst_instance *inst)
-{
-    pthread_mutex_lock(&inst->lock);
-    pthread_cond_signal(&inst->waiters);
-    pthread_mutex_unlock(&inst->lock);
-}
-#else
-void front_lock_contended(rst_instance *inst) { (void)inst; }
-void front_wake_waiter(rst_instance *inst) { (void)inst; }
-#endif
-
-void front_unlock_and_deliver(rst_instance *inst)
-{
-    rst_message *messages = front_take_messages(inst);
-    front_release(inst);
-    front_deliver_messages(inst, messages);
-}
-
-int front_refuse_mode(rst_instance *inst, const char *function)
-{
-    char buffer[80];
-    if (inst->mode == RST_MODE_FATAL) {
-        rst_log(inst, RST_ERROR, "%s: this instance reported %sFatal earlier and cannot be used any more; "
-                "free it (%sFreeInstance)", function, inst->api->prefix, inst->api->prefix);
-        return 0;
-    }
-    rst_log(inst, RST_ERROR, "%s is not allowed in %s (%s %s state machine)", function,
-            front_mode_name(inst, inst->mode, buffer, sizeof buffer), inst->api->standard,
-            inst->model_exchange ? "model-exchange" : "co-simulation");
-    return 0;
-}
-
-/* A backend's answer: RST_ERROR puts the instance into the error mode, RST_FATAL latches it. */
-rst_status front_backend_status(rst_instance *inst, rst_status status)
-{
-    if (status == RST_FATAL)
-        inst->mode = RST_MODE_FATAL;
-    else if (status == RST_ERROR)
-        inst->mode = RST_MODE_ERROR;
-    return status;
-}
 
 /* ------------------------------------------------------------------------------------------------ */
 /* Life cycle                                                                                       */

@@ -212,7 +212,7 @@ typedef void (*rst_write_fn)(void *values, size_t first, size_t n, const double 
             out_[i_] = from_double(in[i_]);                                                     \
     }
 
-/* Entering and leaving an FMI call: the common path inline (below), the rest in rst_front.c. */
+/* Entering and leaving an FMI call: the common path inline (below), the rest in rst_call.c. */
 void front_lock_contended(rst_instance *inst);     /* waits for the lock another thread holds */
 void front_wake_waiter(rst_instance *inst);        /* after giving the lock back: wakes a waiting thread */
 void front_unlock_and_deliver(rst_instance *inst); /* unlocks, then delivers the messages the call logged */
@@ -231,7 +231,7 @@ int front_in_range(const rst_variable *var, double value);
 void front_describe_value(rst_type type, double value, char *out, size_t size);
 const char *front_type_name(rst_type type);
 
-/* The version-neutral FMI functions (rst_front.c; get and set: rst_values.c): each checks its instance,
+/* The version-neutral FMI functions (rst_lifecycle.c; get and set: rst_values.c): each checks its instance,
  * locks it, checks the mode and its arguments, logs under the name `function` and returns the status the
  * host sees. */
 /* A new instance (not yet one the host may use): NULL when out of memory (logged). */

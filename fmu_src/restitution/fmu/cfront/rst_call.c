@@ -1,0 +1,99 @@
+/* The front's call layer, used by every other file of the core (see rst_lifecycle.c for the whole):
+ * the accessors backends read an instance through, the mode's name in messages, entering and leaving an
+ * FMI call (the contended half of the instance lock, handing the call's messages to the host after the
+ * lock is given back), the refusal of a call in a mode that does not allow it, and a backend's status
+ * applied to the mode. It calls only rst_log.c. */
+#include "rst_instance.h"
+
+#include <stdio.h>
+
+/* ------------------------------------------------------------------------------------------------ */
+/* Accessors for backends                                                                           */
+/* ------------------------------------------------------------------------------------------------ */
+double *rst_store(rst_instance *inst) { return inst->store; }
+void *rst_backend(rst_instance *inst) { return inst->backend; }
+const char *rst_instance_name(const rst_instance *inst) { return inst->name; }
+rst_mode rst_mode_of(const rst_instance *inst) { return inst->mode; }
+double rst_start_time(const rst_instance *inst) { return inst->has_start ? inst->start_time : 0.0; }
+const char *rst_fmi_prefix(const rst_instance *inst) { return inst->api->prefix; }
+int rst_is_model_exchange(const rst_instance *inst) { return inst->model_exchange; }
+int rst_event_mode_used(const rst_instance *inst) { return inst->event_mode_used; }
+
+/* The mode as messages name it; `buffer` holds the text of the modes that name a function. */
+const char *front_mode_name(const rst_instance *inst, rst_mode mode, char *buffer, size_t size)
+{
+    switch (mode) {
+    case RST_MODE_INSTANTIATED: return "instantiated";
+    case RST_MODE_INITIALIZATION: return "initialization mode";
+    case RST_MODE_STEP_COMPLETE: return "step mode";
+    case RST_MODE_STEP_FAILED:
+        snprintf(buffer, size, "step failed (after %sDoStep returned %sDiscard)", inst->api->prefix,
+                 inst->api->prefix);
+        return buffer;
+    case RST_MODE_TERMINATED: return "terminated";
+    case RST_MODE_EVENT: return "event mode";
+    case RST_MODE_CONTINUOUS: return "continuous-time mode";
+    case RST_MODE_ERROR: return "error";
+    default: return "fatal error";
+    }
+}
+
+/* ------------------------------------------------------------------------------------------------ */
+/* Entering and leaving a call                                                                      */
+/* ------------------------------------------------------------------------------------------------ */
+#if defined(RST_LOCK_ATOMIC)
+/* The lock word is taken (1 or 2): mark it 2 (a thread waits: whoever gives it back wakes one) and wait
+ * until the exchange finds it free. A waiter woken takes the word as 2, so the waiters still there are
+ * woken in turn; a thread that takes a word freed in between (1) leaves it at 2 for the waiter it
+ * skipped ahead of. */
+void front_lock_contended(rst_instance *inst)
+{
+    pthread_mutex_lock(&inst->lock);
+    while (__atomic_exchange_n(&inst->lock_word, 2, __ATOMIC_ACQUIRE) != 0)
+        pthread_cond_wait(&inst->waiters, &inst->lock);
+    pthread_mutex_unlock(&inst->lock);
+}
+
+/* A waiter marked the word 2 under `lock` before it waits, and waits without letting go of `lock` in
+ * between, so taking `lock` here finds it waiting (or gone with the word): no wake-up is lost. */
+void front_wake_waiter(rst_instance *inst)
+{
+    pthread_mutex_lock(&inst->lock);
+    pthread_cond_signal(&inst->waiters);
+    pthread_mutex_unlock(&inst->lock);
+}
+#else
+void front_lock_contended(rst_instance *inst) { (void)inst; }
+void front_wake_waiter(rst_instance *inst) { (void)inst; }
+#endif
+
+void front_unlock_and_deliver(rst_instance *inst)
+{
+    rst_message *messages = front_take_messages(inst);
+    front_release(inst);
+    front_deliver_messages(inst, messages);
+}
+
+int front_refuse_mode(rst_instance *inst, const char *function)
+{
+    char buffer[80];
+    if (inst->mode == RST_MODE_FATAL) {
+        rst_log(inst, RST_ERROR, "%s: this instance reported %sFatal earlier and cannot be used any more; "
+                "free it (%sFreeInstance)", function, inst->api->prefix, inst->api->prefix);
+        return 0;
+    }
+    rst_log(inst, RST_ERROR, "%s is not allowed in %s (%s %s state machine)", function,
+            front_mode_name(inst, inst->mode, buffer, sizeof buffer), inst->api->standard,
+            inst->model_exchange ? "model-exchange" : "co-simulation");
+    return 0;
+}
+
+/* A backend's answer: RST_ERROR puts the instance into the error mode, RST_FATAL latches it. */
+rst_status front_backend_status(rst_instance *inst, rst_status status)
+{
+    if (status == RST_FATAL)
+        inst->mode = RST_MODE_FATAL;
+    else if (status == RST_ERROR)
+        inst->mode = RST_MODE_ERROR;
+    return status;
+}
