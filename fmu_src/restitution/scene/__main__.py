@@ -47,10 +47,10 @@ class UsageError(Exception):
 
 def _fmu(args) -> Path:
     """The FMU to run, checked (or built) before anything is written."""
-    from .runner import ensure_fmu
+    from .runner import chosen_fmu
 
     try:
-        return ensure_fmu(args.fmu, rebuild=args.rebuild if hasattr(args, "rebuild") else False,
+        return chosen_fmu(args.fmu, rebuild=args.rebuild if hasattr(args, "rebuild") else False,
                           log=lambda text: print(text, file=sys.stderr))
     except SceneError:
         raise

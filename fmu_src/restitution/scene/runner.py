@@ -40,7 +40,7 @@ from ..cosim.interrupt import DeferredInterrupt
 from .loader import Drop, Scene, SceneError
 from .results import READ_FLAGS, READ_OUTPUTS, VALIDITY, DropResult, SceneResult, apex_heights
 
-__all__ = ["SceneInterrupted", "run_scene", "ensure_fmu", "open_instance", "drop_parameters"]
+__all__ = ["SceneInterrupted", "run_scene", "chosen_fmu", "open_instance", "drop_parameters"]
 
 class SceneInterrupted(KeyboardInterrupt):
     """An interrupted scene run: ``result`` holds the drops that finished."""
@@ -54,17 +54,17 @@ class SceneInterrupted(KeyboardInterrupt):
 
 # --- the FMU ---------------------------------------------------------------------------------
 
-def ensure_fmu(fmu=None, rebuild: bool = False, log=None) -> Path:
-    """Path of the FMU to run: ``fmu`` as given, else the default SpherePlateImpact.fmu
-    (dist/ of a source checkout, a per-user cache otherwise), (re)built when missing, built from
-    other sources, or when ``rebuild`` is true (:func:`restitution.fmu.default_fmu`)."""
+def chosen_fmu(fmu=None, rebuild: bool = False, log=None) -> Path:
+    """Path of the FMU to run: ``fmu`` as given (checked), else :func:`restitution.fmu.default_fmu` (the
+    installed FMU of a wheel, else dist/ of a source checkout or a per-user cache, built when missing or
+    stale, or when ``rebuild`` is true)."""
     if fmu is not None:  # ValueError (one line naming --fmu) unless it is a SpherePlateImpact FMU
         from ..cosim.fmu import check_impact_fmu
 
         return check_impact_fmu(fmu)
-    from ..cosim.fmu import build_default_fmu
+    from ..fmu.build import default_fmu
 
-    return build_default_fmu(rebuild=rebuild, log=log)
+    return default_fmu(rebuild=rebuild, log=log)
 
 
 def open_instance(fmu_path):
@@ -204,7 +204,7 @@ def run_scene(scene: Scene, fmu=None, *, effects: str = "scene", zener_method: s
     own = instance is None
     fmu_path = None
     if own:
-        fmu_path = ensure_fmu(fmu, rebuild=rebuild)
+        fmu_path = chosen_fmu(fmu, rebuild=rebuild)
         instance = open_instance(fmu_path)
     drops = scene.drops()
     results = []
