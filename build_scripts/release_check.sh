@@ -21,17 +21,23 @@ sdist=$(ls "$release"/restitution-*.tar.gz) wheel=$(ls "$release"/restitution-*-
 python3 -m venv "$work/venv"
 pins=$(grep -E '^(numpy|scipy|pint|fmpy)==' requirements/dev.lock | sed 's/ .*//' | tr '\n' ' ')
 # shellcheck disable=SC2086  # one argument per pin
-"$work/venv/bin/python" -m pip install --quiet --disable-pip-version-check $pins "$wheel"
-mkdir "$work/elsewhere"
+"$work/venv/bin/python" -m pip install --quiet --disable-pip-version-check $pins "$wheel" 2>&1 \
+    | { grep -v "^WARNING: Location" || true; } >&2
+mkdir "$work/elsewhere" "$work/home"
 cd "$work/elsewhere"
-export PATH="$work/venv/bin" HOME="$work/home" XDG_CACHE_HOME="$work/cache"
+# every command below sees a PATH of the new venv's bin/ alone
+bare() { env PATH="$work/venv/bin" HOME="$work/home" XDG_CACHE_HOME="$work/cache" "$@"; }
 for compiler in gcc cc clang x86_64-w64-mingw32-gcc zig; do
-    if command -v "$compiler" > /dev/null; then echo "release check: $compiler is reachable" >&2; exit 1; fi
+    if bare /bin/sh -c "command -v $compiler" > /dev/null; then
+        echo "release check: $compiler is reachable" >&2
+        exit 1
+    fi
 done
-restitution fmu path SpherePlateImpact
-restitution fmu path SpherePlateImpact --fmi 3
-restitution fmu copy --out "$work/fmus" | wc -l | sed 's/$/ installed files copied/'
-python - <<'EOF'
+bare restitution fmu path SpherePlateImpact
+bare restitution fmu path SpherePlateImpact --fmi 3
+copied=$(bare restitution fmu copy --out "$work/fmus" | grep -c '^copied')
+echo "release check: restitution fmu copy: $copied files"
+bare python - <<'EOF_PY'
 import fmpy, importlib.util
 from restitution.fmu import path
 assert importlib.util.find_spec("ziglang") is None, "ziglang installed: the release check must have no compiler"
@@ -39,5 +45,5 @@ for model, stop, output in (("SpherePlateImpact", 1e-3, "e"), ("BouncingBall", 0
     for fmi, implementation in (("2", "pythonfmu"), ("2", "native"), ("3", "native")):
         result = fmpy.simulate_fmu(str(path(model, fmi, implementation)), stop_time=stop, output=[output])
         print(f"release check: FMI {fmi} {implementation} {model}: {output} = {result[output][-1]:.6g}")
-EOF
+EOF_PY
 echo "release check: wheel $(du -k "$wheel" | cut -f1) KiB, sdist $(du -k "$sdist" | cut -f1) KiB, $((SECONDS - start)) s"
