@@ -4,7 +4,8 @@ a wheel carries the FMUs built, so that ``pip install restitution`` gives every 
 ``build_wheel`` first builds every FMU (``python -m restitution.fmu build``, from the tree being built, with
 zig from PyPI for every platform: ``RESTITUTION_COMPILER=zig``, no gcc or mingw-w64) into
 ``fmu_src/restitution/fmu/installed_fmus/`` (package data, never committed; removed again after the wheel is
-written), with ``dist/ssp/`` copied to ``installed_fmus/ssp/`` where the tree has SSP files. The wheel's
+written), with ``dist/ssp/`` copied to ``installed_fmus/ssp/`` where the tree has SSP files (MANIFEST.in puts
+them into the sdist, from which ``python -m build`` makes the wheel). The wheel's
 extra build requirements (zig, pythonfmu, fmpy and the package's dependencies) are asked for by
 ``get_requires_for_build_wheel`` alone: the sdist and the editable install (the Quickstart's) need only
 setuptools. ``SOURCE_DATE_EPOCH`` passes through, so the FMUs of two wheels of a commit are identical.
