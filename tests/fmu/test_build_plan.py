@@ -92,7 +92,9 @@ def test_the_demo_builds_its_fmu_alone_and_says_so_as_it_goes(demo_dist):
     words = start.split()
     assert words[2:4] == ["SpherePlateImpact.fmu", "linux64,"] and "pythonfmu" in start and start.endswith(" ...")
     assert end.startswith(start[:-len(" ...")] + ": ") and end.endswith(" s")
-    assert total.startswith("fmu build: 1 FMU built in ") and "zig" not in "".join(lines)
+    assert total.startswith("fmu build: 1 FMU built in ")
+    # no cross compilation: at most this machine's guard, by zig for glibc 2.17 (else gcc)
+    assert not any(t.zig_target in "".join(lines) for t in toolchains.PLATFORMS if t.name != "x86_64-linux")
 
 
 def test_a_dist_the_demo_filled_is_not_the_full_set(demo_dist, monkeypatch):
@@ -130,7 +132,7 @@ def test_a_native_fmu_lacking_a_platform_is_not_the_full_set(tmp_path):
     others = [f for f in plan.Product("BouncingBall", "fmi3").buildable_folders() if f != "x86_64-linux"]
     expected = f"lacks binaries/{', binaries/'.join(others)}" if others else None
     assert plan.stale(plan.Product("BouncingBall", "fmi3"), tmp_path) == expected
-    start, end = lines
+    start, end = [line for line in lines if "fmi3/BouncingBall.fmu" in line]  # beside zig's cache line
     label = toolchains.compiler_label("x86_64-linux", toolchains.compiler("x86_64-linux")).split()
     assert start.split() == ["fmu", "build:", "fmi3/BouncingBall.fmu", "x86_64-linux", *label, "..."]
     assert end.split()[:4 + len(label)] == ["fmu", "build:", "fmi3/BouncingBall.fmu", "x86_64-linux", *label[:-1],
