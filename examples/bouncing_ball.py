@@ -24,7 +24,8 @@ import numpy as np
 import restitution as r
 from restitution.options import OptionError, input_quantity, material
 from restitution.viz import finish
-from restitution.cosim import FmuInstance, bounce, build_default_fmu, fmu_rebound, impact_fmu_parameters
+from restitution.cosim import FmuInstance, bounce, fmu_rebound, impact_fmu_parameters
+from restitution.fmu import default_fmu
 
 HERE = Path(__file__).resolve().parent
 OUTPUT = HERE / "output"
@@ -120,7 +121,7 @@ def run(show_plot: bool = False, fmu_path=None, t_over_d=T_OVER_D, drop_height: 
     """Drop the ball (preset ``sphere``, diameter ``d`` [m]) on every plate (preset ``plate``, thickness
     ``thicknesses`` [m], default ``t_over_d`` times ``d``); write the PNG; return {"cases", "rows",
     "markdown", "png"}."""
-    fmu_path = Path(fmu_path) if fmu_path else build_default_fmu()
+    fmu_path = Path(fmu_path) if fmu_path else default_fmu()
     cases = drop_on_plates(fmu_path, t_over_d, drop_height=drop_height, sphere_key=sphere, d=d, plate_key=plate,
                            thicknesses=thicknesses)
     rows = bounce_table(cases, n_bounces)

@@ -18,7 +18,7 @@ import bouncing_ball  # noqa: E402
 import paper_figures  # noqa: E402
 import two_fmu_cosim  # noqa: E402
 
-from restitution.cosim import build_default_fmu  # noqa: E402
+from restitution.fmu import default_fmu  # noqa: E402
 
 DOCS_IMG = HERE.parent / "docs" / "img"
 
@@ -29,7 +29,7 @@ def main(argv=None) -> int:
     parser.add_argument("--steps", type=float, nargs="+", default=[1e-2, 1e-3, 1e-4, 1e-5])
     parser.add_argument("--repeat", type=int, default=3, help="runs per master and step (shortest wall time kept)")
     args = parser.parse_args(argv)
-    fmu_dir = args.fmu_dir or build_default_fmu(model="BouncingBall").parent
+    fmu_dir = args.fmu_dir or default_fmu(model="BouncingBall").parent
     impact = fmu_dir / "SpherePlateImpact.fmu"
     print("## bouncing_ball\n")
     bouncing_ball.run(fmu_path=impact, out_dir=DOCS_IMG, dpi=90)

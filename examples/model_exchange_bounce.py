@@ -24,8 +24,9 @@ from pathlib import Path
 import numpy as np
 
 import restitution as r
-from restitution.cosim import (FmuInstance, ModelExchangeInstance, bounce, bounce_model_exchange, build_default_fmu,
-                               fmu_rebound, impact_fmu_parameters, model_exchange_rebound, package_rebound)
+from restitution.cosim import (FmuInstance, ModelExchangeInstance, bounce, bounce_model_exchange, fmu_rebound,
+                               impact_fmu_parameters, model_exchange_rebound, package_rebound)
+from restitution.fmu import default_fmu
 from restitution.options import OptionError, input_quantity, material
 from restitution.viz import finish
 
@@ -43,7 +44,7 @@ def native_dir(fmu_dir=None) -> Path:
     them with a model-exchange interface, else its ``fmi2/``; by default dist/fmi2 (built when missing)."""
     from fmpy import read_model_description
 
-    base = Path(fmu_dir) if fmu_dir is not None else build_default_fmu(model="BouncingBall").parent
+    base = Path(fmu_dir) if fmu_dir is not None else default_fmu(model="BouncingBall").parent
     for folder in (base, base / "fmi2"):
         ball = folder / "BouncingBall.fmu"
         if ball.is_file() and (folder / "SpherePlateImpact.fmu").is_file() and \

@@ -27,7 +27,8 @@ import numpy as np
 
 import restitution as r
 from restitution.viz import finish
-from restitution.cosim import FmuInstance, build_default_fmu
+from restitution.cosim import FmuInstance
+from restitution.fmu import default_fmu
 from restitution.fmu.models.sphere_plate_impact.variables import TABLE, fmu_values
 from restitution.materials import table4_case
 
@@ -251,7 +252,7 @@ def summary(f4, f5, f6, f7) -> str:
 def run(show_plot: bool = False, fmu_path=None, n_points: int = 141, out_dir=None, dpi: int = 90,
         zener_method: int = 1, verbose: bool = True) -> dict:
     """Compute Figs. 4-7 through the FMU, write the PNGs, return the data and the summary."""
-    fmu_path = Path(fmu_path) if fmu_path else build_default_fmu()
+    fmu_path = Path(fmu_path) if fmu_path else default_fmu()
     t_over_d = np.linspace(0.1, 3.0, n_points)
     t_over_d_long = np.geomspace(0.1, 30.0, 3 * n_points)
     fmu = ImpactFMU(fmu_path, zener_method)

@@ -18,7 +18,8 @@ import sys
 from pathlib import Path
 
 import restitution as r
-from restitution.cosim import FmuInstance, bounce, build_default_fmu, fmu_rebound, impact_fmu_parameters
+from restitution.cosim import FmuInstance, bounce, fmu_rebound, impact_fmu_parameters
+from restitution.fmu import default_fmu
 from restitution.options import OptionError, input_quantity, material
 
 #: The default case: an S2 tool-steel ball, d = 6.35 mm, on Al 6061, t = 6.35 mm.
@@ -36,7 +37,7 @@ def run(fmu_path=None, height: float = 0.3, thickness: float = T, show: int = 5,
     """Bounce the ball (preset ``sphere``, diameter ``d`` [m]) on the plate (preset ``plate``, thickness
     ``thickness`` [m]); return the :class:`~restitution.cosim.Bounces` record."""
     if fmu_path is None:
-        fmu_path = build_default_fmu(log=lambda message: print(message, file=sys.stderr, flush=True), scope="model")
+        fmu_path = default_fmu(log=lambda message: print(message, file=sys.stderr, flush=True), scope="model")
         print(f"FMU: {fmu_path} (built from the installed sources; `restitution fmu build` rebuilds every FMU)")
     fmu_path = Path(fmu_path)
     ball = r.Sphere(r.MATERIALS[sphere], d)

@@ -45,9 +45,9 @@ import numpy as np
 
 import restitution as r
 from restitution.viz import finish
-from restitution.cosim import (FixedStepMaster, FmuInstance, ball_bounces, bounce, build_default_fmu,
-                               fmu_rebound, impact_fmu_parameters)
+from restitution.cosim import FixedStepMaster, FmuInstance, ball_bounces, bounce, fmu_rebound, impact_fmu_parameters
 from restitution.cosim.fixed_step import BALL_IMPACT_CONNECTIONS, BALL_RECORD
+from restitution.fmu import default_fmu
 
 HERE = Path(__file__).resolve().parent
 OUTPUT = HERE / "output"
@@ -195,7 +195,7 @@ def run(show_plot: bool = False, steps=(1e-2, 1e-3, 1e-4, 1e-5), fmu_dir=None, d
     if fmu_dir is not None:
         ball_fmu, impact_fmu = Path(fmu_dir) / "BouncingBall.fmu", Path(fmu_dir) / "SpherePlateImpact.fmu"
     else:
-        ball_fmu, impact_fmu = build_default_fmu(model="BouncingBall"), build_default_fmu()
+        ball_fmu, impact_fmu = default_fmu(model="BouncingBall"), default_fmu()
     possible = masters_for(ball_fmu, impact_fmu)
     if masters is None:
         masters = possible

@@ -5,7 +5,8 @@ which this machine can neither load nor, for most, run.
 
 * ELF (Linux): the 64-bit little-endian file header (e_machine), the dynamic symbol table (``.dynsym``:
   the symbols defined there with global or weak binding and default or protected visibility are the
-  exports) and the dynamic section (DT_NEEDED, DT_SONAME).
+  exports), the dynamic section (DT_NEEDED, DT_SONAME) and the version needs (``.gnu.version_r``: the
+  ``GLIBC_x.y`` symbol versions a loader must find, :func:`glibc_version` the highest).
 * PE (Windows): the COFF header (Machine, Characteristics), the PE32+ optional header's data
   directories: the export directory (its DLL name and the names it exports) and the import directory
   (the DLLs it needs).
@@ -68,14 +69,46 @@ def read_images(data: bytes) -> list[Image]:
 
 # --- ELF -------------------------------------------------------------------------------------------
 ELF_MACHINES = {62: "x86_64", 183: "aarch64"}
-SHT_DYNSYM, SHT_DYNAMIC = 11, 6
+SHT_DYNSYM, SHT_DYNAMIC, SHT_GNU_VERNEED = 11, 6, 0x6FFFFFFE
 DT_NEEDED, DT_SONAME = 1, 14
 STB_GLOBAL, STB_WEAK = 1, 2
 STV_DEFAULT, STV_PROTECTED = 0, 3
 
 
+def _version_needs(data: bytes, offset: int, strtab: int) -> dict[str, tuple[str, ...]]:
+    """The version-needs section (``.gnu.version_r``): library -> the symbol versions the file needs of it
+    (e.g. ``{"libc.so.6": ("GLIBC_2.2.5", "GLIBC_2.3.4")}``). A chain of Elf64_Verneed records (vn_version,
+    vn_cnt, vn_file, vn_aux, vn_next), each followed via vn_aux by vn_cnt Elf64_Vernaux records (vna_hash,
+    vna_flags, vna_other, vna_name, vna_next); offsets are relative to the record holding them."""
+    needs: dict[str, tuple[str, ...]] = {}
+    for _ in range(1 << 12):  # a bound, so that a damaged chain cannot loop forever
+        version, count, file, aux, following = _unpack("<HHIII", data, offset)
+        if version != 1:
+            raise FormatError(f"Elf64_Verneed version {version} (1 expected)")
+        names, at = [], offset + aux
+        for _k in range(count):
+            _hash, _flags, _other, name, next_aux = _unpack("<IHHII", data, at)
+            names.append(_cstring(data, strtab + name))
+            at += next_aux
+        needs[_cstring(data, strtab + file)] = tuple(names)
+        if not following:
+            return needs
+        offset += following
+    raise FormatError("the version-needs chain does not end")
+
+
+def glibc_version(needs: dict[str, tuple[str, ...]]) -> tuple[int, ...] | None:
+    """The highest ``GLIBC_x.y[.z]`` version of ``needs`` (:func:`_version_needs`), as numbers; None where it
+    needs none."""
+    found = [tuple(int(part) for part in name[len("GLIBC_"):].split("."))
+             for names in needs.values() for name in names
+             if name.startswith("GLIBC_") and name[len("GLIBC_"):].replace(".", "").isdigit()]
+    return max(found, default=None)
+
+
 def read_elf(data: bytes) -> Image:
-    """A 64-bit little-endian ELF file: its machine, exports (.dynsym), DT_NEEDED and DT_SONAME."""
+    """A 64-bit little-endian ELF file: its machine, exports (.dynsym), DT_NEEDED, DT_SONAME and the symbol
+    versions it needs (``details["version_needs"]``, from .gnu.version_r)."""
     if data[4] != 2 or data[5] != 1:
         raise FormatError(f"ELF class {data[4]}, data encoding {data[5]}: only 64-bit little-endian is read")
     e_type, e_machine = _unpack("<HH", data, 16)
@@ -91,6 +124,8 @@ def read_elf(data: bytes) -> Image:
                 if (st_shndx != 0 and st_info >> 4 in (STB_GLOBAL, STB_WEAK)
                         and st_other & 3 in (STV_DEFAULT, STV_PROTECTED)):
                     exports.add(_cstring(data, strtab + st_name))
+        elif sh_type == SHT_GNU_VERNEED:
+            details["version_needs"] = _version_needs(data, sh_offset, sections[sh_link][4])
         elif sh_type == SHT_DYNAMIC:
             strtab = sections[sh_link][4]
             for k in range(sh_size // 16):

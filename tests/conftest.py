@@ -7,6 +7,7 @@ files), docs/ (the pages, the site and the examples they show), benchmarks/ (the
 cases.py (case sets), agree.py (comparing within conditioning), independent.py (the references from
 outside the code), fmi_child.py (hostile FMI calls in a child process), toy_fmu.py and toys/, c_host/
 (C hosts and drivers), data/."""
+import os
 import sys
 from pathlib import Path
 
@@ -20,6 +21,37 @@ sys.path.insert(0, str(ROOT / "tests"))  # the shared helpers, from every folder
 MODELS = ROOT / "fmu_src" / "restitution" / "fmu" / "models"
 for _folder in (MODELS / "sphere_plate_impact", MODELS / "bouncing_ball", MODELS):
     sys.path.insert(0, str(_folder))
+
+
+@pytest.fixture(scope="session")
+def release(tmp_path_factory):
+    """(sdist, wheel) of ``python -m build`` (the sdist, then the wheel from it, carrying every FMU built),
+    made once per session (by one pytest-xdist worker, the others waiting for it) with this environment's
+    build tools (--no-isolation: nothing downloaded). With
+    RESTITUTION_RELEASE_DIR=DIR: those of DIR where it holds both, else built into DIR (.ci/run keeps the
+    release for its smoke test so)."""
+    import fcntl
+    import subprocess
+
+    given = os.environ.get("RESTITUTION_RELEASE_DIR", "").strip()
+    if given:
+        dist = Path(given)
+    elif os.environ.get("PYTEST_XDIST_WORKER"):  # the folder every worker of this session shares
+        dist = tmp_path_factory.getbasetemp().parent / "release"
+    else:
+        dist = tmp_path_factory.mktemp("release")
+    dist.mkdir(parents=True, exist_ok=True)
+    patterns = ("restitution-*.tar.gz", "restitution-*-py3-none-any.whl")
+    with open(dist / ".lock", "w") as lock:  # pytest-xdist workers (test_wheel, test_package) build it once
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        found = [sorted(dist.glob(pattern)) for pattern in patterns]
+        if not all(len(f) == 1 for f in found):
+            proc = subprocess.run([sys.executable, "-m", "build", "--no-isolation", "--outdir", str(dist), str(ROOT)],
+                                  capture_output=True, text=True, cwd=dist)
+            assert proc.returncode == 0, proc.stderr[-3000:]
+            found = [sorted(dist.glob(pattern)) for pattern in patterns]
+    (sdist,), (wheel,) = found
+    return sdist, wheel
 
 
 @pytest.fixture(scope="session")

@@ -187,6 +187,80 @@ def test_the_reader_agrees_with_objdump(built_fmus, which, tmp_path):
     assert compared >= 1  # the Linux x86-64 binary at least
 
 
+# --- the C library baseline of the Linux binaries ------------------------------------------------------
+#: The newest glibc symbol version a Linux binary of the project may need (toolchains.GLIBC_BASELINE, written
+#: out here: the manylinux2014 baseline, the first glibc with aarch64).
+GLIBC_BASELINE = (2, 17)
+#: Every FMU of the build: (place in the build directory, whether its binaries/ holds pythonfmu's own).
+ALL_FMUS = [(f"{model}.fmu", "python") for model in MODELS] + [
+    (f"{which}/{model}.fmu", which) for which in ("fmi2", "fmi3") for model in MODELS]
+
+
+def _project_elf_binaries(built_fmus):
+    """(where, bytes) of every ELF binary the project builds, in every FMU of the build: the native FMUs'
+    and the pythonfmu FMUs' guard (not pythonfmu's own ``<id>_pythonfmu.so``, which pythonfmu ships
+    prebuilt)."""
+    for place, which in ALL_FMUS:
+        fmu = built_fmus / place if which == "python" else _implementation(built_fmus, place.split("/")[1][:-4], which)
+        for folder, files in sorted(_binaries(fmu).items()):
+            for name, data in sorted(files.items()):
+                if FOLDERS[folder][0] == "ELF" and not name.endswith("_pythonfmu.so"):
+                    yield f"{place} binaries/{folder}/{name}", data
+
+
+def _glibc_text(version) -> str:
+    return "none" if version is None else "GLIBC_" + ".".join(map(str, version))
+
+
+def test_every_linux_binary_needs_at_most_glibc_2_17(built_fmus):
+    """The highest GLIBC_x.y each Linux binary needs (its .gnu.version_r, read in Python): at most 2.17, so
+    it loads on CentOS 7 and every later distribution, whatever glibc the build machine has."""
+    from binary_formats import glibc_version
+
+    found = {}
+    for where, data in _project_elf_binaries(built_fmus):
+        image, = read_images(data)
+        found[where] = glibc_version(image.details.get("version_needs", {}))
+    print("\n".join(f"{where}: {_glibc_text(v)}" for where, v in found.items()))
+    assert len(found) >= 2 + 2 * 2 * 1  # the two guards, each native FMU's x86_64 binary (and aarch64 in FMI 3.0)
+    above = {where: _glibc_text(v) for where, v in found.items() if v is not None and v > GLIBC_BASELINE}
+    assert not above, f"needs a glibc newer than {_glibc_text(GLIBC_BASELINE)}: {above}"
+
+
+@pytest.mark.parametrize("glibc, expected", [("2.17", (2, 2, 5)), ("2.34", (2, 29))])
+def test_the_version_reader_finds_the_glibc_the_target_names(tmp_path, glibc, expected):
+    """A library calling exp() linked by zig against glibc 2.17 and 2.34: glibc 2.29 gave exp a new symbol
+    version (GLIBC_2.29, glibc's NEWS for 2.29); before it, x86-64's exp is GLIBC_2.2.5, its first version."""
+    from restitution.fmu.builders import toolchains
+    from binary_formats import glibc_version
+
+    if toolchains.zig_command() is None:
+        pytest.skip(f"zig not found ({toolchains.ZIG_INSTALL})")
+    source = tmp_path / "uses_exp.c"
+    # exported as the FMI functions are (the build compiles with -fvisibility=hidden)
+    source.write_text("#include <math.h>\n__attribute__((visibility(\"default\"))) double uses_exp(double x) "
+                      "{ return exp(x); }\n")
+    target = toolchains.Platform("x86_64-linux", None, ".so", f"x86_64-linux-gnu.{glibc}")
+    library = toolchains.compile_library(target, toolchains.zig_compiler(target), tmp_path, [source.name],
+                                         tmp_path / "out" / "libuses_exp.so")
+    image, = read_images(library.read_bytes())
+    assert glibc_version(image.details["version_needs"]) == expected
+    assert any(lib.startswith("libm.so") for lib in image.details["version_needs"])
+
+
+@pytest.mark.parametrize("model", MODELS)
+def test_the_guard_exports_the_fmi2_functions_only(built_fmus, model):
+    """The pythonfmu FMU's binaries/linux64/<id>.so, the project's guard: every FMI 2.0 function and nothing
+    else (its FMI 2.0 layer is the native FMUs'; the model-exchange functions are there and a model-exchange
+    instantiation is refused, docs/installing.md)."""
+    with zipfile.ZipFile(built_fmus / f"{model}.fmu") as z:
+        names = z.namelist()
+        if not any(n.endswith("_pythonfmu.so") for n in names):
+            pytest.skip("the pythonfmu FMU was built without the guard (no zig or gcc)")
+        image, = read_images(z.read(f"binaries/linux64/{model}.so"))
+    assert image.exports == fmi_functions("2.0"), sorted(image.exports ^ fmi_functions("2.0"))
+
+
 # --- the binaries run: a plain C host on each platform this machine can run ---------------------------
 PROBE_STEP = {"SpherePlateImpact": 1e-3, "BouncingBall": 0.1}  # [s] the one communication step
 PROBE_SPEED = 2.3  # [m/s] Green (2022)'s checkpoint

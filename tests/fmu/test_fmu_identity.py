@@ -238,6 +238,28 @@ def test_two_builds_write_byte_identical_model_descriptions(builds, which):
     assert built >= 2  # the pythonfmu FMUs at least
 
 
+def _sha256(path: Path) -> str:
+    import hashlib
+
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("which", ["unset", "set"])
+def test_two_builds_write_byte_identical_fmus(builds, which):
+    """Every FMU, every platform's binaries in it (Windows DLLs included), built twice at different times
+    into different directories: the same SHA-256 (the archives' entry times are SOURCE_DATE_EPOCH's or
+    fixed, their order and permissions fixed: restitution.reproducible.write_zip)."""
+    first, second = builds[which]
+    compared = []
+    for name in ALL_FMUS:
+        if (first / name).is_file() or (second / name).is_file():
+            assert _sha256(first / name) == _sha256(second / name), f"{name}: the two builds differ"
+            compared.append(name)
+    print(which, "identical:", ", ".join(compared))
+    assert len(compared) >= 2  # the pythonfmu FMUs at least
+
+
 @pytest.mark.slow
 def test_the_generation_date_is_source_date_epochs_and_absent_without_it(builds):
     for name in ALL_FMUS:

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import shutil
 import struct
+import time
 import zipfile
 
 import pytest
@@ -37,9 +38,25 @@ def test_every_platform_has_its_folders():
 
 def test_which_compiler(monkeypatch):
     real_which = shutil.which
-    if shutil.which("gcc"):
-        assert toolchains.compiler("x86_64-linux").name == "gcc"
+    monkeypatch.delenv(toolchains.COMPILER_CHOICE, raising=False)
     monkeypatch.setattr(toolchains, "zig_command", lambda: ("python", "-m", "ziglang"))
+    # x86_64-linux: zig first (the glibc 2.17 baseline), gcc where zig is missing
+    linux = toolchains.compiler("x86_64-linux")
+    assert linux.name == "zig cc" and linux.command[-2:] == ("-target", "x86_64-linux-gnu.2.17")
+    if shutil.which("gcc"):
+        assert toolchains.compiler("x86_64-linux", use="native").name == "gcc"
+        with monkeypatch.context() as without_zig:
+            without_zig.setattr(toolchains, "zig_command", lambda: None)
+            assert toolchains.compiler("x86_64-linux").name == "gcc"
+    if shutil.which(toolchains.MINGW):  # RESTITUTION_COMPILER=zig (the wheel's build): zig though mingw is here
+        assert toolchains.compiler("x86_64-windows").name == toolchains.MINGW
+        monkeypatch.setenv(toolchains.COMPILER_CHOICE, "zig")
+        assert toolchains.compiler("x86_64-windows").name == "zig cc"
+        monkeypatch.delenv(toolchains.COMPILER_CHOICE)
+    monkeypatch.setenv(toolchains.COMPILER_CHOICE, "gcc")
+    with pytest.raises(ValueError, match="RESTITUTION_COMPILER"):
+        toolchains.compiler("x86_64-linux")
+    monkeypatch.delenv(toolchains.COMPILER_CHOICE)
     hidden = {toolchains.MINGW, "gcc"}
     monkeypatch.setattr(toolchains.shutil, "which", lambda cmd, *a, **k: None if cmd in hidden else real_which(cmd, *a, **k))
     windows = toolchains.compiler("x86_64-windows")
@@ -93,8 +110,9 @@ def test_universal_binary(tmp_path):
 
 
 def test_builds_are_reproducible(fmi3_ball_fmu, tmp_path):
-    """BouncingBall's FMI 3.0 sources compiled twice, from two folders, by every compiler of every platform
-    there is here (gcc, mingw-w64, zig): the same bytes."""
+    """BouncingBall's FMI 3.0 sources compiled twice, from two folders, seconds apart, by every compiler of
+    every platform there is here (gcc, mingw-w64, zig): the same bytes (a PE link time stamp from the clock
+    would differ)."""
     from restitution.fmu.builders.native import fmi_include_dir
 
     compared = []
@@ -114,6 +132,7 @@ def test_builds_are_reproducible(fmi3_ball_fmu, tmp_path):
                                                      folder / f"BouncingBall{target.suffix}",
                                                      system_include_dirs=[fmi_include_dir("3.0")])
                 builds.append(library.read_bytes())
+                time.sleep(1.1 if k == 1 else 0)  # PE time stamps count seconds
             assert builds[0] == builds[1], f"{target.name} with {cc.name}: two builds differ"
             compared.append(f"{target.name}/{cc.name}")
     if not compared:

@@ -5,7 +5,7 @@ import shutil
 import weakref
 from pathlib import Path
 
-__all__ = ["FmuInstance", "FmiStatusError", "build_default_fmu", "check_impact_fmu", "impact_fmu_parameters",
+__all__ = ["FmuInstance", "FmiStatusError", "check_impact_fmu", "impact_fmu_parameters",
            "quiet_instantiate"]
 
 
@@ -15,15 +15,6 @@ class FmiStatusError(RuntimeError):
     def __init__(self, message: str, status: int | None = None):
         super().__init__(message)
         self.status = status
-
-
-def build_default_fmu(out_dir: str | Path | None = None, model: str = "SpherePlateImpact",
-                      rebuild: bool = False, log=None, scope: str = "all") -> Path:
-    """Path of ``<model>.fmu``, built when missing or stale: :func:`restitution.fmu.default_fmu` (``scope``
-    "all": with every other FMU, every platform; "model": that one alone, the pythonfmu FMU)."""
-    from ..fmu.builders import default_fmu
-
-    return default_fmu(out_dir, model=model, rebuild=rebuild, log=log, scope=scope)
 
 
 def check_impact_fmu(path, option: str = "--fmu") -> Path:

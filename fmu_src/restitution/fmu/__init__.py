@@ -12,12 +12,19 @@ same FMUs as a source checkout:
 * ``builders/``: the builders, one per product (pythonfmu, native, the guard), and the entry points.
 
 The build is imported on first use: the pythonfmu FMUs bundle the interface tables, never the build.
+An installed wheel carries the built FMUs (``installed_fmus/``): :func:`path` names one, :func:`copy` copies
+them out (:mod:`.installed`), and :func:`default_fmu` uses them before building anything.
 """
-__all__ = ["FMUS", "BuildError", "build_all", "build_one", "default_fmu", "default_fmu_dir"]
+_BUILD = ["FMUS", "BuildError", "build_all", "build_one", "default_fmu", "default_fmu_dir"]
+_INSTALLED = ["path", "copy", "NotInstalled"]
+__all__ = [*_BUILD, *_INSTALLED]
 
 
 def __getattr__(name):
-    if name in __all__:
+    if name in _BUILD:
         from . import builders
         return getattr(builders, name)
+    if name in _INSTALLED:
+        from . import installed
+        return getattr(installed, name)
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

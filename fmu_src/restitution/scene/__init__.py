@@ -10,7 +10,7 @@ nothing in the physics modules or the FMU imports this subpackage. See docs/scen
 from .loader import (OUTPUTS, BallSpec, Drop, ModelSpec, PlateSpec, Scene, SceneError, SimulationSpec,
                      load_scene, parse_scene, resolve_material)
 from .results import DropResult, SceneResult
-from .runner import ensure_fmu, run_scene
+from .runner import chosen_fmu, run_scene
 
 __all__ = ["OUTPUTS", "BallSpec", "Drop", "ModelSpec", "PlateSpec", "Scene", "SceneError", "SimulationSpec",
-           "load_scene", "parse_scene", "resolve_material", "DropResult", "SceneResult", "ensure_fmu", "run_scene"]
+           "load_scene", "parse_scene", "resolve_material", "DropResult", "SceneResult", "chosen_fmu", "run_scene"]

@@ -47,10 +47,10 @@ class UsageError(Exception):
 
 def _fmu(args) -> Path:
     """The FMU to run, checked (or built) before anything is written."""
-    from .runner import ensure_fmu
+    from .runner import chosen_fmu
 
     try:
-        return ensure_fmu(args.fmu, rebuild=args.rebuild if hasattr(args, "rebuild") else False,
+        return chosen_fmu(args.fmu, rebuild=args.rebuild if hasattr(args, "rebuild") else False,
                           log=lambda text: print(text, file=sys.stderr))
     except SceneError:
         raise
@@ -61,10 +61,10 @@ def _fmu(args) -> Path:
 def _ball_fmu(args) -> Path:
     """The FMI 3.0 BouncingBall.fmu of ``simulation.master = "event_mode"``, checked (or built) before
     anything is written."""
-    from .runner import ensure_ball_fmu
+    from .runner import chosen_ball_fmu
 
     try:
-        return ensure_ball_fmu(args.ball_fmu, rebuild=args.rebuild,
+        return chosen_ball_fmu(args.ball_fmu, rebuild=args.rebuild,
                                log=lambda text: print(text, file=sys.stderr))
     except ValueError as exc:  # --ball-fmu PATH that is not one, or none could be built here
         raise UsageError(str(exc)) from None

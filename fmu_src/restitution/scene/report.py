@@ -21,7 +21,7 @@ from ..output_files import atomic_write, check_output
 from .loader import Scene, load_scene
 from .explain import explain
 from .results import READ_OUTPUTS, SceneResult
-from .runner import ensure_fmu, open_instance, run_scene
+from .runner import chosen_fmu, open_instance, run_scene
 
 __all__ = ["compare", "SceneReport", "report_scene", "markdown", "write_report", "refreshed", "RELATIVE"]
 
@@ -210,7 +210,7 @@ def write_report(paths, out=None, fmu=None, repeat: int = 3, methods=None, progr
     """
     if out is not None:
         check_output(out, "out")  # before any scene runs
-    fmu_path = ensure_fmu(fmu, log=log)
+    fmu_path = chosen_fmu(fmu, log=log)
     scenes = [load_scene(p) for p in paths]
     instance = open_instance(fmu_path)
     reports = []

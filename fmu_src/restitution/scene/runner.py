@@ -47,7 +47,7 @@ from ..cosim.interrupt import DeferredInterrupt
 from .loader import Drop, Scene, SceneError
 from .results import READ_FLAGS, READ_OUTPUTS, VALIDITY, DropResult, SceneResult, apex_heights
 
-__all__ = ["SceneInterrupted", "run_scene", "ensure_fmu", "ensure_ball_fmu", "open_instance", "drop_parameters"]
+__all__ = ["SceneInterrupted", "run_scene", "chosen_fmu", "chosen_ball_fmu", "open_instance", "drop_parameters"]
 
 class SceneInterrupted(KeyboardInterrupt):
     """An interrupted scene run: ``result`` holds the drops that finished."""
@@ -61,20 +61,20 @@ class SceneInterrupted(KeyboardInterrupt):
 
 # --- the FMU ---------------------------------------------------------------------------------
 
-def ensure_fmu(fmu=None, rebuild: bool = False, log=None) -> Path:
-    """Path of the FMU to run: ``fmu`` as given, else the default SpherePlateImpact.fmu
-    (dist/ of a source checkout, a per-user cache otherwise), (re)built when missing, built from
-    other sources, or when ``rebuild`` is true (:func:`restitution.fmu.default_fmu`)."""
+def chosen_fmu(fmu=None, rebuild: bool = False, log=None) -> Path:
+    """Path of the FMU to run: ``fmu`` as given (checked), else :func:`restitution.fmu.default_fmu` (the
+    installed FMU of a wheel, else dist/ of a source checkout or a per-user cache, built when missing or
+    stale, or when ``rebuild`` is true)."""
     if fmu is not None:  # ValueError (one line naming --fmu) unless it is a SpherePlateImpact FMU
         from ..cosim.fmu import check_impact_fmu
 
         return check_impact_fmu(fmu)
-    from ..cosim.fmu import build_default_fmu
+    from ..fmu.builders import default_fmu
 
-    return build_default_fmu(rebuild=rebuild, log=log)
+    return default_fmu(rebuild=rebuild, log=log)
 
 
-def ensure_ball_fmu(ball_fmu=None, rebuild: bool = False, log=None) -> Path:
+def chosen_ball_fmu(ball_fmu=None, rebuild: bool = False, log=None) -> Path:
     """Path of the FMI 3.0 BouncingBall.fmu the event-mode master runs (``simulation.master =
     "event_mode"``): ``ball_fmu`` as given (ValueError, one line naming --ball-fmu, unless it is one with
     event mode), else ``fmi3/BouncingBall.fmu`` beside the default FMUs, built with them where missing or
@@ -83,9 +83,9 @@ def ensure_ball_fmu(ball_fmu=None, rebuild: bool = False, log=None) -> Path:
 
     if ball_fmu is not None:
         return check_event_ball_fmu(ball_fmu)
-    from ..cosim.fmu import build_default_fmu
+    from ..fmu.builders import default_fmu
 
-    path = build_default_fmu(rebuild=rebuild, log=log).parent / "fmi3" / "BouncingBall.fmu"
+    path = default_fmu(rebuild=rebuild, log=log).parent / "fmi3" / "BouncingBall.fmu"
     if not path.is_file():
         raise ValueError(f"no native FMI 3.0 BouncingBall.fmu could be built here (it needs a C compiler): "
                          f"give --ball-fmu PATH, or use simulation.master = \"closed_form\"")
@@ -233,7 +233,7 @@ def run_scene(scene: Scene, fmu=None, *, effects: str = "scene", zener_method: s
     final line on stderr with the drops done; False: nothing. ``on_drop``: called with each
     :class:`DropResult` as soon as its drop finishes (e.g. :meth:`DropWriter.write`). An
     interrupt raises :class:`SceneInterrupted` with the finished drops. ``simulation.master = "event_mode"``:
-    each drop is the FMI 3.0 BouncingBall.fmu (``ball_fmu``, else :func:`ensure_ball_fmu`'s) co-simulated
+    each drop is the FMI 3.0 BouncingBall.fmu (``ball_fmu``, else :func:`chosen_ball_fmu`'s) co-simulated
     with the FMU in event mode with early return (:mod:`restitution.cosim.event_mode`).
     """
     if effects == "scene":
@@ -251,8 +251,8 @@ def run_scene(scene: Scene, fmu=None, *, effects: str = "scene", zener_method: s
     own = instance is None
     fmu_path = None
     if own:
-        fmu_path = ensure_fmu(fmu, rebuild=rebuild)
-    ball_path = ensure_ball_fmu(ball_fmu, rebuild=rebuild and own) if scene.simulation.master == "event_mode" else None
+        fmu_path = chosen_fmu(fmu, rebuild=rebuild)
+    ball_path = chosen_ball_fmu(ball_fmu, rebuild=rebuild and own) if scene.simulation.master == "event_mode" else None
     if own:
         instance = open_instance(fmu_path)
     ball = None

@@ -447,8 +447,8 @@ class FmuBackend(Backend):
 
     def __init__(self, fmu=None):
         if fmu is None:
-            from ..cosim.fmu import build_default_fmu
-            fmu = build_default_fmu()
+            from ..fmu.builders import default_fmu
+            fmu = default_fmu()
         self.path = Path(fmu).resolve()
         data = self.path.read_bytes()
         self.sha = hashlib.sha256(data).hexdigest()

@@ -1,5 +1,5 @@
 """Writing FMU archives and putting them in place, for every builder: the output directory checked, an
-archive written from a staged folder in a stable order, a zip member rewritten, and the finished FMU
+archive written reproducibly from a staged folder (fixed times, order, permissions), a zip member rewritten, and the finished FMU
 moved into place atomically (``os.replace``), readable as the umask allows, so a failed build leaves
 the previous FMU untouched."""
 from __future__ import annotations
@@ -7,6 +7,8 @@ from __future__ import annotations
 import os
 import zipfile
 from pathlib import Path
+
+from ...reproducible import write_zip, zip_directory
 
 __all__ = ["BuildError", "writable_dir", "zip_dir", "rewrite_zip", "place"]
 
@@ -30,23 +32,19 @@ def writable_dir(out_dir: Path) -> Path:
 
 
 def zip_dir(directory: Path, fmu: Path) -> None:
-    """The archive ``fmu`` of every file below ``directory``, in sorted order."""
-    with zipfile.ZipFile(fmu, "w", zipfile.ZIP_DEFLATED) as z:
-        for path in sorted(directory.rglob("*")):
-            if path.is_file():
-                z.write(path, path.relative_to(directory).as_posix())
+    """The archive ``fmu`` of every file below ``directory``, reproducibly
+    (:func:`restitution.reproducible.write_zip`: fixed times, order and permissions)."""
+    zip_directory(directory, fmu)
 
 
 def rewrite_zip(fmu: Path, replace: dict[str, bytes]) -> None:
     """The archive ``fmu`` with the members named in ``replace`` given that content (added where new),
-    every other member kept as it is."""
+    every other member's content kept, written anew reproducibly (:func:`restitution.reproducible.write_zip`),
+    whatever times and order the archive had."""
     tmp = fmu.with_suffix(".tmp")
-    with zipfile.ZipFile(fmu) as src, zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as dst:
-        for item in src.infolist():
-            if item.filename not in replace:
-                dst.writestr(item, src.read(item.filename))
-        for name, data in replace.items():
-            dst.writestr(name, data)
+    with zipfile.ZipFile(fmu) as src:
+        entries = {item.filename: src.read(item.filename) for item in src.infolist() if not item.is_dir()}
+    write_zip(tmp, {**entries, **replace})
     tmp.replace(fmu)
 
 

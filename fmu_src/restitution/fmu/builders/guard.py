@@ -42,7 +42,10 @@ from pathlib import Path
 from typing import Iterable, Optional, Sequence
 from xml.etree import ElementTree
 
+from ...reproducible import write_zip
+from . import toolchains
 from .compile import NativeBuildSkipped, fmi_include_dir
+from .toolchains import Compiler
 from .sources import FRONT, GUARD, front_files
 
 #: The guard's C sources: the front, then the guard's backend (forwarding to pythonfmu) and Python loader.
@@ -207,6 +210,15 @@ GUARD_CFLAGS = ("-std=gnu99", "-O2", "-Wall", "-Wextra", "-Werror", "-shared", "
                 "-pthread")
 
 
+def guard_compiler() -> Compiler:
+    """The compiler of the guard: x86_64-linux's (:func:`restitution.fmu.builders.toolchains.compiler`: zig for
+    the glibc 2.17 baseline, else gcc); StandaloneError where there is none."""
+    try:
+        return toolchains.compiler("x86_64-linux")
+    except toolchains.ToolchainMissing as exc:
+        raise StandaloneError(f"the FMU guard cannot be compiled: {exc}") from None
+
+
 def _fmi2_headers() -> Path:
     try:
         return fmi_include_dir("2.0")
@@ -214,10 +226,12 @@ def _fmi2_headers() -> Path:
         raise StandaloneError(f"the FMU guard cannot be compiled: {exc}") from None
 
 
-def guard_command(output: Path, generated: Path, real_name: str, compiler: str = "gcc", include_dir: str = "",
+def guard_command(output: Path, generated: Path, real_name: str, compiler="gcc", include_dir: str = "",
                   real_binary: Optional[bytes] = None, extra_flags: Sequence[str] = ()) -> list[str]:
-    """The compiler command for the guard; ``generated`` holds rst_interface.h and rst_model_info.h."""
-    cmd = [compiler, *GUARD_CFLAGS, *extra_flags, f'-DPYLOADER_REAL_BINARY="{real_name}"',
+    """The compiler command for the guard; ``generated`` holds rst_interface.h and rst_model_info.h.
+    ``compiler``: a command name ("gcc") or a :class:`~restitution.fmu.builders.toolchains.Compiler`."""
+    prefix = [compiler] if isinstance(compiler, str) else [*compiler.command, *compiler.flags]
+    cmd = [*prefix, *GUARD_CFLAGS, *extra_flags, f'-DPYLOADER_REAL_BINARY="{real_name}"',
            f'-DPYLOADER_CONFIG_NAME="{CONFIG_NAME}"', f"-I{generated}", f"-I{FRONT}", f"-I{GUARD}", f"-I{_fmi2_headers()}"]
     offset = _pystate_offset(real_binary) if real_binary else None
     if offset is not None:
@@ -239,12 +253,12 @@ def write_guard_headers(directory: Path, model_description: str, interface_heade
     (directory / "rst_model_info.h").write_text(model_info_header(*model_info(model_description)), encoding="ascii")
 
 
-def _compile_guard(output: Path, real_name: str, include_dir: str, compiler: str, real_binary: bytes,
+def _compile_guard(output: Path, real_name: str, include_dir: str, compiler: Compiler, real_binary: bytes,
                    model_description: str, interface_header: Optional[str]) -> None:
     with tempfile.TemporaryDirectory(prefix="fmi2guard_") as tmp:
         write_guard_headers(Path(tmp), model_description, interface_header)
         cmd = guard_command(output, Path(tmp), real_name, compiler, include_dir, real_binary)
-        proc = subprocess.run(cmd, capture_output=True, text=True)
+        proc = subprocess.run(cmd, capture_output=True, text=True, env=compiler.env)
     if proc.returncode != 0:
         raise StandaloneError(f"compiling the FMU guard failed:\n{' '.join(cmd)}\n{proc.stderr}")
 
@@ -254,7 +268,7 @@ def make_standalone(
     python_executable: str = sys.executable,
     *,
     required_modules: Optional[Sequence[str]] = None,
-    compiler: str = "gcc",
+    compiler: "Compiler | str | None" = None,
     interface_header: Optional[str] = None,
 ) -> None:
     """Rewrite the FMU zip at ``fmu_path`` in place so that its Linux binary
@@ -265,21 +279,25 @@ def make_standalone(
     recorded. ``required_modules`` are checked at instantiation for a clear
     error message; by default they are the non-stdlib top-level modules
     imported by the FMU's Python files that are importable at build time.
+    ``compiler``: None (default) for :func:`guard_compiler`, or a command name ("gcc").
     ``interface_header`` is the guard's variable table (:func:`restitution.fmu.describe.c_header.c_header`
     of the model's interface table); without it the table is made from the FMU's modelDescription.xml.
     """
     fmu_path = Path(fmu_path)
     if not sys.platform.startswith("linux"):
         raise StandaloneError("make_standalone builds a Linux x86_64 guard and must run on Linux")
-    if shutil.which(compiler) is None:
-        raise StandaloneError(f"C compiler '{compiler}' not found (install gcc)")
+    if isinstance(compiler, str):
+        if shutil.which(compiler) is None:
+            raise StandaloneError(f"C compiler '{compiler}' not found (install gcc)")
+        compiler = Compiler(compiler, (compiler,), ())
+    elif compiler is None:
+        compiler = guard_compiler()
     missing = [str(p) for p in GUARD_SOURCES if not p.is_file()]
     if missing:
         raise StandaloneError(f"guard sources missing: {', '.join(missing)}")
 
     with zipfile.ZipFile(fmu_path) as zin:
-        infos = zin.infolist()
-        entries = {i.filename: zin.read(i.filename) for i in infos}
+        entries = {i.filename: zin.read(i.filename) for i in zin.infolist()}
 
     model_id = _model_identifier(entries["modelDescription.xml"])
     guard_name = f"binaries/linux64/{model_id}.so"
@@ -321,31 +339,16 @@ def make_standalone(
                        entries["modelDescription.xml"].decode("utf-8"), interface_header)
         guard_binary = guard_so.read_bytes()
 
-    new_entries: dict[str, bytes] = {}
-    order: list[zipfile.ZipInfo] = []
-    for zi in infos:
-        if zi.filename in (guard_name, real_name, f"resources/{CONFIG_NAME}"):
-            continue
-        order.append(zi)
-        new_entries[zi.filename] = entries[zi.filename]
-
-    def add(name: str, data: bytes, mode: int) -> None:
-        zi = zipfile.ZipInfo(name, date_time=(1980, 1, 1, 0, 0, 0))
-        zi.compress_type = zipfile.ZIP_DEFLATED
-        zi.external_attr = (0o100000 | mode) << 16
-        order.append(zi)
-        new_entries[name] = data
-
-    add(guard_name, guard_binary, 0o755)
-    add(real_name, real_binary, 0o755)
-    add(f"resources/{CONFIG_NAME}", _config_text(info, requires).encode("utf-8"), 0o644)
+    entries = {name: data for name, data in entries.items()
+               if name not in (guard_name, real_name, f"resources/{CONFIG_NAME}") and not name.endswith("/")}
+    entries[guard_name] = guard_binary
+    entries[real_name] = real_binary
+    entries[f"resources/{CONFIG_NAME}"] = _config_text(info, requires).encode("utf-8")
 
     fd, tmp_name = tempfile.mkstemp(prefix=fmu_path.name, suffix=".tmp", dir=fmu_path.parent)
     os.close(fd)
     try:
-        with zipfile.ZipFile(tmp_name, "w", zipfile.ZIP_DEFLATED) as zout:
-            for zi in order:
-                zout.writestr(zi, new_entries[zi.filename])
+        write_zip(tmp_name, entries)
         os.replace(tmp_name, fmu_path)
     except BaseException:
         Path(tmp_name).unlink(missing_ok=True)
@@ -362,7 +365,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         default=None,
         help="module that must import at instantiation (repeatable; default: detected from the FMU's imports)",
     )
-    parser.add_argument("--cc", default="gcc", help="C compiler")
+    parser.add_argument("--cc", default=None, help="C compiler command (default: zig for glibc 2.17, else gcc)")
     args = parser.parse_args(argv)
     for fmu in args.fmu:
         make_standalone(fmu, args.python, required_modules=args.require, compiler=args.cc)

@@ -12,6 +12,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
+from ..installed import installed_dir
 from .files import BuildError
 from .plan import full_plan, model_plan, run, to_build
 from .progress import PREFIX, stderr_line
@@ -55,7 +56,12 @@ def default_fmu_dir() -> Path:
 
 def default_fmu(out_dir: str | Path | None = None, model: str = "SpherePlateImpact",
                 rebuild: bool = False, log=None, scope: str = "all") -> Path:
-    """Path of ``<model>.fmu`` (default SpherePlateImpact) in ``out_dir`` (default :func:`default_fmu_dir`).
+    """The default FMU: path of ``<model>.fmu`` (default SpherePlateImpact), built when missing or stale. The
+    one function for that job (scenes, sweeps, examples, the Quickstart demo).
+
+    Without ``out_dir`` and ``rebuild``, the FMU a wheel installed (:mod:`restitution.fmu.installed`) where
+    what ``scope`` names is there and up to date: nothing is built. Otherwise ``<model>.fmu`` in ``out_dir``
+    (default :func:`default_fmu_dir`).
 
     What ``scope`` names (:data:`SCOPES`) is built first where it is missing, was built from other
     sources than the installed package's (the source hash recorded in the FMU differs; a stale build
@@ -68,9 +74,13 @@ def default_fmu(out_dir: str | Path | None = None, model: str = "SpherePlateImpa
     """
     if scope not in SCOPES:
         raise ValueError(f"scope={scope!r}: one of {', '.join(SCOPES)}")
+    plan = full_plan() if scope == "all" else model_plan(model)
+    if out_dir is None and not rebuild:
+        installed = installed_dir()
+        if installed is not None and (installed / f"{model}.fmu").is_file() and not to_build(plan, installed):
+            return installed / f"{model}.fmu"
     out = Path(out_dir) if out_dir is not None else default_fmu_dir()
     fmu = out / f"{model}.fmu"
-    plan = full_plan() if scope == "all" else model_plan(model)
     todo = [(p, "rebuild asked") for p in plan] if rebuild else to_build(plan, out)
     if todo:
         say = log if log is not None else stderr_line

@@ -80,9 +80,19 @@ def _check_registration(model: str, xml_text: str) -> None:
 PYTHONFMU_FOLDERS = ("linux64", "win64")
 
 
+def _guard_compiler_found() -> bool:
+    from .toolchains import ToolchainMissing, compiler
+
+    try:
+        compiler("x86_64-linux")
+    except ToolchainMissing:
+        return False
+    return True
+
+
 def toolchain_label(standalone: bool = True) -> str:
     """What builds a pythonfmu FMU here, as the build's lines say it: pythonfmu and its version, and the
-    compiler of the guard (gcc) or why there is none."""
+    compiler of the guard (zig for glibc 2.17, else gcc) or why there is none."""
     from importlib import metadata
 
     try:
@@ -91,7 +101,12 @@ def toolchain_label(standalone: bool = True) -> str:
         label = "pythonfmu (not installed)"
     if not standalone:
         return f"{label}, no guard"
-    return f"{label}, guard gcc" if shutil.which("gcc") else f"{label}, no guard (no gcc)"
+    from .toolchains import ToolchainMissing, compiler, compiler_label
+
+    try:
+        return f"{label}, guard {compiler_label('x86_64-linux', compiler('x86_64-linux'))}"
+    except ToolchainMissing:
+        return f"{label}, no guard (no gcc or zig)"
 
 
 def build_one(model: str, out_dir: Path, standalone: bool = True, log=None, progress=None) -> Path:
@@ -132,9 +147,9 @@ def _build(model: str, out_dir: Path, standalone: bool, log, FmuBuilder, validat
         info = json.dumps({"model": model, "source_hash": source_hash(model)}, indent=1)
         rewrite_zip(fmu, {"modelDescription.xml": fmi2.model_description(model, native=False).encode("utf-8"),
                           BUILD_INFO: info.encode("utf-8"), **documentation_files(model, "2.0")})
-        if standalone and shutil.which("gcc") is None:
-            log(f"warning: gcc not found: {model}.fmu is built for Python hosts only (fmpy, libcosimpy), "
-                "without the C guard that checks every FMI call; install gcc")
+        if standalone and not _guard_compiler_found():
+            log(f"warning: neither zig nor gcc found: {model}.fmu is built for Python hosts only (fmpy, "
+                "libcosimpy), without the C guard that checks every FMI call; pip install ziglang")
         elif standalone:
             from .guard import make_standalone
             make_standalone(fmu, interface_header=c_header(model))

@@ -8,7 +8,8 @@ no folder for aarch64-linux (:func:`folders`).
 
 The compilers:
 
-* x86_64-linux: gcc, the machine's own compiler (``-fPIC -fvisibility=hidden -pthread``), else zig.
+* x86_64-linux: zig (glibc 2.17 baseline), else gcc, the machine's own compiler (``-fPIC -fvisibility=hidden
+  -pthread``; its binaries need this machine's glibc).
 * x86_64-windows: mingw-w64's ``x86_64-w64-mingw32-gcc`` where it is on PATH (runtime linked statically:
   the DLL needs only Windows' own DLLs), else zig.
 * aarch64-linux, x86_64-darwin, aarch64-darwin: zig.
@@ -52,6 +53,9 @@ from .compile import CFLAGS
 ZIG_PACKAGE = "ziglang"
 ZIG_INSTALL = f"pip install {ZIG_PACKAGE}"
 MINGW = "x86_64-w64-mingw32-gcc"
+#: The environment variable that, set to "zig" or "native", makes every build use that compiler only (the
+#: wheel's build sets "zig": the same compiler for every platform, no gcc or mingw-w64).
+COMPILER_CHOICE = "RESTITUTION_COMPILER"
 
 
 @dataclass(frozen=True)
@@ -62,7 +66,8 @@ class Platform:
     fmi2: str | None  #: its FMI 2.0 binaries/ folder (darwin64: one universal file of both macOS slices), or None
     suffix: str  #: the shared library's suffix
     zig_target: str  #: zig's target (architecture-os[.minimum version]-abi[.glibc version])
-    native: str | None = None  #: the compiler tried before zig where it is on PATH; None: zig only
+    native: str | None = None  #: the platform's own compiler where it is on PATH; None: zig only
+    zig_first: bool = False  #: zig tried before ``native`` (which is then the fallback without the ziglang package)
     native_flags: tuple = ()  #: that compiler's flags
     install: str = ""  #: how to get that compiler (Debian)
 
@@ -71,12 +76,17 @@ class Platform:
         return self.name if fmi_version.startswith("3.") else self.fmi2
 
 
-#: The platforms, in build order. zig targets: glibc 2.17 for aarch64-linux (the manylinux2014 baseline,
-#: the oldest glibc with aarch64), macOS 11.0 (the first with Apple silicon); Windows through zig links the
-#: Universal C Runtime (api-ms-win-crt-*, part of Windows 10 and later).
+#: The Linux binaries need at most :data:`GLIBC_BASELINE`.
+GLIBC_BASELINE = (2, 17)
+#: The platforms, in build order. zig targets: glibc 2.17 for both Linux platforms (the manylinux2014
+#: baseline, the oldest glibc with aarch64; zig links against stubs of that version's symbols, so the
+#: binaries load on every Linux with glibc >= 2.17, e.g. CentOS 7, whatever this machine's glibc is),
+#: macOS 11.0 (the first with Apple silicon); Windows through zig links the Universal C Runtime
+#: (api-ms-win-crt-*, part of Windows 10 and later). x86_64-linux: zig first for that baseline; gcc, the
+#: fallback without the ziglang package, links against this machine's glibc (e.g. exp/log/pow need 2.29).
 PLATFORMS = (
     # the front locks each instance (pthreads here; -pthread for glibc < 2.34)
-    Platform("x86_64-linux", "linux64", ".so", "x86_64-linux-gnu.2.17",
+    Platform("x86_64-linux", "linux64", ".so", "x86_64-linux-gnu.2.17", zig_first=True,
              native="gcc", native_flags=("-fPIC", "-fvisibility=hidden", "-pthread"), install="apt-get install gcc"),
     Platform("aarch64-linux", None, ".so", "aarch64-linux-gnu.2.17"),
     # mingw: the runtime linked statically; no symbol table, time stamp or image base chosen from the path
@@ -88,9 +98,11 @@ PLATFORMS = (
     Platform("aarch64-darwin", "darwin64", ".dylib", "aarch64-macos.11.0"),
 )
 #: zig's flags by operating system (the target's C library and compiler runtime come with zig; -s: no
-#: debug information and no symbol table, whose paths would make the bytes depend on the build folder).
+#: debug information and no symbol table, whose paths would make the bytes depend on the build folder;
+#: Windows: /Brepro, lld's reproducible mode, puts a hash of the image where the link time would be in the
+#: COFF header's TimeDateStamp, which zig's linker otherwise fills with the clock).
 ZIG_FLAGS = {"linux": ("-fPIC", "-fvisibility=hidden", "-pthread", "-s"),
-             "windows": ("-s",),
+             "windows": ("-s", "-Wl,/Brepro"),
              "darwin": ("-fvisibility=hidden", "-s")}
 
 
@@ -239,11 +251,17 @@ def zig_compiler(target: Platform) -> Compiler:
 
 def compiler(target: Platform | str, use: str | None = None) -> Compiler:
     """The compiler that builds ``target``'s binaries here: its native compiler where it has one and that
-    is on PATH, else zig. ``use``: "native" or "zig" to ask for that one only. ToolchainMissing (a one-line
-    reason naming what to install) where there is none."""
+    is on PATH, else zig (x86_64-linux: zig first, for the glibc baseline, else gcc). ``use``: "native" or "zig" to ask for that one only. ToolchainMissing (a one-line
+    reason naming what to install) where there is none. Without ``use``, the environment variable
+    :data:`COMPILER_CHOICE` where set ("zig": the wheel's build, zig from PyPI for every platform)."""
     target = platform(target) if isinstance(target, str) else target
+    if use is None:
+        use = os.environ.get(COMPILER_CHOICE, "").strip() or None
     if use not in (None, "native", "zig"):
-        raise ValueError(f"use={use!r}: None, 'native' or 'zig'")
+        raise ValueError(f"use={use!r} ({COMPILER_CHOICE}): 'native' or 'zig'")
+    if target.zig_first and use is None:
+        with contextlib.suppress(ToolchainMissing):
+            return zig_compiler(target)
     if use != "zig" and target.native is not None:
         found = shutil.which(target.native)
         if found is not None:

@@ -4,12 +4,11 @@ unit definitions and the XML text itself. Pure data in, text out."""
 from __future__ import annotations
 
 import math
-import os
-import re
 from datetime import datetime, timezone
 from xml.etree import ElementTree as ET
 
 from ...about import AUTHOR, COPYRIGHT, LICENSE, VERSION
+from ...reproducible import source_date_epoch
 from ..table import UNITS, Table, Variable
 
 __all__ = ["GENERATION_TOOL", "PYTHON_GENERATION_TOOL", "PARAMETER_CAUSALITIES", "generation_date_and_time",
@@ -33,15 +32,13 @@ def generation_date_and_time(environ=None) -> str | None:
     in the form the standard recommends (UTC, whole seconds, "Z": ``2026-11-25T10:00:00Z``); None where
     it is unset or empty, and the attribute (optional) is then left out, so that two builds of the same
     sources write the same files. ValueError for a value that is not a whole number of seconds."""
-    text = (os.environ if environ is None else environ).get("SOURCE_DATE_EPOCH", "").strip()
-    if not text:
+    seconds = source_date_epoch(environ)
+    if seconds is None:
         return None
-    if not re.fullmatch(r"[0-9]+", text):
-        raise ValueError(f"SOURCE_DATE_EPOCH={text!r} is not a whole number of seconds since 1970-01-01 UTC")
     try:
-        return datetime.fromtimestamp(int(text), timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
+        return datetime.fromtimestamp(seconds, timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
     except (OverflowError, OSError, ValueError):
-        raise ValueError(f"SOURCE_DATE_EPOCH={text} is beyond the dates a modelDescription can state") from None
+        raise ValueError(f"SOURCE_DATE_EPOCH={seconds} is beyond the dates a modelDescription can state") from None
 
 
 def model_attributes(table: Table, token_attribute: str, token: str, generation_tool: str) -> dict[str, str]:
