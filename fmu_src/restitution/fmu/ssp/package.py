@@ -4,15 +4,15 @@
 * ``BallOnPlate-SSP2.ssp``: SSP 2.0 with the native FMI 3.0 FMUs (``<out>/fmi3/``).
 
 Each holds ``SystemStructure.ssd`` at the root (:mod:`.ssd`), the two FMUs and the SSV parameter sets
-(:mod:`.ssv`) in ``resources/``. The archive is deterministic: entries in a fixed order (the SSD first),
-each dated 1980-01-01 00:00 (zip's earliest date) with mode 0644, so the same FMUs give the same bytes.
-(The FMU archives have their own writer, restitution.fmu.builders.files.zip_dir.)
+(:mod:`.ssv`) in ``resources/``. The archive is reproducible, written as the FMUs are
+(:func:`restitution.reproducible.write_zip`: entries in sorted order, the SSD first, each dated
+SOURCE_DATE_EPOCH or 1980-01-01 with fixed permissions), so the same FMUs give the same bytes.
 """
 from __future__ import annotations
 
-import zipfile
 from pathlib import Path
 
+from ...reproducible import write_zip
 from .ssd import Component, system_structure
 from .ssv import BALL_SET, DEFAULT_SET, ParameterSet, impact_parameter_sets, parameter_set_element, write_parameter_set
 from .xml_common import check_version, fmu_variables
@@ -23,21 +23,14 @@ __all__ = ["SSP_FILES", "build_ssp", "inline_ssp", "write_ssps", "deterministic_
 SSP_FILES = {"1.0": ("BallOnPlate.ssp", "fmi2"), "2.0": ("BallOnPlate-SSP2.ssp", "fmi3")}
 SSD_ENTRY = "SystemStructure.ssd"
 MODELS = {"ball": "BouncingBall", "impact": "SpherePlateImpact"}
-#: Every entry's date: zip's earliest (1980-01-01 00:00), so no build time leaks into the archive.
-ZIP_EPOCH = (1980, 1, 1, 0, 0, 0)
 
 
 def deterministic_zip(path: Path, entries: list[tuple[str, bytes]]) -> Path:
-    """Write ``entries`` (name, content), in the order given, to the zip ``path``: deflated, dated
-    :data:`ZIP_EPOCH`, mode 0644, no extra fields. Written to a temporary file and renamed into place."""
+    """Write ``entries`` (name, content) to the zip ``path`` reproducibly
+    (:func:`restitution.reproducible.write_zip`: fixed times, sorted names, fixed permissions), through a
+    temporary file renamed into place so that a reader never finds half an archive."""
     tmp = path.with_name(path.name + ".tmp")
-    with zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as archive:
-        for name, data in entries:
-            info = zipfile.ZipInfo(name, date_time=ZIP_EPOCH)
-            info.compress_type = zipfile.ZIP_DEFLATED
-            info.external_attr = 0o100644 << 16
-            info.create_system = 3  # Unix: the mode above is read as such
-            archive.writestr(info, data)
+    write_zip(tmp, entries)
     tmp.replace(path)
     return path
 
