@@ -23,7 +23,7 @@ import numpy as np
 
 import restitution as r
 from restitution.inputs import input_quantity, material
-from restitution.refusal import OptionError
+from restitution.units import OptionError
 from restitution.viz import finish
 from restitution.cosim import FmuInstance, bounce, build_default_fmu, fmu_rebound, impact_fmu_parameters
 

@@ -27,7 +27,7 @@ import restitution as r
 from restitution.cosim import (FmuInstance, ModelExchangeInstance, bounce, bounce_model_exchange, build_default_fmu,
                                fmu_rebound, impact_fmu_parameters, model_exchange_rebound, package_rebound)
 from restitution.inputs import input_quantity, material
-from restitution.refusal import OptionError
+from restitution.units import OptionError
 from restitution.viz import finish
 
 HERE = Path(__file__).resolve().parent

@@ -20,7 +20,7 @@ from pathlib import Path
 import restitution as r
 from restitution.cosim import FmuInstance, bounce, build_default_fmu, fmu_rebound, impact_fmu_parameters
 from restitution.inputs import input_quantity, material
-from restitution.refusal import OptionError
+from restitution.units import OptionError
 
 #: The default case: an S2 tool-steel ball, d = 6.35 mm, on Al 6061, t = 6.35 mm.
 SPHERE, D, PLATE, T = "s2_tool_steel", 6.35e-3, "al_6061", 6.35e-3

@@ -21,7 +21,7 @@ from .model import ZENER_METHODS, impact, published
 from .zener import WAVE_DELAY_LIMIT
 from .inputs import check_plausible_lengths, input_reading, material
 from .options import BARE_NUMBER_RULE, ArgumentParser, add_material_options, material_from_args
-from .refusal import OptionError
+from .units import OptionError
 from .output_files import (EXIT_IO_ERROR, EXIT_REFUSED, OutputPathError, atomic_write, check_output,
                            finish_stdout)
 
@@ -47,7 +47,7 @@ def evaluate(sphere, d, plate, t, v, zener_method: str = "exact", edge=None,
     approach speed ``v`` and the edge distance ``edge`` (each a number in SI or a text with its unit;
     ``edge`` None or 0: an unbounded plate). Without ``allow_implausible`` a bare-number length that is
     a likely slip is refused (:func:`~restitution.inputs.check_plausible_lengths`).
-    :class:`~restitution.refusal.OptionError` (one line) for an unknown material or a value outside the domain."""
+    :class:`~restitution.units.OptionError` (one line) for an unknown material or a value outside the domain."""
     bodies = {role: (material(role, body) if isinstance(body, str) else body)
               for role, body in (("sphere", sphere), ("plate", plate))}
     readings = {option: input_reading(option, QUANTITIES[option][0], str(text))

@@ -9,8 +9,8 @@ cor``, ``fit``, ``sweep`` and ``scene`` and the examples' command lines.
 * a material by name, from a TOML file or from its four properties;
 * the lengths a person likely slipped on (a bare "10" for a sphere's diameter).
 
-Each refusal is one line naming the option or the input (:class:`~restitution.refusal.OptionError`,
-:class:`QuantityError`), the user's text shortened (:func:`~restitution.refusal.echo`).
+Each refusal is one line naming the option or the input (:class:`~restitution.units.OptionError`,
+:class:`QuantityError`), the user's text shortened (:func:`~restitution.units.echo`).
 """
 from __future__ import annotations
 
@@ -19,8 +19,8 @@ import math
 from ._num import decimal_like
 from .domain import number_text, outside_text, slipped_prefix
 from .fmu.models.sphere_plate_impact.variables import TABLE
-from .refusal import ECHO_CHARS, OptionError, echo, short_enough, shorten_quoted
-from .units import EXAMPLES, QUANTITIES, UnitError, convert_quantity, read_quantity, split_quantity
+from .units import (ECHO_CHARS, EXAMPLES, QUANTITIES, OptionError, UnitError, convert_quantity, echo, read_quantity,
+                    short_enough, shorten_quoted, split_quantity)
 
 __all__ = ["QuantityError", "ROWS", "unit_of", "quantity", "quantities", "outside", "material", "input_quantity",
            "input_reading", "positive_quantity", "MATERIAL_PROPERTIES", "read_material_file", "custom_material",

@@ -6,7 +6,7 @@ from __future__ import annotations
 import argparse
 
 from .inputs import MATERIAL_PROPERTIES, MAX_BARE_LENGTH, PLAUSIBLE_T_OVER_D, custom_material
-from .refusal import shorten_quoted
+from .units import shorten_quoted
 
 __all__ = ["ArgumentParser", "add_material_options", "material_from_args", "BARE_NUMBER_RULE"]
 

@@ -14,7 +14,7 @@ from ..materials_table import text as materials_text
 from ..inputs import QuantityError
 from ..options import BARE_NUMBER_RULE, ArgumentParser, add_material_options
 from ..output_files import EXIT_IO_ERROR, EXIT_REFUSED, OutputPathError, OutputWriteError, describe_os_error
-from ..refusal import OptionError
+from ..units import OptionError
 from .outputs import SweepOutputs, check_sweep_outputs, resolve_outputs
 from .sobol import SOBOL_OUTPUTS, SobolCollector, SobolError, SobolSpec
 from .spec import CODES, INPUT_NAMES, INPUTS, MAX_SAMPLES, MAX_SEED, T_OVER_D, SweepSpec, canonical_name, load_spec
