@@ -48,6 +48,7 @@ for _p in (ROOT / "fmu_src", ROOT / "benchmarks"):
         sys.path.insert(0, str(_p))
 
 import restitution as r  # noqa: E402
+from accuracy_bench.docs_block import replace_block  # noqa: E402
 from harness import interleaved, median, median_ratio, settle_allocator  # noqa: E402
 from restitution.fit.datasets import ImpactTimes, ReboundPairs  # noqa: E402
 from restitution.fit.estimate import base_of, fit_parameters  # noqa: E402
@@ -241,12 +242,7 @@ def report(c: dict, cov: dict | None, drag: list | None, args, n_pairs: int, n_t
 
 
 def write_doc(block: str, path: Path = DOC) -> None:
-    text = path.read_text(encoding="utf-8")
-    if BEGIN not in text or END not in text:
-        raise SystemExit(f"{path}: no {BEGIN} ... {END} block to replace")
-    head, rest = text.split(BEGIN, 1)
-    _old, tail = rest.split(END, 1)
-    path.write_text(f"{head}{BEGIN}\n```text\n{block}\n```\n{END}{tail}", encoding="utf-8")
+    replace_block(path, BEGIN, END, block)
 
 
 def main(argv=None) -> int:

@@ -22,7 +22,8 @@ from pathlib import Path
 import numpy as np
 
 import restitution as r
-from restitution.options import OptionError, input_quantity, material
+from restitution.inputs import input_quantity, material
+from restitution.units import OptionError
 from restitution.viz import finish
 from restitution.cosim import FmuInstance, bounce, fmu_rebound, impact_fmu_parameters
 from restitution.fmu import default_fmu

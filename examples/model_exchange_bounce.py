@@ -27,7 +27,8 @@ import restitution as r
 from restitution.cosim import (FmuInstance, ModelExchangeInstance, bounce, bounce_model_exchange, fmu_rebound,
                                impact_fmu_parameters, model_exchange_rebound, package_rebound)
 from restitution.fmu import default_fmu
-from restitution.options import OptionError, input_quantity, material
+from restitution.inputs import input_quantity, material
+from restitution.units import OptionError
 from restitution.viz import finish
 
 HERE = Path(__file__).resolve().parent

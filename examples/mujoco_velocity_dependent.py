@@ -24,7 +24,8 @@ import restitution as r
 from restitution.export import export_case
 from restitution.export.mujoco import ramp_solimp
 from restitution.export.mujoco_bounce import G, bounce_in_mujoco, solref_from_model
-from restitution.options import OptionError, input_quantity, material, positive_quantity
+from restitution.inputs import input_quantity, material, positive_quantity
+from restitution.units import OptionError
 from restitution.viz import finish
 
 HERE = Path(__file__).resolve().parent

@@ -20,7 +20,8 @@ from pathlib import Path
 import restitution as r
 from restitution.cosim import FmuInstance, bounce, fmu_rebound, impact_fmu_parameters
 from restitution.fmu import default_fmu
-from restitution.options import OptionError, input_quantity, material
+from restitution.inputs import input_quantity, material
+from restitution.units import OptionError
 
 #: The default case: an S2 tool-steel ball, d = 6.35 mm, on Al 6061, t = 6.35 mm.
 SPHERE, D, PLATE, T = "s2_tool_steel", 6.35e-3, "al_6061", 6.35e-3

@@ -25,7 +25,7 @@ def impact_between(sphere: Sphere, plate: Plate, v, **options) -> ImpactResult:
     an array, a pint Quantity or a string with its unit, "2 m/s"), which must lie in the model's domain,
     0 to 10 km/s, as the sphere's and the plate's properties do (a ValueError names a value outside it)."""
     if isinstance(v, str):
-        from .options import python_quantity
+        from .units import python_quantity
 
         v = python_quantity("v_approach", v, "m/s")
     v = check_in_domain("v_approach", "v", check_nonnegative("v_approach", v, "m/s"), "m/s")

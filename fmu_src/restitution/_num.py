@@ -13,7 +13,7 @@ import numbers
 
 import numpy as np
 
-__all__ = ["is_scalar", "exp", "expm1", "log", "sqrt", "fifth_root", "where", "minimum", "maximum", "as_output"]
+__all__ = ["decimal_like", "POW10", "DECIMAL_BLOCK", "is_scalar", "exp", "expm1", "log", "sqrt", "fifth_root", "where", "minimum", "maximum", "as_output"]
 
 
 def is_scalar(x) -> bool:
@@ -89,3 +89,38 @@ def as_output(x):
     if is_scalar(x) or (isinstance(x, np.ndarray) and x.ndim == 0):
         return float(x)
     return x
+
+
+#: A computed value within SNAP_ULPS ulps of a decimal of SNAP_DIGITS significant digits is that decimal's
+#: double (an ulp taken as 2**-52 of the value: at the foot of a binade, up to twice as many).
+SNAP_DIGITS = 12
+SNAP_ULPS = 2
+_SNAP_REL = SNAP_ULPS * 2.0**-52
+#: 10**k for k = 0 ... 22, each exact as a double.
+POW10 = np.array([float(10**k) for k in range(23)])
+#: For k = -22 ... 22 (index k + 22), a decimal with k places is digits * _MUL / _DIV, one exact factor 1.
+_MUL = np.concatenate([POW10[:0:-1], np.ones(23)])
+_DIV = np.concatenate([np.ones(22), POW10])
+#: Values handled at a time (bounds the temporaries of an axis of 10^8 values, and keeps them in cache).
+DECIMAL_BLOCK = 1 << 16
+
+
+def decimal_like(values) -> np.ndarray:
+    """``values`` with each one that lies within :data:`SNAP_ULPS` ulps of a decimal of
+    :data:`SNAP_DIGITS` significant digits replaced by the double nearest that decimal (the others,
+    zeros and non-finite values as they are): the rounding of a computation, an ulp or two, taken off a
+    value that is a short decimal (7.999999999999999 is 8, 0.0045000000000000005 is 0.0045)."""
+    x = np.array(values, dtype=float, ndmin=1)
+    for lo in range(0, x.size, DECIMAL_BLOCK):
+        block = x[lo:lo + DECIMAL_BLOCK]
+        with np.errstate(all="ignore"):
+            size = np.abs(block)
+            places = (SNAP_DIGITS - 1 + 22) - np.floor(np.log10(size))  # of a SNAP_DIGITS-digit decimal, + 22
+            fine = (places >= 0) & (places <= 44)  # False where NaN: zeros, non-finite values
+            k = np.where(fine, places, 22).astype(np.intp)
+            mul, div = _MUL[k], _DIV[k]
+            digits = np.rint(block * div / mul)  # an integer below 10^13: exact
+            near = digits * mul / div  # one correctly rounded operation (the other is by 1)
+            fine &= np.abs(near - block) <= _SNAP_REL * size
+        np.copyto(block, near, where=fine)
+    return x if np.ndim(values) else x[:1].reshape(())

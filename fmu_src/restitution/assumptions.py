@@ -14,7 +14,7 @@ from __future__ import annotations
 import warnings
 
 __all__ = ["CONDITIONS", "departures", "AssumptionWarning", "warn_departures", "E_NEGATIVE_MEANING",
-           "VALID_MEANING"]
+           "VALID_MEANING", "meaning_lines"]
 
 #: What e < 0 means (the flag ``e_negative``), in the words every report showing e < 0 gives beside it
 #: (``restitution cor``, the fit report, a sweep's statistics, a scene's summary; docs/assumptions.md).
@@ -24,6 +24,20 @@ E_NEGATIVE_MEANING = ("the sphere keeps moving with the plate after the impact i
 #: What ``valid`` means, where it is shown beside one impact (docs/assumptions.md, "Validated ranges").
 VALID_MEANING = ("inside the models' validated ranges, lambda <= 1.5 and V* <= 1000 (outside them e is an "
                  "extrapolation); it does not cover e < 0 (e_negative)")
+
+
+def meaning_lines(n_negative: int | None, n_invalid: int, of: int, what: str = "impacts",
+                  zero_negative: bool = True) -> list[str]:
+    """Lines saying how many of ``of`` cases have e < 0 (``e_negative``; None: not known, no line; 0: a
+    line only with ``zero_negative``) and how many lie outside the validated ranges (``valid`` false),
+    each with what it means where there are any."""
+    lines = []
+    if n_negative is not None and (n_negative or zero_negative):
+        lines.append(f"e < 0 (e_negative): {n_negative:,} of {of:,} {what}"
+                     + (f": {E_NEGATIVE_MEANING}" if n_negative else ""))
+    lines.append(f"valid = false (outside the models' validated ranges, lambda <= 1.5 and V* <= 1000): "
+                 f"{n_invalid:,} of {of:,} {what}" + ("; their e is an extrapolation" if n_invalid else ""))
+    return lines
 
 
 class AssumptionWarning(UserWarning):

@@ -54,7 +54,7 @@ def _run(argv: list[str]) -> int:
     if name not in SUBCOMMANDS:
         import difflib
 
-        from .options import echo
+        from .units import echo
 
         close = difflib.get_close_matches(name, list(SUBCOMMANDS), n=1) if len(name) <= 40 else []
         hint = f" (did you mean {close[0]}?)" if close else ""

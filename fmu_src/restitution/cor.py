@@ -16,10 +16,12 @@ import math
 import sys
 
 from .assumptions import E_NEGATIVE_MEANING, VALID_MEANING
+from .fmu.models.sphere_plate_impact.variables import TABLE
 from .model import ZENER_METHODS, impact, published
 from .zener import WAVE_DELAY_LIMIT
-from .options import (BARE_NUMBER_RULE, IMPACT_QUANTITIES, ArgumentParser, OptionError, add_impact_options,
-                      impact_inputs, material_from_args)
+from .inputs import IMPACT_QUANTITIES, impact_inputs
+from .options import BARE_NUMBER_RULE, ArgumentParser, add_impact_options, material_from_args
+from .units import OptionError
 from .output_files import (EXIT_IO_ERROR, EXIT_REFUSED, OutputPathError, atomic_write, check_output,
                            finish_stdout)
 
@@ -27,10 +29,14 @@ __all__ = ["main", "evaluate"]
 
 #: The options with a unit: option -> (FMU input name whose unit and range apply, impact keyword).
 QUANTITIES = IMPACT_QUANTITIES
+#: The result's numeric fields, in the order the JSON lists their units.
+_FIELDS = ("e", "e_ep", "e_ze", "v_rebound", "V_c", "V_star", "eps_y", "lam", "tau0", "T", "t_contact", "m_a", "m_eff",
+           "mass_ratio", "v_plate", "wave_delay", "edge_echo")
+#: The units of the fields the FMUs do not publish; the interface table carries the others'.
+_UNPUBLISHED_UNITS = {"eps_y": "1", "T": "s", "m_eff": "kg"}
+_TABLE_UNITS = {row.key: row.unit for row in TABLE.rows if row.causality == "output" and row.unit}
 #: Units of the result's fields, as printed and in the JSON (SI).
-UNITS = {"e": "1", "e_ep": "1", "e_ze": "1", "v_rebound": "m/s", "V_c": "m/s", "V_star": "1", "eps_y": "1",
-         "lam": "1", "tau0": "1", "T": "s", "t_contact": "s", "m_a": "kg", "m_eff": "kg", "mass_ratio": "1",
-         "v_plate": "m/s", "wave_delay": "1", "edge_echo": "1"}
+UNITS = {name: _TABLE_UNITS.get(name) or _UNPUBLISHED_UNITS[name] for name in _FIELDS}
 
 
 def evaluate(sphere, d, plate, t, v, zener_method: str = "exact", edge=None,
@@ -39,8 +45,8 @@ def evaluate(sphere, d, plate, t, v, zener_method: str = "exact", edge=None,
     preset's name or a :class:`~restitution.Material`), the diameter ``d``, the thickness ``t``, the
     approach speed ``v`` and the edge distance ``edge`` (each a number in SI or a text with its unit;
     ``edge`` None or 0: an unbounded plate). Without ``allow_implausible`` a bare-number length that is
-    a likely slip is refused (:func:`~restitution.options.check_plausible_lengths`).
-    :class:`~restitution.options.OptionError` (one line) for an unknown material or a value outside the domain."""
+    a likely slip is refused (:func:`~restitution.inputs.check_plausible_lengths`).
+    :class:`~restitution.units.OptionError` (one line) for an unknown material or a value outside the domain."""
     v, params = impact_inputs(sphere, d, plate, t, v, edge, allow_implausible)
     result = published(impact(v, **params, zener_method=zener_method).as_dict())
     inputs = {"sphere": sphere if isinstance(sphere, str) else sphere.name,

@@ -17,8 +17,8 @@ import numpy as np
 
 from ._num import is_scalar
 
-__all__ = ["DOMAIN", "PREFIXED", "TYPICAL", "DomainWarning", "slipped_prefix", "outside_domain", "check_in_domain",
-           "warn_outside_domain", "number_text"]
+__all__ = ["DOMAIN", "PREFIXED", "TYPICAL", "DomainWarning", "slipped_prefix", "outside_text", "outside_domain",
+           "check_in_domain", "warn_outside_domain", "number_text"]
 
 #: The domain the FMUs declare (min/max in modelDescription.xml) and the property tests cover, per
 #: argument of :func:`restitution.impact`: (low, high) [SI], both included; nu has its own [0, 0.5].
@@ -61,6 +61,17 @@ def slipped_prefix(value: float, unit: str, accepts, typical: float) -> str | No
     return None if best is None else f"{number_text(value)} {best[1]}"
 
 
+def outside_text(label: str, value: float, unit: str | None, allowed: str, hint: str | None = None) -> str:
+    """The one wording of a value refused for lying outside its range, whatever front end read it (the
+    objects, :func:`restitution.impact`, the command lines, sweeps, scenes): ``plate.E = 114 Pa is outside
+    100000 <= value <= 1e+13 Pa: did you mean 114 GPa?``. ``value`` [SI], ``unit`` its SI unit (None or
+    "": dimensionless), ``allowed`` the range as text, ``hint`` the value as it was likely meant
+    (:func:`slipped_prefix`)."""
+    suffix = f" {unit}" if unit else ""
+    message = f"{label} = {number_text(value)}{suffix} is outside {allowed}{suffix}"
+    return f"{message}: did you mean {hint}?" if hint else message
+
+
 class DomainWarning(UserWarning):
     """A value outside the model's domain given to :func:`restitution.impact`, which computes it anyway."""
 
@@ -81,9 +92,8 @@ def outside_domain(label: str, key: str, value, unit: str) -> str | None:
         if arr.size == 0 or (low <= arr.min() and arr.max() <= high):
             return None
         bad = float(arr[(arr < low) | (arr > high)].flat[0])
-    message = f"{label} = {number_text(bad)} {unit} is outside {low:g} <= value <= {high:g} {unit}"
     hint = slipped_prefix(bad, unit, lambda x: low <= x <= high, TYPICAL[key.split("_", 1)[-1]])
-    return f"{message}: did you mean {hint}?" if hint else message
+    return outside_text(label, bad, unit, f"{low:g} <= value <= {high:g}", hint)
 
 
 def check_in_domain(label: str, key: str, value, unit: str):

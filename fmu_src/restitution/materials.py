@@ -95,9 +95,9 @@ class Plate:
 
 def _si(name: str, value, unit: str):
     """``value`` in SI: a pint Quantity converted, a string with its unit read as the command lines read
-    it (``"2 mm"``, ``"115 GPa"``; :func:`restitution.options.python_quantity`), a number as it is."""
+    it (``"2 mm"``, ``"115 GPa"``; :func:`restitution.units.python_quantity`), a number as it is."""
     if isinstance(value, str):
-        from .options import python_quantity  # host side only: the FMUs never pass text
+        from .units import python_quantity  # host side only: the FMUs never pass text
 
         return python_quantity(name, value, unit)
     return to_si(name, value, unit)

@@ -11,14 +11,13 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, fields
 from functools import lru_cache
-from typing import NamedTuple
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
 from . import fusion, jgm, zener
 from ._array_steps import (_moving, _own_array, _skip_small_loss, _waves_needed, _zener_restitution_where_needed,
                            _zener_where_needed)
-from ._output_steps import Wanted, dependencies, wanted
 from ._num import fifth_root, is_scalar, minimum, where
 from .fusion import apparent_restitution, mass_ratio, plate_mass_from_ratio, plate_velocity_after_impact
 from .jgm import restitution_e44, restitution_e45, vstar_in_fit_range
@@ -30,6 +29,9 @@ from .zener import (TAU0_HERTZ, ZENER_METHODS, edge_clear, edge_echo_ratio_from_
                     lambda_in_studied_range, lambda_material_factor, lambda_speed_factor, time_scale_factor,
                     time_scale_from_root, wave_delay, waves_concurrent, zener_linear, zener_paper_fit, zener_restitution_only,
                     zener_solution)
+
+if TYPE_CHECKING:  # loaded by impact(outputs=...) when a caller chooses its outputs
+    from ._output_steps import Wanted
 
 # The pipeline passes SI numbers it has checked: it calls the equations without their unit layer
 # (restitution.quantities), which would cost more than the equations on the scalar path.
@@ -543,6 +545,8 @@ _DERIVED = {
 def output_dependencies(name: str) -> frozenset:
     """The outputs of :data:`RECORD` that :func:`impact` computes to give ``name`` (itself included);
     ValueError for a name not in :data:`RECORD`."""
+    from ._output_steps import dependencies  # loaded by the callers that choose their outputs
+
     return dependencies(name, RECORD)
 
 
@@ -552,6 +556,8 @@ def _wanted(outputs) -> Wanted:
         names = (outputs,) if isinstance(outputs, str) else tuple(dict.fromkeys(outputs))
     except TypeError:  # not a sequence of names
         raise ValueError(f"outputs = {outputs!r:.60} is not a name or a sequence of names of {RECORD}") from None
+    from ._output_steps import wanted
+
     return wanted(names, RECORD)
 
 

@@ -19,7 +19,6 @@ from ._num import exp, expm1, is_scalar, minimum, sqrt, where
 from .quantities import si_only, with_units
 from .jgm import reduced_modulus
 from .zener_exact import zener_exact_restitution, zener_exact_solution
-from .zener_ode import solve_zener_ode
 
 __all__ = [
     "ZENER_METHODS", "LAMBDA_STUDIED_MAX", "lambda_in_studied_range", "TAU0_HERTZ", "plate_wave_speed", "inelasticity_parameter",
@@ -286,6 +285,8 @@ def zener_ode(lam, rtol: float = 1e-10):
     are floored at what the integrator honours, and above lambda = 100 the verified large-lambda
     form is returned instead of a solve (see :mod:`restitution.zener_ode`, "Bounded cost").
     """
+    from .zener_ode import solve_zener_ode  # the ODE solver, loaded by the few that ask for it
+
     if is_scalar(lam):
         return solve_zener_ode(float(lam), rtol=rtol)
     lam = np.asarray(lam)  # each element goes through float() below

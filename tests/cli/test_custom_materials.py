@@ -14,7 +14,7 @@ import pytest
 import restitution as r
 from restitution.cor import main as cor_main
 from restitution.fit.command import main as fit_main
-from restitution.options import OptionError
+from restitution.units import OptionError
 from restitution.sweep.__main__ import main as sweep_main
 
 #: The custom copper plate of the tests, as the options give it and in SI.

@@ -79,13 +79,16 @@ def test_the_fit_report_says_what_e_below_0_means_at_its_points():
 
 
 def test_one_copy_of_the_words():
-    """The sweep statistics and the scene summary take the same constant (no second copy of the text)."""
+    """The sweep statistics and the scene summary take the same lines (restitution.assumptions.meaning_lines)
+    and the same constant (no second copy of the text)."""
     from pathlib import Path
 
-    from restitution.scene import explain
+    from restitution import assumptions
+    from restitution.scene import results
     from restitution.sweep import statistics
 
-    assert statistics.E_NEGATIVE_MEANING is E_NEGATIVE_MEANING and explain.E_NEGATIVE_MEANING is E_NEGATIVE_MEANING
+    assert statistics.E_NEGATIVE_MEANING is E_NEGATIVE_MEANING
+    assert statistics.meaning_lines is assumptions.meaning_lines and results.meaning_lines is assumptions.meaning_lines
     source = Path(restitution.__file__).parent
     holders = [p.relative_to(source).as_posix() for p in source.rglob("*.py")
                if "keeps moving with the plate after the impact instead" in p.read_text(encoding="utf-8")]

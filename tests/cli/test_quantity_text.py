@@ -1,11 +1,11 @@
-"""Reading "<number> <unit>" text (restitution.scene.units.split_quantity): what is a number, where the
+"""Reading "<number> <unit>" text (restitution.units.split_quantity): what is a number, where the
 unit starts and ends, and text of any length read in time proportional to its length."""
 import subprocess
 import sys
 
 import pytest
 
-from restitution.scene.units import split_quantity
+from restitution.units import split_quantity
 
 
 @pytest.mark.parametrize("text, expected", [
@@ -26,7 +26,7 @@ def test_a_long_text_is_read_in_linear_time():
     first to its last non-blank character. The old pattern (a lazy unit before trailing blanks) took time
     growing with the square of the length: about 2.5 minutes for this text; linear, it takes milliseconds.
     Run in a child process with a 60 s limit, so that a quadratic pattern fails instead of stalling."""
-    code = ("from restitution.scene.units import split_quantity\n"
+    code = ("from restitution.units import split_quantity\n"
             "text = '1 a' + ' ' * 100000 + 'b '\n"
             "number, unit = split_quantity(text)\n"
             "assert number == 1.0 and unit == 'a' + ' ' * 100000 + 'b', (number, len(unit))\n"

@@ -22,7 +22,7 @@ import pytest
 
 import restitution as r
 from restitution.fit.command import _needs
-from restitution.options import OptionError
+from restitution.units import OptionError
 
 from test_recording import clicks, write_wav
 

@@ -185,3 +185,36 @@ def test_the_co_simulation_indicator_follows_the_flight(any_ball_fmu, tmp_path):
             want = v_up * (t - t1) - g * (t - t1) ** 2 / 2 if falling else apex  # h(t), then the apex
             assert z == pytest.approx(want, abs=1e-13), (t, z, want)
             assert (v < 0.0) == falling
+
+
+# --- the free flight: the C ball's contacts where restitution.flight.flight_to_plate, the one Python form
+# --- the slave, the co-simulation master and the calibration share, puts them
+#: Both sides evaluate v_hit = sqrt(v^2 + 2 g h) and t_start + (v + v_hit)/g: seven correctly rounded
+#: operations on non-negative terms (no cancellation to amplify a rounding), each side within 4 ulps of the
+#: exact value, so within 8 ulps of each other (the same expression in the same order: equal in practice).
+FLIGHT_ULPS = 8
+
+
+@pytest.mark.parametrize("h0,g,e", [(0.3, 9.80665, 0.8), (2.0, 1.62, 0.5), (1e-3, 9.81, 0.95), (50.0, 24.79, 0.3)])
+def test_the_c_ball_lands_where_the_python_flight_puts_it(ball, h0, g, e):
+    from restitution.flight import flight_to_plate
+
+    store = (ctypes.c_double * len(TABLE))()
+    for name, value in {"h0": h0, "g": g, "v_min": 1e-6, "contact_mode": 1, "e": e}.items():
+        store[TABLE[name].vr] = value
+    ball.rst_ball_initialize(store, 0.0)
+    at = {name: TABLE[name].vr for name in ("impacts", "t_impact", "v_impact", "flight.t_start", "flight.h_start",
+                                            "flight.v_start")}
+    fall, v1 = flight_to_plate(h0, 0.0, g)
+    step = min(fall, 2.0 * e**3 * v1 / g) / 3.7  # shorter than the first four flights: one contact a step
+    t, checked = 0.0, 0
+    while checked < 4:
+        start = (store[at["flight.t_start"]], store[at["flight.h_start"]], store[at["flight.v_start"]])
+        ball.rst_ball_do_step(store, t, step)
+        t += step
+        if store[at["impacts"]] > checked:
+            checked = int(store[at["impacts"]])
+            duration, v_hit = flight_to_plate(start[1], start[2], g)
+            for got, want in ((store[at["t_impact"]], start[0] + duration), (store[at["v_impact"]], v_hit)):
+                assert abs(got - want) <= FLIGHT_ULPS * math.ulp(want), (checked, got, want)
+    assert start[1] == 0.0 < start[2]  # the last flight checked started at the plate, going up

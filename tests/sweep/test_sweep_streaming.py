@@ -18,7 +18,7 @@ import pytest
 
 from restitution.sweep import SweepSpec, compare_results, read_table, run_sweep
 from restitution.sweep.__main__ import main as sweep_cli
-from restitution.sweep.parts import DiskSweepResult
+from restitution.sweep.result import DiskSweepResult
 from restitution.sweep.run import SweepInterrupted
 from restitution.sweep.size import check_memory, plan_size, table_bytes
 from restitution.sweep.spec import SizeError

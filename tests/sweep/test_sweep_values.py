@@ -9,10 +9,10 @@ import numpy as np
 import pytest
 
 from restitution.fmu.models.sphere_plate_impact.variables import TABLE
-from restitution.scene.units import split_quantity
+from restitution.units import split_quantity
 from restitution.sweep import SweepSpec, read_table, run_sweep
 from restitution.sweep.__main__ import main as sweep_cli
-from restitution.sweep.values import QuantityError, outside, quantity
+from restitution.inputs import QuantityError, outside, quantity
 
 RUN = ["--scheduler", "serial", "--backend", "package", "--no-plot", "--no-progress"]
 

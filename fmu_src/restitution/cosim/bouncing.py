@@ -28,6 +28,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..assumptions import warn_departures
+from ..flight import flight_to_plate
 from ..fmu.models.sphere_plate_impact.variables import TABLE
 
 __all__ = ["Bounces", "Trajectory", "bounce", "impact_sequence", "fmu_rebound", "package_rebound", "RECORDED", "STANDARD_GRAVITY"]
@@ -172,9 +173,7 @@ def impact_sequence(rebound, drop_height: float, gravity: float = STANDARD_GRAVI
     v_up = 0.0  # upward speed at the last impact (0: released from rest)
     h = drop_height
     for _ in range(max_bounces):
-        # h + v_up s - g s^2/2 = 0; this form avoids cancellation when v_up is large.
-        v_impact = math.sqrt(v_up * v_up + 2.0 * gravity * h)
-        flight = (v_up + v_impact) / gravity
+        flight, v_impact = flight_to_plate(h, v_up, gravity)
         if advance is not None:
             advance(t + t_err, flight)
         total = t + flight

@@ -19,6 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..flight import flight_to_plate
 from ..model import DOMAIN, PARAMETERS, impact
 
 __all__ = ["G_STANDARD", "PARAMETER_NAMES", "KEYS", "UNITS", "FIT_OPTIONS", "check_base", "check_names",
@@ -165,7 +166,7 @@ def bounce_train(v1, n: int, params: dict, *, g: float = G_STANDARD, t1=0.0,
         v = np.maximum(result.e, 0.0) * v if batch else max(result.e, 0.0) * v
     speeds, es, lams, vstars = (np.stack(np.broadcast_arrays(*x), axis=-1) if batch else np.array(x)
                                 for x in (speeds, es, lams, vstars))
-    flights = (2.0 / g) * speeds[..., 1:]
+    flights = flight_to_plate(0.0, speeds[..., 1:], g)[0]
     times = np.concatenate([np.zeros(speeds.shape[:-1] + (1,)), np.cumsum(flights, axis=-1)], axis=-1)
     times = times + np.asarray(t1, dtype=float)[..., None] if np.ndim(t1) else times + float(t1)
     return BounceTrain(times=times, speeds=speeds, e=es, lam=lams, V_star=vstars)

@@ -13,12 +13,12 @@ from .forward import KEYS, bounce_train, restitution_at
 
 __all__ = ["table", "write_json", "plot", "band_params", "bound_words"]
 
-#: SI unit -> the kind of quantity restitution.scene.units formats (MPa, GPa, mm, ...).
+#: SI unit -> the kind of quantity restitution.units formats (MPa, GPa, mm, ...).
 _KINDS = {"Pa": "pressure", "m": "length", "kg/m3": "density"}
 
 
 def _value(value: float, unit: str) -> str:
-    from ..scene.units import format_quantity
+    from ..units import format_quantity
 
     if unit in _KINDS and value > 0:
         return format_quantity(float(f"{value:.5g}"), _KINDS[unit])

@@ -1,29 +1,11 @@
 """Why a scene run left effects out: computed host side from the impact speeds and the package
-(the FMU is asked for nothing more); and what e < 0 and ``valid`` false mean, in the words a scene's
-summary and a sweep's statistics give beside their counts."""
+(the FMU is asked for nothing more)."""
 from __future__ import annotations
 
 import numpy as np
 
-from ..assumptions import E_NEGATIVE_MEANING
 from ..model import ZENER_SLOPE_BOUND, impact
 from .loader import Drop
-
-
-
-
-def meaning_lines(n_negative: int | None, n_invalid: int, of: int, what: str = "impacts",
-                  zero_negative: bool = True) -> list[str]:
-    """Lines saying how many of ``of`` cases have e < 0 (``e_negative``; None: not known, no line; 0: a
-    line only with ``zero_negative``) and how many lie outside the validated ranges (``valid`` false),
-    each with what it means where there are any."""
-    lines = []
-    if n_negative is not None and (n_negative or zero_negative):
-        lines.append(f"e < 0 (e_negative): {n_negative:,} of {of:,} {what}"
-                     + (f": {E_NEGATIVE_MEANING}" if n_negative else ""))
-    lines.append(f"valid = false (outside the models' validated ranges, lambda <= 1.5 and V* <= 1000): "
-                 f"{n_invalid:,} of {of:,} {what}" + ("; their e is an extrapolation" if n_invalid else ""))
-    return lines
 
 
 def critical_velocity_of(drop: Drop) -> float:

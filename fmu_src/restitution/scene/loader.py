@@ -62,11 +62,11 @@ from pathlib import Path
 
 import tomllib  # Python >= 3.11
 
-from ..domain import TYPICAL, slipped_prefix
+from ..domain import TYPICAL, outside_text, slipped_prefix
 from ..materials import BRITTLE_SY, MATERIALS, TABLE4_CASES, Material, suggest_material, table4_case
 from ..model import DOMAIN, EFFECT_MODES, RESTITUTION_MODELS
 from ..zener import ZENER_METHODS
-from .units import QUANTITIES, UnitError, parse_quantity, split_quantity
+from ..units import QUANTITIES, UnitError, parse_quantity, split_quantity
 
 __all__ = ["SceneError", "Scene", "BallSpec", "PlateSpec", "ModelSpec", "SimulationSpec", "Drop",
            "OUTPUTS", "MASTERS", "load_scene", "parse_scene", "resolve_material"]
@@ -233,13 +233,11 @@ def _quantity(ctx, table, where, key, kind, *, positive=True, default=None, doma
         raise ctx.error(full, f"{table[key]!r} must be > 0")
     if domain is not None and not domain[0] <= value <= domain[1]:
         unit = QUANTITIES[kind]
-        message = (f"{table[key]!r} is outside the range the FMU accepts: "
-                   f"{domain[0]:g} {unit} <= value <= {domain[1]:g} {unit}")
         hint = None
         if not isinstance(table[key], str) or _unit_free(table[key]):  # a bare number: SI, maybe a slip
             typical = TYPICAL.get(_TYPICAL_KEY.get(key, key), math.sqrt(domain[0] * domain[1]))
             hint = slipped_prefix(value, unit, lambda x: domain[0] <= x <= domain[1], typical)
-        raise ctx.error(full, f"{message}: did you mean {hint}?" if hint else message)
+        raise ctx.error(full, outside_text(key, value, unit, f"{domain[0]:g} <= value <= {domain[1]:g}", hint))
     return value
 
 

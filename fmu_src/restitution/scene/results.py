@@ -13,7 +13,8 @@ import numpy as np
 from ..cosim.bouncing import Trajectory
 from ..fmu.models.sphere_plate_impact.variables import TABLE
 from ..output_files import GrowingOutput, atomic_write
-from .explain import explain, meaning_lines
+from ..assumptions import meaning_lines
+from .explain import explain
 from .loader import MAX_BOUNCES, Drop, Scene
 
 __all__ = ["DropResult", "SceneResult", "DropWriter", "COLUMNS", "READ_OUTPUTS", "VALIDITY", "apex_heights"]

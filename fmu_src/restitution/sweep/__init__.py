@@ -12,7 +12,8 @@ from .backends import Backend, FmuBackend, PackageBackend, code_fingerprint, get
 from .cluster import machine_workers, open_client
 from .compare import compare_results
 from .run import run_sweep
-from .table import COLUMNS, SweepResult, read_table
+from .result import SweepResult
+from .table import COLUMNS, read_table
 from .spec import CODES, INPUTS, OUTPUTS, SweepSpec, canonical_name, load_spec, resolve_pair
 
 __all__ = ["SweepSpec", "run_sweep", "SweepResult", "open_client", "machine_workers", "compare_results",

@@ -4,19 +4,20 @@ from __future__ import annotations
 
 import argparse
 import contextlib
-import os
 import sys
 import time
+from dataclasses import dataclass
 from pathlib import Path
 
-from ..extras import MissingExtra, require
+from ..extras import MissingExtra
 from ..materials_table import text as materials_text
-from ..options import BARE_NUMBER_RULE, ArgumentParser, OptionError, add_material_options
-from ..output_files import (EXIT_IO_ERROR, EXIT_REFUSED, OutputPathError, OutputWriteError,
-                            check_output, check_outputs, describe_os_error)
+from ..inputs import QuantityError
+from ..options import BARE_NUMBER_RULE, ArgumentParser, add_material_options
+from ..output_files import EXIT_IO_ERROR, EXIT_REFUSED, OutputPathError, OutputWriteError, describe_os_error
+from ..units import OptionError
+from .outputs import SweepOutputs, check_sweep_outputs, resolve_outputs
 from .sobol import SOBOL_OUTPUTS, SobolCollector, SobolError, SobolSpec
 from .spec import CODES, INPUT_NAMES, INPUTS, MAX_SAMPLES, MAX_SEED, T_OVER_D, SweepSpec, canonical_name, load_spec
-from .values import QuantityError
 
 #: The command's name in its usage line and its errors, however it was started.
 PROG = "restitution sweep"
@@ -174,7 +175,8 @@ def build_spec(args) -> tuple[SweepSpec, dict]:
 def _material_values(args) -> dict:
     """The fixed values (SI, by FMU name) of --sphere/--plate, --ROLE-material and --ROLE-E ...: a
     material's four properties; refused with --pair, which names both materials."""
-    from ..options import MATERIAL_PROPERTIES, material_from_args
+    from ..inputs import MATERIAL_PROPERTIES
+    from ..options import material_from_args
 
     out = {}
     for role in ("sphere", "plate"):
@@ -192,8 +194,8 @@ def _material_values(args) -> dict:
 
 def _check_set_lengths(args) -> None:
     """A bare-number sphere.d or plate.t of --set that is a likely slip refused
-    (:func:`restitution.options.check_plausible_lengths`) unless --allow-implausible."""
-    from ..options import check_plausible_lengths, input_reading
+    (:func:`restitution.inputs.check_plausible_lengths`) unless --allow-implausible."""
+    from ..inputs import check_plausible_lengths, input_reading
 
     readings = {}
     for item in args.set or []:
@@ -311,9 +313,22 @@ def _ignore_further_interrupts() -> None:
     atexit.register(signal.signal, signal.SIGINT, signal.SIG_IGN)
 
 
-def _main(parser, args) -> int:
-    from .size import plan_size, table_bytes
-    from .spec import SizeError
+@dataclass
+class _Settings:
+    """What the options and the spec file's [run] table ask of a sweep, besides its files."""
+    spec: SweepSpec
+    run: dict
+    backend: str
+    scheduler: str | None
+    workers: int | None
+    chunk: int | None
+    fmu: str | None
+    columns: list | None
+
+
+def _settings(parser, args) -> _Settings | int:
+    """The spec and the run's settings from the options and the spec file (the options win); an exit
+    status for a refused value."""
     from .table import keep_columns
 
     try:
@@ -327,11 +342,6 @@ def _main(parser, args) -> int:
     backend = args.backend or run.get("backend", "package")
     if backend not in ("package", "fmu", "both"):
         parser.error(f"[run] backend = {backend!r}: use 'package', 'fmu' or 'both'")
-    scheduler = args.scheduler or run.get("scheduler")
-    workers = args.workers if args.workers is not None else run_ints.get("workers")
-    chunk = args.chunk_size if args.chunk_size is not None else run_ints.get("chunk_size")
-    fmu = args.fmu or run.get("fmu")
-    out = args.out or run.get("out")
     columns = args.columns or run.get("columns")
     if isinstance(columns, str):
         columns = [c.strip() for c in columns.split(",") if c.strip()]
@@ -345,62 +355,57 @@ def _main(parser, args) -> int:
         missing = [c for c in ("ok", *INPUT_NAMES) if c not in columns]
         if missing:  # checked before the run, not after it
             parser.error(f"--backend both compares every case from its inputs: --columns must keep {', '.join(missing)}")
-    if out is None:
-        try:
-            import pyarrow  # noqa: F401
-            out = "sweep.parquet"
-        except ModuleNotFoundError:
-            out = "sweep.csv"
-    out = Path(out)
-    plot_wanted = not (args.no_plot or run.get("plot") is False)
-    try:  # before any work: one line naming the extra, not a traceback after the cluster started
-        require("restitution sweep", {"distributed": "sweep", **({"fmpy": "fmu"} if backend != "package" else {}),
-                                      **({"matplotlib": "examples"} if plot_wanted else {}),
-                                      **({"pyarrow": "parquet"} if out.suffix.lower() == ".parquet" else {})})
-    except MissingExtra as exc:
-        hint = "; or --no-plot" if plot_wanted and "matplotlib" in str(exc) else ""
-        return _error(f"{exc}{hint}", EXIT_REFUSED)
-    if out.name in ("", ".."):  # ".", "/", "..": no file name to write (nor to derive the map's from)
-        return _error(f"--out {out}: is a directory, not a regular file; give the name of a file to write "
-                      f"(.csv or .parquet)", EXIT_REFUSED)
-    from .plot import plot_kind
+    return _Settings(spec, run, backend, args.scheduler or run.get("scheduler"),
+                     args.workers if args.workers is not None else run_ints.get("workers"),
+                     args.chunk_size if args.chunk_size is not None else run_ints.get("chunk_size"),
+                     args.fmu or run.get("fmu"), columns)
 
-    plot_suffix, plot_name = plot_kind(spec)  # a histogram of e, or a COR map
-    plot = None if (args.no_plot or run.get("plot") is False) else Path(
-        args.plot or run.get("plot") or out.with_name(out.stem + plot_suffix))
-    sobol_chart = out.with_name(out.stem + "_sobol.png") if args.sobol and plot is not None else None
-    parts = out.with_name(out.name + ".parts")
-    summary = args.summary or run.get("summary")
+
+def _main(parser, args) -> int:
+    from .size import plan_size, table_bytes
+    from .spec import SizeError
+
+    settings = _settings(parser, args)
+    if isinstance(settings, int):
+        return settings
+    spec, run, backend = settings.spec, settings.run, settings.backend
+    no_plot = args.no_plot or run.get("plot") is False
+    try:  # before any work: one line naming the extra, not a traceback after the cluster started
+        outputs = resolve_outputs(spec, args.out or run.get("out"), args.plot or run.get("plot"),
+                                  args.summary or run.get("summary"), no_plot, args.sobol, backend)
+    except MissingExtra as exc:
+        hint = "; or --no-plot" if not no_plot and "matplotlib" in str(exc) else ""
+        return _error(f"{exc}{hint}", EXIT_REFUSED)
+    except OutputPathError as exc:
+        return _error(str(exc), EXIT_REFUSED)
     print(f"sweep: {spec.describe()}")
 
     n_backends = 2 if backend == "both" else 1
     try:  # the size guard, from the axis sizes alone
         spec.check_axes()
-        plan = plan_size(spec, columns, args.memory_budget, backends=n_backends, out=out, parts=parts)
+        plan = plan_size(spec, settings.columns, args.memory_budget, backends=n_backends, out=outputs.out,
+                         parts=outputs.parts)
     except SizeError as exc:
         if args.dry_run:
             print(f"sweep: refused: {exc}")
             return 0
         parser.error(str(exc))
     if args.dry_run:
-        print(f"sweep: {plan.describe()} ({table_bytes(1, columns) * n_backends} bytes a case)")
+        print(f"sweep: {plan.describe()} ({table_bytes(1, settings.columns) * n_backends} bytes a case)")
         return 0
     try:
-        check_output(out)
-        for where in (parts, *(parts / name for name in ("package", "fmu"))):
-            if os.path.lexists(where) and not where.is_dir():
-                raise OutputPathError(f"--out {out}: {where} (where finished chunks go) exists and is not a directory")
-        if plot is not None and not plan.stream:
-            check_output(plot, "--plot")
-        if sobol_chart is not None:
-            check_output(sobol_chart, "the Sobol' chart")
-        if summary is not None:
-            check_output(summary, "--summary")
-        # no output over an input (the FMU, the spec file) or over another output, links and hard links included
-        check_outputs({"--out": out, "--plot": plot if not plan.stream else None, "the Sobol' chart": sobol_chart,
-                       "--summary": summary}, {"--fmu": fmu, "SPEC": args.spec})
+        check_sweep_outputs(outputs, plan.stream, {"--fmu": settings.fmu, "SPEC": args.spec})
     except OutputPathError as exc:
         return _error(str(exc), EXIT_REFUSED)
+    settings.fmu = _impact_fmu(parser, backend, settings.fmu)
+    if plan.stream:
+        print(f"sweep: {plan.describe()}", file=sys.stderr)
+    return _run_and_write(parser, args, settings, outputs, plan)
+
+
+def _impact_fmu(parser, backend: str, fmu):
+    """The FMU the fmu back end runs: ``fmu`` checked, or the default one (built when missing); None for
+    the package back end."""
     try:
         if backend in ("fmu", "both") and fmu is not None:
             from ..cosim.fmu import check_impact_fmu
@@ -414,42 +419,47 @@ def _main(parser, args) -> int:
             fmu = default_fmu(log=print)
         except BuildError as exc:
             parser.error(str(exc))
+    return fmu
 
+
+def _run_and_write(parser, args, settings: _Settings, outputs: SweepOutputs, plan) -> int:
+    """Run the sweep on each back end, then write its table and report (statistics, Sobol' indices, the
+    summary, the plot); the exit status."""
     from .cluster import open_client
     from .parts import PartError, ResumeError
     from .run import SweepInterrupted, run_sweep
-    from .statistics import SweepStatistics, write_summary
+    from .statistics import SweepStatistics
+    from .table import keep_columns
 
-    if plan.stream:
-        print(f"sweep: {plan.describe()}", file=sys.stderr)
-    progress = not args.no_progress
-    status = 0
+    spec, backend, columns, parts, out = settings.spec, settings.backend, settings.columns, outputs.parts, outputs.out
+    scheduler = settings.scheduler
     backends = ("package", "fmu") if backend == "both" else (backend,)
     if args.resume and not all((parts / name / "manifest.json").is_file() for name in backends):
         print(f"--resume: no finished chunks in {parts}: the whole sweep runs", file=sys.stderr)
     results = {}
     # gathered from the chunks as they come (and from the kept parts on --resume) of the written table's back end
-    statistics = SweepStatistics(spec, keep_columns(columns)) if spec.random or summary else None
+    statistics = SweepStatistics(spec, keep_columns(columns)) if spec.random or outputs.summary else None
     sobol = SobolCollector(spec) if args.sobol else None
     chosen = None
     if scheduler is None:  # neither --scheduler nor $DASK_SCHEDULER_ADDRESS: a cluster only where it can pay
         from .cluster import serial_reason
-        chosen = serial_reason(spec, backends, workers)
+        chosen = serial_reason(spec, backends, settings.workers)
         scheduler = "serial" if chosen else None
     try:
         with contextlib.ExitStack() as stack:
             target = "serial"
             if scheduler != "serial":
                 try:
-                    target = stack.enter_context(open_client(scheduler, workers))
+                    target = stack.enter_context(open_client(scheduler, settings.workers))
                 except OSError as exc:  # an address nothing answers at (Dask waits its connect timeout)
                     parser.error(f"--scheduler {scheduler}: cannot connect: {exc}")
             # the columns stay in memory only for what reads them here: the plot, the comparison of
             # two back ends; the table itself is joined from the parts, and the statistics come chunk by chunk
-            in_memory = not plan.stream and (plot is not None or backend == "both")
+            in_memory = not plan.stream and (outputs.plot is not None or backend == "both")
             for name in backends:
-                res = run_sweep(spec, name, fmu=fmu, scheduler=target, chunk_size=chunk, progress=progress,
-                                columns=columns, parts=parts / name, resume=args.resume, in_memory=in_memory,
+                res = run_sweep(spec, name, fmu=settings.fmu, scheduler=target, chunk_size=settings.chunk,
+                                progress=not args.no_progress, columns=columns, parts=parts / name,
+                                resume=args.resume, in_memory=in_memory,
                                 on_chunk=_hooks(statistics, sobol) if name == backends[0] else None)
                 if chosen:
                     res.scheduler = f"this process ({chosen})"
@@ -476,6 +486,19 @@ def _main(parser, args) -> int:
     except OutputWriteError as exc:  # a part or the manifest: the chunks written before it stay
         return _error(f"{exc}; {_kept(parts)}: run the same command with --resume once it can be written",
                       EXIT_IO_ERROR)
+    return _write_and_report(spec, results, backends, backend, outputs, plan, statistics, sobol)
+
+
+def _write_and_report(spec, results: dict, backends: tuple, backend: str, outputs: SweepOutputs, plan, statistics,
+                      sobol) -> int:
+    """Compare two back ends' results, write the table, print the statistics and the Sobol' indices, write
+    the summary and the plot; the exit status."""
+    from .parts import PartError
+    from .statistics import write_summary
+
+    out, parts, plot, summary, sobol_chart = (outputs.out, outputs.parts, outputs.plot, outputs.summary,
+                                              outputs.sobol_chart)
+    status = 0
     if backend == "both":
         from .compare import agreement_report
 
@@ -530,7 +553,7 @@ def _main(parser, args) -> int:
                           EXIT_REFUSED if isinstance(exc, OutputPathError) else EXIT_IO_ERROR)
     if plot is None:
         return status
-    return _draw(result, plot, plot_name, out, statistics, streamed=plan.stream) or status
+    return _draw(result, plot, outputs.plot_name, out, statistics, streamed=plan.stream) or status
 
 
 def _draw(result, plot: Path, name: str, out: Path, statistics, streamed: bool) -> int:

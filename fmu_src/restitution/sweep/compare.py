@@ -15,7 +15,7 @@ import numpy as np
 from ..agreement import disagreements, tolerances
 from .backends import impact_groups
 from .spec import OUTPUT_NAMES, OUTPUTS
-from .table import SweepResult
+from .result import SweepResult
 
 __all__ = ["agreement_report", "compare_results"]
 

@@ -1,5 +1,6 @@
 """Finished chunks on disk: the part store a sweep writes each chunk to as it completes (and resumes
-from), and the result whose table stays there.
+from), and writing a table from them (the result whose table stays there is
+:class:`restitution.sweep.result.DiskSweepResult`).
 
 Every finished chunk is one Parquet file, ``chunk-<start>-<stop>.parquet``: the chunk's columns as
 one row group, encoded once, when the chunk finishes. Its footer carries a record of what it is (key
@@ -33,17 +34,16 @@ import stat
 import struct
 import sys
 import zlib
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from ..output_files import OutputWriteError, atomic_write, file_kind, os_reason
 from .parquet_join import MAGIC
-from .table import (COLUMNS, VALIDITY, SweepResult, assemble, chunk_table, csv_header, parquet_options,
+from .table import (COLUMNS, VALIDITY, assemble, chunk_table, csv_header, parquet_options,
                     pair_codes, table_counts, write_csv_rows)
 
-__all__ = ["PartStore", "DiskSweepResult", "ResumeError", "PartError", "write_from_parts"]
+__all__ = ["PartStore", "ResumeError", "PartError", "write_from_parts"]
 
 #: A part file's name: its first case and one past its last, 15 digits each.
 PART_NAME = re.compile(r"chunk-(\d{15})-(\d{15})\.parquet")
@@ -346,40 +346,3 @@ def _check_record(file: Path, sweep) -> None:
         raise PartError(file, "holds other cases than its name says (parts swapped or renamed)")
     if record.get("sweep") != sweep:
         raise PartError(file, "belongs to another sweep")
-
-
-@dataclass
-class DiskSweepResult(SweepResult):
-    """A sweep whose table stays on disk, in its finished chunks (``run_sweep(..., in_memory=False)``):
-    the counts are known, :meth:`write` joins the table from the parts; ``columns`` is empty."""
-
-    def __len__(self):
-        return sum(c["cases"] for c in self.chunk_counts.values())
-
-    def __getitem__(self, name):
-        raise KeyError(f"{name!r}: this sweep's table is on disk ({self.parts}), not in memory; write() it")
-
-    def counts(self) -> dict:
-        total = {k: 0 for k in ("cases", "ok", "inside", *VALIDITY)}
-        for c in self.chunk_counts.values():
-            for k in total:
-                total[k] += c[k]
-        return total
-
-    def _write_to(self, path: Path, suffix: str) -> None:
-        write_from_parts(self, path, suffix)
-
-    def to_csv(self, path) -> Path:
-        self._write_to(Path(path), ".csv")
-        return Path(path)
-
-    def to_parquet(self, path) -> Path:
-        self._write_to(Path(path), ".parquet")
-        return Path(path)
-
-    def to_pandas(self):
-        raise RuntimeError(f"this sweep's table is on disk ({self.parts}), too big for memory; write() it")
-
-    def plot(self, path, **kwargs) -> Path:
-        raise RuntimeError("no COR map for a sweep streamed to disk: its table does not fit in memory "
-                           "(plot a smaller sweep, or from the written table)")

@@ -11,7 +11,7 @@ import numpy as np
 
 from ..output_files import atomic_write
 from .spec import T_OVER_D, pair_label
-from .values import unit_of
+from ..inputs import unit_of
 
 __all__ = ["plot_cor_map", "plot_random", "NoPlot", "plot_kind", "map_axes"]
 

@@ -40,10 +40,11 @@ import numpy as np
 from ..cosim.interrupt import DeferredInterrupt
 from .backends import Backend, FmuBackend, code_fingerprint, get_backend, release_fmus
 from .cluster import CASE_SECONDS, cost_class, count_workers, describe_client, open_client
-from .parts import DiskSweepResult, PartStore
+from .parts import PartStore
+from .result import DiskSweepResult, SweepResult
 from .size import check_case_numbers
 from .spec import SweepSpec
-from .table import PackedColumns, SweepResult, TableBuilder, keep_columns, table_counts
+from .table import PackedColumns, TableBuilder, keep_columns, table_counts
 
 __all__ = ["run_sweep", "SweepInterrupted"]
 

@@ -13,7 +13,7 @@ cut into chunks (they come in fixed blocks of :data:`RANDOM_BLOCK` cases, each s
 Names are the FMU's (``sphere.E``, ``plate.t``, ``v_approach``, ...); the package's
 keyword names (``sphere_E``, ``plate_t``, ``v``) are accepted too. ``t_over_d`` is a derived
 axis: ``plate.t = t_over_d * sphere.d``. Values take units (``"3mm"``, ``"114 GPa"``; a bare number
-is SI, :mod:`restitution.sweep.values`); :meth:`SweepSpec.check_domain` checks the explicit ones
+is SI, :mod:`restitution.inputs`); :meth:`SweepSpec.check_domain` checks the explicit ones
 against the inputs' declared ranges.
 """
 from __future__ import annotations
@@ -28,8 +28,9 @@ import numpy as np
 
 from ..fmu.models.sphere_plate_impact.variables import MATERIAL_SELECTORS, TABLE, fmu_values
 from ..materials import MATERIALS, TABLE4_CASES, table4_case
-from .values import (MAX_AXIS_VALUES, ROWS, QuantityError, axis_form, axis_size, draw_standard, from_standard,  # noqa: F401 (axis_size)
-                     outside, parse_distribution, parse_values, range_ends, range_size, range_values)
+from ..inputs import ROWS, QuantityError, outside
+from .values import (MAX_AXIS_VALUES, axis_form, axis_size, draw_standard, from_standard,  # noqa: F401 (axis_size)
+                     parse_distribution, parse_values, range_ends, range_size, range_values)
 
 __all__ = ["SweepSpec", "INPUTS", "OUTPUTS", "CODES", "RANDOM_BLOCK", "canonical_name", "load_spec",
            "parse_values", "parse_distribution", "resolve_pair", "SizeError", "QuantityError"]

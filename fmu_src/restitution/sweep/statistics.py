@@ -19,15 +19,14 @@ import math
 
 import numpy as np
 
-from ..assumptions import E_NEGATIVE_MEANING
+from ..assumptions import E_NEGATIVE_MEANING, meaning_lines
 from ..fmu.models.sphere_plate_impact.variables import TABLE
 from ..output_files import write_json
-from ..scene.explain import meaning_lines
 from .order_statistics import Scratch, moments_and_order_statistics, order_statistics
 from .student_t import t975
 from .spec import OUTPUTS, T_OVER_D, pair_label
 from .table import VALIDITY, table_counts
-from .values import unit_of
+from ..inputs import unit_of
 
 __all__ = ["SweepStatistics", "UNITS", "MAIN_OUTPUTS", "PERCENTILES", "describe", "write_summary"]
 

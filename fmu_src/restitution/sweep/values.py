@@ -1,11 +1,9 @@
-"""The values a sweep is given: numbers with units, value lists, ranges and distributions, and the
-range each input declares.
+"""The values a sweep is given: value lists, ranges (grids) and distributions.
 
-A quantity is a number with an optional unit: ``"3mm"``, ``"3 mm"``, ``"6.35e-3 m"``, ``"114GPa"``,
-``"1/4 in"``; a bare number is SI (``"0.003"`` for ``plate.t`` is 3 mm). Units are read by the
-scene's parser (:mod:`restitution.scene.units`: pint, any unit of the right kind); a unit of another
-kind is refused naming the input, the unit given and the kind expected. Dimensionless inputs
-(``sphere.nu``, tolerances, ``t_over_d``) and relative spreads take plain numbers.
+Each value is read as every front end reads an input's value (:mod:`restitution.inputs`): a number with
+an optional unit (``"3mm"``, ``"114GPa"``, ``"1/4 in"``; a bare number is SI), a unit of another kind
+refused naming the input. Dimensionless inputs (``sphere.nu``, tolerances, ``t_over_d``) and relative
+spreads take plain numbers.
 
 Values are the decimals they were given as, where a computation would leave them an ulp away
 (:func:`decimal_like`): a unit's conversion (``4.5mm`` is 0.0045, not 0.0045000000000000005), and the
@@ -13,10 +11,6 @@ points of a ``linspace`` or ``arange`` whose ends and step are short decimals (`
 gives 0.3, not numpy's 0.30000000000000004: each point is the double nearest its exact decimal
 value); a ``geomspace`` or ``logspace`` point within two ulps of a decimal of 12 significant digits is
 that decimal's double (``geomspace:2:32:5`` gives 8, not 7.999999999999999).
-
-An explicit value outside the input's declared range (the interface table's interval, the FMUs'
-``min``/``max``, :data:`restitution.domain.DOMAIN`) is refused by :func:`outside`, with a hint where a
-slipped SI prefix explains it (``plate.E = 114 Pa ... did you mean 114 GPa?``).
 """
 from __future__ import annotations
 
@@ -25,105 +19,11 @@ from decimal import Decimal
 
 import numpy as np
 
-from ..domain import number_text, slipped_prefix
-from ..fmu.models.sphere_plate_impact.variables import TABLE
-from ..scene.units import EXAMPLES, QUANTITIES, UnitError, convert_quantity, split_quantity
+from .._num import DECIMAL_BLOCK, POW10, decimal_like
+from ..inputs import ROWS, QuantityError, quantities
 
-__all__ = ["QuantityError", "quantity", "quantities", "unit_of", "outside", "parse_values", "parse_distribution",
-           "axis_size", "axis_form", "range_size", "range_values", "range_ends", "draw_standard", "from_standard", "MAX_AXIS_VALUES",
-           "DISTRIBUTIONS", "decimal_like"]
-
-#: FMU name -> row of the interface table, for every input and parameter.
-ROWS = {v.name: v for v in TABLE.settable}
-#: SI unit (as the interface table writes it) -> the kind of quantity the scene's parser converts to.
-KINDS = {si: kind for kind, si in QUANTITIES.items()}
-
-
-class QuantityError(ValueError):
-    """A value the sweep refuses: not a number, a unit it cannot take, or outside the input's declared
-    range. ``name`` is the input, ``section`` where the value was given ("grid", "random", "fixed";
-    set by :class:`~restitution.sweep.SweepSpec`), for the command line to name the option."""
-
-    def __init__(self, message: str, name: str, section: str | None = None):
-        super().__init__(message)
-        self.name, self.section = name, section
-
-
-def unit_of(name: str) -> str | None:
-    """The SI unit of input ``name`` (``"m"``, ``"Pa"``, ``"kg/m3"``, ``"m/s"``); None where it is
-    dimensionless or a code (no unit is taken)."""
-    row = ROWS.get(name)
-    return row.unit if row is not None and row.unit in KINDS else None
-
-
-def _read(name: str, value) -> tuple[float, bool]:
-    """(SI value, whether a unit was given) of one value."""
-    if not isinstance(value, str):
-        try:
-            return float(value), False
-        except (TypeError, ValueError):
-            raise QuantityError(f"{name} = {value!r} is not a number", name) from None
-    si = unit_of(name)
-    parsed = split_quantity(value, fractions=True)
-    if parsed is None:
-        example = f" with an optional unit ({EXAMPLES[KINDS[si]]}; a bare number is in {si})" if si else ""
-        raise QuantityError(f"{name} = {value!r} is not a number{example}", name)
-    number, unit = parsed
-    if unit is None:
-        return number, False
-    if si is None:
-        raise QuantityError(f"{name} = {value!r}: {name} is dimensionless: give a plain number, no unit", name)
-    try:  # the unit's factor may leave the product an ulp off the decimal it is (4.5 x 0.001)
-        return float(decimal_like(convert_quantity(name, value.strip(), number, unit, KINDS[si]))), True
-    except UnitError as exc:
-        raise QuantityError(f"{name} = {exc}", name) from None
-
-
-def quantity(name: str, value) -> float:
-    """SI value of ``value`` for input ``name``: a number (SI), or text ``"<number>[ <unit>]"``
-    (see the module docstring). :class:`QuantityError` (a ValueError) naming ``name`` otherwise."""
-    return _read(name, value)[0]
-
-
-def quantities(name: str, values, text=None) -> list[float]:
-    """SI values of ``values`` given together (a list, the ends of a range, a distribution's
-    parameters): either all with units or none (``"1,2,3mm"`` is refused, not read as 1 m, 2 m and
-    3 mm); a bare 0 goes with either. ``text`` is the whole value, for the message."""
-    read = [_read(name, v) for v in values]
-    with_unit = [v for v, (_, unit) in zip(values, read) if unit]
-    bare = [v for v, (si, unit) in zip(values, read) if not unit and si != 0]
-    if with_unit and bare:
-        shown = text if text is not None else list(values)
-        raise QuantityError(f"{name} = {shown!r}: give every value its unit or none ({bare[0]!r} has none and "
-                            f"would be {bare[0]} {unit_of(name)}, {with_unit[0]!r} has one)", name)
-    return [si for si, _ in read]
-
-
-def _hint(name: str, value: float) -> str | None:
-    """``"114 GPa"`` where ``value`` (SI, outside the range) lands in it with a slipped SI prefix
-    (:func:`restitution.domain.slipped_prefix`, nearest the input's start value); None where none does."""
-    row = ROWS[name]
-    return slipped_prefix(value, unit_of(name), row.accepts, float(row.start))
-
-
-def outside(name: str, value: float) -> str | None:
-    """The message refusing ``value`` (SI) for input ``name`` when it lies outside the input's declared
-    range (``v_approach = -1 m/s is outside 0 <= value <= 10000 m/s``, with ``: did you mean 114 GPa?``
-    where a slipped prefix explains it); None when it lies inside, or ``name`` is a code (checked when
-    read) or not an input."""
-    row = ROWS.get(name)
-    if row is None or row.interval is None or row.choices is not None:
-        return None
-    try:
-        if row.accepts(value):
-            return None
-    except (ValueError, OverflowError):
-        pass
-    unit = unit_of(name)
-    suffix = f" {unit}" if unit else ""
-    message = f"{name} = {number_text(value)}{suffix} is outside {row.allowed_text()}{suffix}"
-    hint = _hint(name, value) if unit and math.isfinite(value) else None
-    return f"{message}: did you mean {hint}?" if hint else message
+__all__ = ["parse_values", "parse_distribution", "axis_size", "axis_form", "range_size", "range_values",
+           "range_ends", "draw_standard", "from_standard", "MAX_AXIS_VALUES", "DISTRIBUTIONS"]
 
 
 # --- value lists, ranges and distributions --------------------------------------------------
@@ -233,41 +133,6 @@ def range_size(name: str, kind: str, args: list) -> int:
     return int(args[2])
 
 
-#: A computed value within SNAP_ULPS ulps of a decimal of SNAP_DIGITS significant digits is that decimal's
-#: double (an ulp taken as 2**-52 of the value: at the foot of a binade, up to twice as many).
-SNAP_DIGITS = 12
-SNAP_ULPS = 2
-_SNAP_REL = SNAP_ULPS * 2.0**-52
-#: 10**k for k = 0 ... 22, each exact as a double.
-_POW10 = np.array([float(10**k) for k in range(23)])
-#: For k = -22 ... 22 (index k + 22), a decimal with k places is digits * _MUL / _DIV, one exact factor 1.
-_MUL = np.concatenate([_POW10[:0:-1], np.ones(23)])
-_DIV = np.concatenate([np.ones(22), _POW10])
-#: Values handled at a time (bounds the temporaries of an axis of 10^8 values, and keeps them in cache).
-_BLOCK = 1 << 16
-
-
-def decimal_like(values) -> np.ndarray:
-    """``values`` with each one that lies within :data:`SNAP_ULPS` ulps of a decimal of
-    :data:`SNAP_DIGITS` significant digits replaced by the double nearest that decimal (the others,
-    zeros and non-finite values as they are): the rounding of a computation, an ulp or two, taken off a
-    value that is a short decimal (7.999999999999999 is 8, 0.0045000000000000005 is 0.0045)."""
-    x = np.array(values, dtype=float, ndmin=1)
-    for lo in range(0, x.size, _BLOCK):
-        block = x[lo:lo + _BLOCK]
-        with np.errstate(all="ignore"):
-            size = np.abs(block)
-            places = (SNAP_DIGITS - 1 + 22) - np.floor(np.log10(size))  # of a SNAP_DIGITS-digit decimal, + 22
-            fine = (places >= 0) & (places <= 44)  # False where NaN: zeros, non-finite values
-            k = np.where(fine, places, 22).astype(np.intp)
-            mul, div = _MUL[k], _DIV[k]
-            digits = np.rint(block * div / mul)  # an integer below 10^13: exact
-            near = digits * mul / div  # one correctly rounded operation (the other is by 1)
-            fine &= np.abs(near - block) <= _SNAP_REL * size
-        np.copyto(block, near, where=fine)
-    return x if np.ndim(values) else x[:1].reshape(())
-
-
 def _scaled(*numbers: float):
     """(the numbers as integers, k): each number's shortest decimal (its repr) times 10**k, k its most
     decimal places; None beyond k = 22 (10**k no longer exact as a double)."""
@@ -282,9 +147,9 @@ def _decimal_points(start: int, step: int, n: int, k: int) -> np.ndarray | None:
     if max(abs(start), abs(start + (n - 1) * step)) >= 2**53:
         return None
     out = np.empty(n)
-    for lo in range(0, n, _BLOCK):
-        ints = np.arange(lo, min(n, lo + _BLOCK), dtype=np.int64)
-        out[lo:lo + ints.size] = (ints * step + start).astype(np.float64) / _POW10[k]
+    for lo in range(0, n, DECIMAL_BLOCK):
+        ints = np.arange(lo, min(n, lo + DECIMAL_BLOCK), dtype=np.int64)
+        out[lo:lo + ints.size] = (ints * step + start).astype(np.float64) / POW10[k]
     return out
 
 

@@ -31,7 +31,7 @@ duration, tens of microseconds, is not spent), as in that master.
 Every ``do_step`` takes a bounded time, whatever the step and the parameters: in ``immediate``
 mode the bounces after the first rebound of a step all start at the plate with the same COR, so
 their impact times and speeds form a geometric series, and the step jumps to the last impact
-inside it in closed form (:func:`bounce_train`) instead of visiting each one (with e = 1 and a
+inside it in closed form (:func:`constant_e_bounces`) instead of visiting each one (with e = 1 and a
 flight shorter than the clock's resolution there would be no end to them). ``impacts`` saturates
 at ``MAX_IMPACTS``.
 
@@ -80,6 +80,8 @@ from restitution_slave_support import (checked_setter, restore_state, state_chec
 # the package this instance runs: the one the FMU ships, or a copy of the same code
 _restitution = _support.start(globals(), locals(), "BouncingBall", _resources)
 TABLE = _support.submodule(_restitution, "fmu.models.bouncing_ball.variables").TABLE
+#: the package's free flight under gravity (restitution.flight), shared with the host tools
+flight_to_plate = _support.submodule(_restitution, "flight").flight_to_plate
 
 #: A contact found within this time [s] after the end of a step still belongs to the step:
 #: a master that steps exactly to a reported contact time (t_impact) must see the contact
@@ -93,20 +95,7 @@ MAX_IMPACTS = 2**31 - 1
 #: clock to tell apart, the count is only a bound anyway).
 MAX_TRAIN = 1e18
 
-def flight_duration(h_start, v_start, g):
-    """Time [s] from the start of a free flight (height h_start [m], upward speed v_start [m/s],
-    gravity g [m/s2]) to its contact with the plate: the root of h_start + v_start s - g s^2/2 = 0,
-    as (v_start + v_hit)/g, the form without cancellation."""
-    return (v_start + math.sqrt(v_start * v_start + 2.0 * g * h_start)) / g
-
-
-def flight_end(t_start, h_start, v_start, g):
-    """Time [s] and approach speed [m/s] of the contact that ends a free flight started at t_start [s]."""
-    v_hit = math.sqrt(v_start * v_start + 2.0 * g * h_start)
-    return t_start + (v_start + v_hit) / g, v_hit
-
-
-def bounce_train(t0, u, e, g, v_min, limit):
+def constant_e_bounces(t0, u, e, g, v_min, limit):
     """The bounces of a ball that leaves the plate at t0 [s] with upward speed u > 0 [m/s] and
     rebounds every time with the same COR 0 < e <= 1 under gravity g [m/s2], until it would rebound
     slower than v_min [m/s]: (n, T_n [s], w_n [m/s]), the number of its impacts at or before `limit`
@@ -262,7 +251,7 @@ class BouncingBall(Fmi2Slave):
         else:
             g = float(self._values["g"])
             # within the flight: a flight shorter than the clock's resolution must not extrapolate past its end
-            dt = min(max(t - s["t_start"], 0.0), flight_duration(s["h_start"], s["v_start"], g))
+            dt = min(max(t - s["t_start"], 0.0), flight_to_plate(s["h_start"], s["v_start"], g)[0])
             s["h"] = max(s["h_start"] + s["v_start"] * dt - 0.5 * g * dt * dt, 0.0)
             s["v"] = s["v_start"] - g * dt
             s["v_approach"] = -s["v"] if -s["v"] > 0.0 else 0.0  # +0.0 at the apex, never -0.0
@@ -306,13 +295,14 @@ class BouncingBall(Fmi2Slave):
         if s["in_contact"]:  # the COR for the pending contact arrived at this communication point
             self._rebound(now)
         if not s["at_rest"]:
-            t_hit, v_hit = flight_end(s["t_start"], s["h_start"], s["v_start"], g)
+            duration, v_hit = flight_to_plate(s["h_start"], s["v_start"], g)
+            t_hit = s["t_start"] + duration
             if t_hit <= limit:  # (a NaN is no contact)
                 self._impact(t_hit, v_hit, 1)
                 if not wait:
                     self._rebound(t_hit)
                     if not s["at_rest"]:  # the rest of the step: flights from the plate, all with this e
-                        n, t_last, v_last = bounce_train(s["t_start"], s["v_start"], e, g, v_min, limit)
+                        n, t_last, v_last = constant_e_bounces(s["t_start"], s["v_start"], e, g, v_min, limit)
                         if n > 0:
                             self._impact(t_last, v_last, n)
                             self._rebound(t_last)

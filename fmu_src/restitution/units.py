@@ -1,12 +1,18 @@
-"""Quantities with explicit units for scene files: ``"3.18 mm"``, ``"69 GPa"``, ``"2700 kg/m3"``.
+"""Text with a unit to SI, by kind of quantity: ``"3.18 mm"``, ``"69 GPa"``, ``"2700 kg/m3"``, the one
+reader of every front end (the command lines' options, sweeps, scene files, the package's objects).
 
-A dimensional value in a scene is a string "<number> <unit>", or a bare number in SI units
+A dimensional value is a string "<number> <unit>", or a bare number in SI units
 (``thickness = 0.00318`` is 3.18 mm), as everywhere in the package. Dimensionless values (Poisson's
 ratio, tolerances) are plain numbers. Units are read by pint, so any unit of the right kind works
 (``"0.125 in"``, ``"1 ft"``, ``"2.7 g/cm3"``, ``"9.81 m/s2"``);
 a digit right after a unit's letters is its exponent (``m3`` is m**3). Everything is converted to SI
-on load. The sweep reads its values with the same parser (:func:`split_quantity`, :func:`convert_quantity`),
-where a bare number is SI and a fraction (``"1/4 in"``) is a number.
+on load. The command lines and the sweep read with the same parser (:func:`split_quantity`,
+:func:`convert_quantity`, :func:`read_quantity`), where a fraction (``"1/4 in"``) is a number too;
+:mod:`restitution.inputs` reads an FMU input's value by its name.
+
+A refused value is one line (:class:`OptionError`, what every reader of a user's value raises), the
+user's text echoed shortened to :data:`ECHO_CHARS` characters (:func:`echo`): a 100 000-character value
+is refused in one short line.
 """
 from __future__ import annotations
 
@@ -15,7 +21,60 @@ import re
 from functools import lru_cache
 
 __all__ = ["QUANTITIES", "EXAMPLES", "parse_quantity", "split_quantity", "convert_quantity", "UnitError",
-           "format_quantity"]
+           "format_quantity", "read_quantity", "python_quantity", "OptionError", "echo", "shorten_quoted",
+           "short_enough", "ECHO_CHARS", "MAX_VALUE_CHARS"]
+
+
+# --- a refused value, in one line ------------------------------------------------------------
+#: The most characters of a user's text a refusal echoes; longer text is cut, "..." and its length added.
+ECHO_CHARS = 60
+#: The longest value a quantity option takes ("6.35 mm" is 7): longer text is refused unparsed (the unit
+#: parser's time grows with the square of the length: 100 000 characters took minutes).
+MAX_VALUE_CHARS = 200
+#: A quoted run in a message: what the parsers echo of the user's text.
+_QUOTED = re.compile(r"'[^'\n]*'|\"[^\"\n]*\"")
+#: The end of a text :func:`echo` shortened.
+_ECHOED = re.compile(r"\.\.\. \(\d+ characters\)$")
+
+
+class OptionError(ValueError):
+    """A refused option value: the message is one line naming the option."""
+
+
+def echo(text) -> str:
+    """``text`` as a refusal shows it: whole up to :data:`ECHO_CHARS` characters, else its first
+    ECHO_CHARS characters, an ellipsis and its length (``'xxx...' (100000 characters)``), line breaks
+    and other control characters shown escaped so that the message stays one line."""
+    text = str(text)
+    shown = text if len(text) <= ECHO_CHARS else text[:ECHO_CHARS]
+    shown = repr(shown)[1:-1] if not shown.isprintable() else shown
+    return shown if len(text) <= ECHO_CHARS else f"{shown}... ({len(text)} characters)"
+
+
+def shorten_quoted(message: str, *texts) -> str:
+    """``message`` with every occurrence of each of ``texts`` (the user's values) and every quoted run
+    longer than :data:`ECHO_CHARS` shortened by :func:`echo`, on one line."""
+    for text in texts:
+        text = str(text)
+        if len(text) > ECHO_CHARS or not text.isprintable():
+            message = message.replace(repr(text), f"'{echo(text)}'").replace(text, echo(text))
+
+    def cut(match):
+        inner = match.group(0)[1:-1]
+        if len(inner) <= ECHO_CHARS or _ECHOED.search(inner):
+            return match.group(0)
+        return f"'{echo(inner)}'"
+
+    return " ".join(_QUOTED.sub(cut, message).split())
+
+
+def short_enough(option: str, text, label: str | None = None) -> str:
+    """``text`` as a string, OptionError if it is longer than :data:`MAX_VALUE_CHARS`."""
+    text = str(text)
+    if len(text) > MAX_VALUE_CHARS:
+        raise OptionError(f"{label or '--' + option} '{echo(text)}': too long for a value "
+                          f"(at most {MAX_VALUE_CHARS} characters)")
+    return text
 
 
 class UnitError(ValueError):
@@ -125,3 +184,37 @@ def format_quantity(value: float, kind: str) -> str:
     if kind == "pressure":
         return f"{value / 1e9:g} GPa" if value >= 1e9 else f"{value / 1e6:g} MPa"
     return f"{value:g} {QUANTITIES[kind]}"
+
+
+def read_quantity(label: str, text, unit: str, kind: str | None) -> float:
+    """The SI value of ``text``: a number (SI, ``unit``) or a number with any unit of ``kind`` ("length",
+    "pressure", "density", "speed", "acceleration"; None: a plain number, no unit). OptionError, one
+    line starting with ``label``, for anything else."""
+    text = short_enough("", text, label)
+    parsed = split_quantity(text, fractions=True)
+    if parsed is None:
+        raise OptionError(f"{label} = '{echo(text)}' is not a number with an optional unit (a bare number is "
+                          f"in {unit})" if kind else f"{label} = '{echo(text)}' is not a number")
+    number, given = parsed
+    if given is not None and kind is None:
+        raise OptionError(f"{label} = '{echo(text)}': a plain number (dimensionless), no unit")
+    try:
+        return number if given is None else convert_quantity(label.lstrip("-"), text.strip(), number, given, kind)
+    except UnitError as exc:
+        raise OptionError(shorten_quoted(f"{label} = {exc}", text, text.strip())) from None
+
+
+#: The kind of quantity of each SI unit the package's objects take (:mod:`restitution.quantities` spelling).
+_KIND_OF_UNIT = {"m": "length", "Pa": "pressure", "kg/m**3": "density", "kg/m3": "density", "m/s": "speed",
+                 "m/s**2": "acceleration", "dimensionless": None}
+
+
+def python_quantity(name: str, value, unit: str):
+    """``value`` unchanged unless it is a string; a string's SI value, read as the command lines read
+    a value (``"2 mm"``, ``"1/4 in"``, ``"115 GPa"``, ``"0.003"`` in SI; a plain number for a
+    dimensionless ``unit``): what :class:`~restitution.Sphere`, :class:`~restitution.Plate`,
+    :class:`~restitution.Material` and :func:`restitution.impact_between` take. OptionError (a
+    ValueError, one line naming ``name``) for text that is not one."""
+    if not isinstance(value, str):
+        return value
+    return read_quantity(name, value, unit.replace("**", ""), _KIND_OF_UNIT[unit])
