@@ -26,8 +26,8 @@ def build_toy_fmu(work: Path, module: str) -> Path:
     """The toy FMU with the project's guard in front of pythonfmu's binary, as every project FMU has (a
     plain pythonfmu 0.7 binary also frees its static PyState twice at process exit, which can abort the
     test process)."""
-    from restitution.fmu.builders.guard import make_standalone
+    from restitution.fmu.builders.guard import add_guard
 
     fmu = build_plain_toy(work, module)
-    make_standalone(fmu)
+    add_guard(fmu)
     return fmu

@@ -62,7 +62,7 @@ def build_fmus(work: Path) -> dict:
     from pythonfmu.builder import FmuBuilder
     from restitution.fmu.builders import FMUS, build_one
     from restitution.fmu.models import table
-    from restitution.fmu.builders.guard import make_standalone
+    from restitution.fmu.builders.guard import add_guard
 
     out = {"SpherePlateImpact": build_one("SpherePlateImpact", work)}
     if "BouncingBall" in FMUS:
@@ -80,7 +80,7 @@ def build_fmus(work: Path) -> dict:
         # The same guard as the project's pythonfmu FMU: a like-for-like floor (the guard's checks
         # and forwarding are part of every call), and the fix for pythonfmu 0.7's exit double-free,
         # which a plain pythonfmu binary would bring into this process.
-        make_standalone(out[name])
+        add_guard(out[name])
     out["counts"] = counts
     return out
 

@@ -55,7 +55,7 @@ def test_unknown_material_lists_the_names_and_suggests_the_closest():
 @pytest.fixture(scope="module")
 def built(tmp_path_factory):
     out = tmp_path_factory.mktemp("dist")
-    return out, fmu_build.build_one("SpherePlateImpact", out, standalone=False)
+    return out, fmu_build.build_one("SpherePlateImpact", out, guard=False)
 
 
 def test_built_fmu_is_readable_by_others_and_records_its_sources(built):
@@ -80,7 +80,7 @@ def test_a_failed_build_leaves_the_previous_fmu_untouched(built, monkeypatch):
     before = fmu.read_bytes()
     monkeypatch.setattr("fmpy.validation.validate_fmu", lambda path: ["injected validation problem"])
     with pytest.raises(fmu_build.BuildError, match="injected validation problem"):
-        fmu_build.build_one("SpherePlateImpact", out, standalone=False)
+        fmu_build.build_one("SpherePlateImpact", out, guard=False)
     assert fmu.read_bytes() == before
     assert sorted(p.name for p in out.iterdir()) == ["SpherePlateImpact.fmu"]  # no temporary left
 

@@ -169,7 +169,7 @@ def bouncing_ball_fmu(tmp_path_factory):
     """An FMU that is not a SpherePlateImpact FMU."""
     from restitution.fmu.builders import build_one
 
-    return build_one("BouncingBall", tmp_path_factory.mktemp("ball"), standalone=False)
+    return build_one("BouncingBall", tmp_path_factory.mktemp("ball"), guard=False)
 
 
 def test_cli_unreachable_scheduler_is_one_line_error(tmp_path):

@@ -56,7 +56,7 @@ def main(argv=None) -> int:
         return _installed(lambda: [print(f"copied {target}") for target in copy(args.out)])
     out = args.out if args.out is not None else default_fmu_dir()
     try:
-        for product in build_all(out, standalone=not args.python_hosts_only, log=stderr_line):
+        for product in build_all(out, guard=not args.python_hosts_only, log=stderr_line):
             checked = "fmpy validation: 0 problems" if product.suffix == ".fmu" else check_ssp(product)
             print(f"built {product} ({checked})")
     except (BuildError, ValueError) as exc:

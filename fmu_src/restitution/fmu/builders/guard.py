@@ -20,8 +20,8 @@ FMU rebuilds the guard and the configuration file.
 
 Usage::
 
-    from restitution.fmu.builders.guard import make_standalone
-    make_standalone(Path("build/Model.fmu"))            # this interpreter / venv
+    from restitution.fmu.builders.guard import add_guard
+    add_guard(Path("build/Model.fmu"))                  # this interpreter / venv
 
     python -m restitution.fmu.builders.guard build/Model.fmu \
         [--python /path/to/venv/bin/python] [--require numpy --require scipy]
@@ -56,11 +56,11 @@ GUARD_SOURCES = (*(p for p in front_files("2.0") if p.suffix == ".c"), GUARD / "
 CONFIG_NAME = "python_env.txt"  # must match PYLOADER_CONFIG_NAME in python_loader.c
 REAL_SUFFIX = "_pythonfmu"
 
-__all__ = ["make_standalone", "StandaloneError", "describe_interpreter"]
+__all__ = ["add_guard", "GuardError", "describe_interpreter"]
 
 
-class StandaloneError(RuntimeError):
-    """The FMU cannot be made standalone (missing compiler, static Python, ...)."""
+class GuardError(RuntimeError):
+    """The FMU cannot be given its guard (missing compiler, static Python, ...)."""
 
 
 # Runs inside the target interpreter: everything the guard needs to know about it.
@@ -124,7 +124,7 @@ def _model_identifier(model_description: bytes) -> str:
     root = ElementTree.fromstring(model_description)
     cs = root.find("CoSimulation")
     if cs is None:
-        raise StandaloneError("modelDescription.xml has no <CoSimulation> element")
+        raise GuardError("modelDescription.xml has no <CoSimulation> element")
     return cs.attrib["modelIdentifier"]
 
 
@@ -212,18 +212,18 @@ GUARD_CFLAGS = ("-std=gnu99", "-O2", "-Wall", "-Wextra", "-Werror", "-shared", "
 
 def guard_compiler() -> Compiler:
     """The compiler of the guard: x86_64-linux's (:func:`restitution.fmu.builders.toolchains.compiler`: zig for
-    the glibc 2.17 baseline, else gcc); StandaloneError where there is none."""
+    the glibc 2.17 baseline, else gcc); GuardError where there is none."""
     try:
         return toolchains.compiler("x86_64-linux")
     except toolchains.ToolchainMissing as exc:
-        raise StandaloneError(f"the FMU guard cannot be compiled: {exc}") from None
+        raise GuardError(f"the FMU guard cannot be compiled: {exc}") from None
 
 
 def _fmi2_headers() -> Path:
     try:
         return fmi_include_dir("2.0")
     except NativeBuildSkipped as exc:
-        raise StandaloneError(f"the FMU guard cannot be compiled: {exc}") from None
+        raise GuardError(f"the FMU guard cannot be compiled: {exc}") from None
 
 
 def guard_command(output: Path, generated: Path, real_name: str, compiler="gcc", include_dir: str = "",
@@ -260,10 +260,10 @@ def _compile_guard(output: Path, real_name: str, include_dir: str, compiler: Com
         cmd = guard_command(output, Path(tmp), real_name, compiler, include_dir, real_binary)
         proc = subprocess.run(cmd, capture_output=True, text=True, env=compiler.env)
     if proc.returncode != 0:
-        raise StandaloneError(f"compiling the FMU guard failed:\n{' '.join(cmd)}\n{proc.stderr}")
+        raise GuardError(f"compiling the FMU guard failed:\n{' '.join(cmd)}\n{proc.stderr}")
 
 
-def make_standalone(
+def add_guard(
     fmu_path: Path,
     python_executable: str = sys.executable,
     *,
@@ -285,16 +285,16 @@ def make_standalone(
     """
     fmu_path = Path(fmu_path)
     if not sys.platform.startswith("linux"):
-        raise StandaloneError("make_standalone builds a Linux x86_64 guard and must run on Linux")
+        raise GuardError("add_guard builds a Linux x86_64 guard and must run on Linux")
     if isinstance(compiler, str):
         if shutil.which(compiler) is None:
-            raise StandaloneError(f"C compiler '{compiler}' not found (install gcc)")
+            raise GuardError(f"C compiler '{compiler}' not found (install gcc)")
         compiler = Compiler(compiler, (compiler,), ())
     elif compiler is None:
         compiler = guard_compiler()
     missing = [str(p) for p in GUARD_SOURCES if not p.is_file()]
     if missing:
-        raise StandaloneError(f"guard sources missing: {', '.join(missing)}")
+        raise GuardError(f"guard sources missing: {', '.join(missing)}")
 
     with zipfile.ZipFile(fmu_path) as zin:
         entries = {i.filename: zin.read(i.filename) for i in zin.infolist()}
@@ -307,16 +307,16 @@ def make_standalone(
     elif guard_name in entries:
         real_binary = entries[guard_name]
     else:
-        raise StandaloneError(f"{fmu_path} has no {guard_name}")
+        raise GuardError(f"{fmu_path} has no {guard_name}")
     if b"Py_IsInitialized" not in real_binary:
-        raise StandaloneError(f"{guard_name} does not look like a pythonfmu binary")
+        raise GuardError(f"{guard_name} does not look like a pythonfmu binary")
 
     candidates = _detect_requirements(entries) if required_modules is None else set()
     info = describe_interpreter(python_executable, candidates)
     if not info["libpython"]:
-        raise StandaloneError(
+        raise GuardError(
             f"{python_executable} (Python {info['version']}) has no shared libpython "
-            f"(Py_ENABLE_SHARED={info['shared']}); a standalone FMU needs an interpreter built with "
+            f"(Py_ENABLE_SHARED={info['shared']}); a guarded FMU needs an interpreter built with "
             "--enable-shared (pyenv: PYTHON_CONFIGURE_OPTS=--enable-shared, Debian: libpython3.X package)"
         )
     if required_modules is None:
@@ -368,7 +368,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     parser.add_argument("--cc", default=None, help="C compiler command (default: zig for glibc 2.17, else gcc)")
     args = parser.parse_args(argv)
     for fmu in args.fmu:
-        make_standalone(fmu, args.python, required_modules=args.require, compiler=args.cc)
+        add_guard(fmu, args.python, required_modules=args.require, compiler=args.cc)
         print(f"{fmu}: guard added ({CONFIG_NAME} records {args.python})")
     return 0
 

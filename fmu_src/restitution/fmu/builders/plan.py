@@ -98,12 +98,12 @@ def model_plan(model: str = "SpherePlateImpact") -> list[Product]:
     return [Product(model)]
 
 
-def steps(plan, standalone: bool = True) -> list[Step]:
+def steps(plan, guard: bool = True) -> list[Step]:
     """Every (product, platform) of ``plan`` in build order, with the compiler that builds it here."""
     out = []
     for product in plan:
         if not product.native:
-            out.append(Step(product.name, ", ".join(PYTHONFMU_FOLDERS), "x86_64-linux", toolchain_label(standalone)))
+            out.append(Step(product.name, ", ".join(PYTHONFMU_FOLDERS), "x86_64-linux", toolchain_label(guard)))
             continue
         for folder in product.planned_folders():
             for target in toolchains.folders(product.fmi_version)[folder]:
@@ -170,7 +170,7 @@ def _headline(plan, out_dir) -> str:
     return f"{count} into {out_dir}: {'; '.join(parts)}"
 
 
-def run(plan, out_dir, standalone: bool = True, log=None, progress: Progress | None = None) -> list[Path]:
+def run(plan, out_dir, guard: bool = True, log=None, progress: Progress | None = None) -> list[Path]:
     """Build every product of ``plan`` into ``out_dir``, in order; returns the FMUs built. ``log``: every
     line (the progress and the warnings; default stderr, flushed). A native FMU that cannot be built here
     is skipped with a warning (the pythonfmu ones stay usable); a pythonfmu one that cannot be built
@@ -187,7 +187,7 @@ def run(plan, out_dir, standalone: bool = True, log=None, progress: Progress | N
     built = []
     for product in plan:
         if not product.native:
-            built.append(build_one(product.model, out_dir, standalone=standalone, log=say, progress=progress))
+            built.append(build_one(product.model, out_dir, guard=guard, log=say, progress=progress))
             continue
         begun = progress.clock()
         try:

@@ -26,14 +26,14 @@ __all__ = ["FMUS", "SCOPES", "BuildError", "build_all", "build_one", "default_fm
 SCOPES = ("all", "model")
 
 
-def build_all(out_dir: Path, standalone: bool = True, log=None) -> list[Path]:
+def build_all(out_dir: Path, guard: bool = True, log=None) -> list[Path]:
     """Build every FMU of the project into ``out_dir``: the pythonfmu ones, then the native ones into
     ``out_dir/fmi2`` and ``out_dir/fmi3``, every platform (:func:`~restitution.fmu.builders.plan.full_plan`),
     then the SSPs of the native ones into ``out_dir/ssp`` (:func:`restitution.fmu.ssp.write_ssps`).
     ``log``: the build's lines and warnings (default stderr). Returns the FMUs, then the SSPs."""
     from ..ssp import write_ssps
 
-    fmus = run(full_plan(), out_dir, standalone=standalone, log=log)
+    fmus = run(full_plan(), out_dir, guard=guard, log=log)
     return fmus + write_ssps(out_dir, log=log if log is not None else stderr_line)
 
 

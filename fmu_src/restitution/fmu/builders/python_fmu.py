@@ -12,7 +12,7 @@ the installed ``restitution`` package (the same source ``pip install`` installs)
 * ``resources/build_info.json`` records a hash of the sources it was built from, which
   :func:`restitution.fmu.builders.products.default_fmu` compares to decide whether an FMU is stale;
   ``documentation/`` gets the index page and the licenses;
-* the guard goes in front of pythonfmu's Linux binary (:func:`restitution.fmu.builders.guard.make_standalone`:
+* the guard goes in front of pythonfmu's Linux binary (:func:`restitution.fmu.builders.guard.add_guard`:
   the C FMI front checks every call against the FMI 2.0 state machine and the model's interface table,
   and the binary also loads in plain C hosts; needs gcc, without it the FMU is built for Python hosts
   only, unguarded, and the build says so);
@@ -90,7 +90,7 @@ def _guard_compiler_found() -> bool:
     return True
 
 
-def toolchain_label(standalone: bool = True) -> str:
+def toolchain_label(guard: bool = True) -> str:
     """What builds a pythonfmu FMU here, as the build's lines say it: pythonfmu and its version, and the
     compiler of the guard (zig for glibc 2.17, else gcc) or why there is none."""
     from importlib import metadata
@@ -99,7 +99,7 @@ def toolchain_label(standalone: bool = True) -> str:
         label = f"pythonfmu {metadata.version('pythonfmu')}"
     except metadata.PackageNotFoundError:
         label = "pythonfmu (not installed)"
-    if not standalone:
+    if not guard:
         return f"{label}, no guard"
     from .toolchains import ToolchainMissing, compiler, compiler_label
 
@@ -109,7 +109,7 @@ def toolchain_label(standalone: bool = True) -> str:
         return f"{label}, no guard (no gcc or zig)"
 
 
-def build_one(model: str, out_dir: Path, standalone: bool = True, log=None, progress=None) -> Path:
+def build_one(model: str, out_dir: Path, guard: bool = True, log=None, progress=None) -> Path:
     """Build, complete and validate ``out_dir/<model>.fmu``; return its path.
 
     The FMU is built and validated in a temporary directory inside ``out_dir`` and moved into
@@ -128,11 +128,11 @@ def build_one(model: str, out_dir: Path, standalone: bool = True, log=None, prog
     except ValueError as exc:
         raise BuildError(str(exc)) from None
     out_dir = writable_dir(out_dir)
-    with (progress or quiet()).step(f"{model}.fmu", ", ".join(PYTHONFMU_FOLDERS), toolchain_label(standalone)):
-        return _build(model, out_dir, standalone, log, FmuBuilder, validate_fmu)
+    with (progress or quiet()).step(f"{model}.fmu", ", ".join(PYTHONFMU_FOLDERS), toolchain_label(guard)):
+        return _build(model, out_dir, guard, log, FmuBuilder, validate_fmu)
 
 
-def _build(model: str, out_dir: Path, standalone: bool, log, FmuBuilder, validate_fmu) -> Path:
+def _build(model: str, out_dir: Path, guard: bool, log, FmuBuilder, validate_fmu) -> Path:
     """:func:`build_one`'s work, its checks done."""
     script = FMUS[model]
     with tempfile.TemporaryDirectory(prefix=f".{model}-build-", dir=out_dir) as tmp:
@@ -147,12 +147,12 @@ def _build(model: str, out_dir: Path, standalone: bool, log, FmuBuilder, validat
         info = json.dumps({"model": model, "source_hash": source_hash(model)}, indent=1)
         rewrite_zip(fmu, {"modelDescription.xml": fmi2.model_description(model, native=False).encode("utf-8"),
                           BUILD_INFO: info.encode("utf-8"), **documentation_files(model, "2.0")})
-        if standalone and not _guard_compiler_found():
+        if guard and not _guard_compiler_found():
             log(f"warning: neither zig nor gcc found: {model}.fmu is built for Python hosts only (fmpy, "
                 "libcosimpy), without the C guard that checks every FMI call; pip install ziglang")
-        elif standalone:
-            from .guard import make_standalone
-            make_standalone(fmu, interface_header=c_header(model))
+        elif guard:
+            from .guard import add_guard
+            add_guard(fmu, interface_header=c_header(model))
         problems = validate_fmu(str(fmu))
         if problems:
             raise BuildError(f"{model}.fmu failed fmpy validation: " + "; ".join(problems))

@@ -28,7 +28,7 @@ def variables(model: str) -> tuple[Variable, ...]:
 
 def variables_from_model_description(xml_text: str) -> list[Variable]:
     """The variables of any pythonfmu FMU, from its modelDescription.xml, for FMUs without a
-    interface table (a foreign or toy FMU given to ``make_standalone``). Read at build time only.
+    interface table (a foreign or toy FMU given to ``add_guard``). Read at build time only.
     Ranges are the declared min/max (closed), or any finite value; every input and parameter is
     part of the state, outputs and locals are not (pythonfmu cannot say which the model evolves)."""
     from xml.etree import ElementTree as ET
@@ -167,7 +167,7 @@ def c_header(model: str, rows: list[Variable] | None = None) -> str:
     ``RST_<MODEL>_VARIABLES`` and ``RST_MODEL_VARIABLES`` (the same table under a generic name, for the
     front's glue). ``rows`` defaults to the model's interface table, and then the header also names
     every value reference and code (:func:`_c_enums`); rows read from a foreign FMU's modelDescription
-    (``make_standalone``) give the table alone."""
+    (``add_guard``) give the table alone."""
     enums = rows is None
     rows = variables(model) if rows is None else rows
     if [v.vr for v in rows] != list(range(len(rows))):

@@ -32,7 +32,7 @@ VR_X, VR_Y = 0, 2  # x, gain, y, steps
 CLEAN_ENV = {"PATH": "/usr/bin:/bin"}
 
 
-def _load_make_standalone():
+def _load_add_guard():
     from restitution.fmu.builders import guard
 
     return guard
@@ -91,12 +91,12 @@ def _values(proc: subprocess.CompletedProcess) -> dict[int, float]:
 def built(tmp_path_factory):
     work = tmp_path_factory.mktemp("chost")
     plain = build_plain_toy(work / "plain", MODULE)
-    standalone = work / f"{MODEL}.fmu"
-    shutil.copy(plain, standalone)
-    _load_make_standalone().make_standalone(standalone)
+    guarded = work / f"{MODEL}.fmu"
+    shutil.copy(plain, guarded)
+    _load_add_guard().add_guard(guarded)
 
     host = build_host(work / "fmi2_script_host", 2)
-    return {"work": work, "plain": plain, "fmu": standalone, "host": host, "guid": _guid(standalone)}
+    return {"work": work, "plain": plain, "fmu": guarded, "host": host, "guid": _guid(guarded)}
 
 
 def test_fmu_layout(built):
@@ -127,7 +127,7 @@ def test_runs_in_plain_c_host(built, tmp_path, x):
 
 
 def test_runs_in_fmpy(built, tmp_path):
-    """Same standalone FMU in a Python host: the guard uses the running interpreter."""
+    """Same guarded FMU in a Python host: the guard uses the running interpreter."""
     code = textwrap.dedent(
         f"""
         import sys
@@ -196,10 +196,10 @@ def test_missing_config_gives_log_message_and_null(built, tmp_path):
     assert "python_env.txt" in proc.stdout and "needs a Python interpreter" in proc.stdout
 
 
-def test_make_standalone_is_idempotent(built, tmp_path):
+def test_add_guard_is_idempotent(built, tmp_path):
     again = tmp_path / f"{MODEL}.fmu"
     shutil.copy(built["fmu"], again)
-    _load_make_standalone().make_standalone(again)
+    _load_add_guard().add_guard(again)
     with zipfile.ZipFile(again) as zf:
         names = zf.namelist()
         assert zf.read(f"binaries/linux64/{MODEL}_pythonfmu.so") == \
