@@ -249,17 +249,9 @@ def drop_contacts(ball: EventModeInstance, rebound, drop_height: float, gravity:
 def check_event_ball_fmu(path, option: str = "--ball-fmu"):
     """``path`` if it is an FMI 3.0 BouncingBall FMU that offers event mode and early return; else ValueError,
     one line naming ``option`` and the path."""
-    from pathlib import Path
+    from .fmu import read_fmu_description
 
-    path = Path(path)
-    if not path.is_file():
-        raise ValueError(f"{option} {path}: {'not a file' if path.exists() else 'no such file'}")
-    try:
-        from fmpy import read_model_description
-
-        md = read_model_description(str(path))
-    except Exception as exc:  # noqa: BLE001 - whatever the archive is, it is not an FMU we can read
-        raise ValueError(f"{option} {path}: not an FMU ({type(exc).__name__}: {exc})") from None
+    path, md = read_fmu_description(path, option)
     cs = md.coSimulation
     if md.modelName != "BouncingBall" or not md.fmiVersion.startswith("3") or cs is None or not cs.hasEventMode \
             or not cs.mightReturnEarlyFromDoStep:

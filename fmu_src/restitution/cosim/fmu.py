@@ -5,7 +5,7 @@ import shutil
 import weakref
 from pathlib import Path
 
-__all__ = ["FmuInstance", "FmiStatusError", "check_impact_fmu", "impact_fmu_parameters",
+__all__ = ["FmuInstance", "FmiStatusError", "check_impact_fmu", "read_fmu_description", "impact_fmu_parameters",
            "quiet_instantiate"]
 
 
@@ -17,21 +17,27 @@ class FmiStatusError(RuntimeError):
         self.status = status
 
 
-def check_impact_fmu(path, option: str = "--fmu") -> Path:
-    """``path`` if it is a SpherePlateImpact FMU (a file, an FMU archive with a co-simulation interface and
-    every input, parameter and output of the model's interface table, which sweeps and scenes use); else
-    ValueError, one line naming ``option`` and the path."""
-    from ..fmu.models import table
-
+def read_fmu_description(path, option: str) -> tuple:
+    """(``path`` as a Path, its modelDescription read by fmpy) for an FMU given as ``option``; ValueError, one
+    line naming ``option`` and the path, where it is no file or no FMU fmpy can read."""
     path = Path(path)
     if not path.is_file():
         raise ValueError(f"{option} {path}: {'not a file' if path.exists() else 'no such file'}")
     try:
         from fmpy import read_model_description
 
-        md = read_model_description(str(path))
+        return path, read_model_description(str(path))
     except Exception as exc:  # noqa: BLE001 - whatever the archive is, it is not an FMU we can read
         raise ValueError(f"{option} {path}: not an FMU ({type(exc).__name__}: {exc})") from None
+
+
+def check_impact_fmu(path, option: str = "--fmu") -> Path:
+    """``path`` if it is a SpherePlateImpact FMU (a file, an FMU archive with a co-simulation interface and
+    every input, parameter and output of the model's interface table, which sweeps and scenes use); else
+    ValueError, one line naming ``option`` and the path."""
+    from ..fmu.models import table
+
+    path, md = read_fmu_description(path, option)
     names = {v.name for v in md.modelVariables}
     missing = [row.name for row in table("SpherePlateImpact")
                if row.causality in ("input", "parameter", "output") and row.name not in names]
