@@ -45,7 +45,7 @@ def test_quick_run_writes_the_page_with_every_row(quick):
         assert f"| {goal} |" in line
     for label in page.FMU_ROWS:  # fmpy and C host tables, and native and floor against the precomputed C floor
         assert len(row(f"{label} (")) == 2 + (label in page.IMPACT_ROWS), label
-    assert len(row("fmi3 (")) == 1  # the native FMI 3.0 FMU: C host table only
+    assert len(row("fmi3 (")) == 2  # the native FMI 3.0 FMU: the C host table and the per-impact table
     assert len(row("precomputed (")) == 1
     assert "the native physics and its glue above the floor FMU" in md  # native / precomputed split in two
     for call in page.CALLS:

@@ -108,7 +108,7 @@ def test_cli_user_mistakes_are_one_line_errors(tmp_path, impact_fmu):
     out = tmp_path / "out"
     fmu = ("--fmu", impact_fmu)
     for args, words in (((tmp_path / "missing.toml", *fmu), ["missing.toml", "cannot read"]),
-                        ((scene, *fmu), ["balls[0].diameter", "1e300 m"]),
+                        ((scene, *fmu), ["balls[0].diameter", "1e+300 m", "outside"]),
                         ((latin1, *fmu), ["latin1.toml", "not UTF-8"]),
                         ((good, *fmu, "--out", a_file), ["--out", "not a directory"]),
                         ((good, *fmu, "--out", a_file / "sub"), ["--out", "cannot write"]),

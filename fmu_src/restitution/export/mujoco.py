@@ -2,7 +2,7 @@
 
 MuJoCo's contacts are soft constraints (MuJoCo documentation, Computation, "Soft constraints"): along the
 normal the constraint's acceleration obeys a1 + d (b v + k r) = (1 - d) a0, r the signed distance (below
-zero in penetration), v its rate, a0 the acceleration without the contact, d = d(|r|) the impedance of
+zero in penetration), v its rate, a0 the acceleration without the contact, d = d(abs(r)) the impedance of
 ``solimp`` and the reference acceleration -b v - k r set by ``solref``: (timeconst, dampratio) gives
 b = 2 / (dmax timeconst), k = d(r) / (dmax^2 timeconst^2 dampratio^2). With s = d / dmax and gravity off the
 contact is r'' = -s (2 zeta omega) r' - s^2 omega^2 r, omega = 1 / (timeconst dampratio), zeta = dampratio,

@@ -32,6 +32,10 @@ BUILD_INFO = "resources/build_info.json"
 #: helpers whose imports (fmpy, dask, matplotlib, ...) the slaves never need. Bundling them made the
 #: guard's loader require those packages at start-up in a plain C host (python_env.txt require=).
 BUNDLED_SUBDIRS = {"data"}
+#: Modules at the package's top that read a user's text (a value with its unit, an option, a material by
+#: name): host side only, the FMUs never pass text. Not bundled: units.py would make the guard's loader
+#: require pint (its lazy import counts), which a plain C host need not have.
+HOST_ONLY_MODULES = {"units.py", "inputs.py", "options.py"}
 #: Of fmu/, the slaves need only the interface tables (pure data): these files, and models/*/variables.py.
 BUNDLED_FMU_FILES = {"__init__.py", "table.py"}
 
@@ -44,11 +48,12 @@ def front_files(fmi_version: str = "2.0") -> list[Path]:
 
 def bundle_filter(directory, names):
     """copytree filter: no caches; below the package root only BUNDLED_SUBDIRS and, of fmu/, the
-    interface tables."""
+    interface tables; at the root, not the HOST_ONLY_MODULES."""
     ignored = set(shutil.ignore_patterns("__pycache__", "*.pyc", "*.egg-info")(directory, names))
     here = Path(directory).resolve()
     if here == PACKAGE:
         ignored |= {n for n in names if (PACKAGE / n).is_dir() and n not in BUNDLED_SUBDIRS | {"fmu"}}
+        ignored |= HOST_ONLY_MODULES & set(names)
     elif here == FMU_DIR:
         ignored |= {n for n in names if n not in BUNDLED_FMU_FILES | {"models"}}
     elif here == MODELS or here.parent == MODELS:
