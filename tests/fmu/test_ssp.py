@@ -46,7 +46,8 @@ H0 = 0.3  # [m] the ball set's drop height
 CASE = "table1_case07"  # brass 260, d = 6.35 mm, on S7 tool steel, t = 10 d
 CASE_SPHERE, CASE_PLATE = r.Sphere(r.MATERIALS["brass_260"], 6.35e-3), r.Plate(r.MATERIALS["s7_tool_steel"], 63.5e-3)
 #: The FMUs' Table 3 default pair, which the shipped SSD binds as numbers (resources/<DEFAULT_SET>.ssv).
-DEFAULT_SPHERE, DEFAULT_PLATE = r.Sphere(r.MATERIALS["s2_tool_steel"], 6.35e-3), r.Plate(r.MATERIALS["al_6061"], 6.35e-3)
+DEFAULT_SPHERE = r.Sphere(r.MATERIALS["s2_tool_steel"], 6.35e-3)
+DEFAULT_PLATE = r.Plate(r.MATERIALS["al_6061"], 6.35e-3)
 STEP = 1e-3  # [s] the SSD's default communication step
 N = 4  # contacts compared (the Table 1 case bounces four times within the 1 s default experiment)
 SSV = "http://ssp-standard.org/SSP1/SystemStructureParameterValues"
@@ -354,9 +355,11 @@ def _changed_bindings(src: Path, dst: Path) -> Path:
 
     def change(name, data):
         if name == f"resources/{DEFAULT_SET}.ssv":
-            changed = data.replace(b'"plate.t">\n      <ssv:Real value="0.00635"', b'"plate.t">\n      <ssv:Real value="0.0635"')
+            changed = data.replace(b'"plate.t">\n      <ssv:Real value="0.00635"',
+                                   b'"plate.t">\n      <ssv:Real value="0.0635"')
         elif name == "resources/ball.ssv":
-            changed = data.replace(b'name="h0">\n      <ssv:Real value="0.3"', b'name="h0">\n      <ssv:Real value="0.2"')
+            changed = data.replace(b'name="h0">\n      <ssv:Real value="0.3"',
+                                   b'name="h0">\n      <ssv:Real value="0.2"')
         else:
             return data
         assert changed != data, name
