@@ -7,18 +7,20 @@ from this platform's native FMUs (gcc):
    from PyPI, so its archive gets the packaging rules and its SSP 2.0 types are checked by name.
 2. Parameter sets: materials set by enumeration item name, items of the FMU's own enumeration; the custom
    set gives every property with the unit the FMU declares; the archive's bytes repeat.
-3. Importers, each on a Table 1 case (not the FMUs' defaults, so the bindings must be applied):
-   - restitution.cosim.ssp (fmpy, a master applying the bindings), SSP 1.0 and 2.0: the first contact at
+3. Importers:
+   - restitution.cosim.ssp (fmpy, a master applying the bindings), SSP 1.0 and 2.0, on a Table 1 case by
+     item name (not the FMUs' defaults, so the enumeration binding must be applied): the first contact at
      the closed-form free-fall time; each later contact late by at most the waits at the plate before it
      (contact_mode wait: at most one step each), and every COR applied equal to the package's at the
-     contact's own impact speed (the ball holds its impact speed while it waits, so no lag);
-   - libcosim (libcosimpy) and ecos (ecospy's engine; needs libtbb.so.12: the tbb wheel or libtbb12): both
-     stop at the SSV's <ssv:Enumeration> (libcosim 0.0.6 aborts in its SSP parser, ecos 0.7.2 exits with
-     "Unknown XML node in ssv:Parameter"): asserted. Each then runs a copy whose enumerations are written
-     as the FMU's Integer codes: both apply the Real parameters but set no FMI Enumeration variable (the
-     materials stay the defaults, asserted); their contacts follow the closed-form flights, and each COR is
-     the package's at a speed within one step before the impact (their one-step lag).
-   Both run in child processes (libcosim's abort would end pytest).
+     contact's own impact speed (the ball holds its impact speed while it waits, so no lag). The default
+     binding (Real only), custom.ssv and the preset pair by name give the same bounces.
+   - libcosim (libcosimpy) and ecos (ecospy's engine; needs libtbb.so.12: the tbb wheel or libtbb12) run
+     the shipped SSP as it is (its default binding needs no ssv:Enumeration, which neither reads): the
+     contacts follow the closed-form flights, each COR is the package's at the ball's speed at the last
+     communication point before the contact (a fixed-step master without events passes the outputs at
+     communication points only), each contact within one step of the fmpy master's. A copy with changed
+     values shows which bindings each applies (libcosim: both; ecos: the one set --parameterSet names).
+   libcosim runs in a child process (an abort in it would end pytest); ecos is a program.
 """
 from __future__ import annotations
 
@@ -43,6 +45,9 @@ G = 9.80665  # [m/s2] the ball set's g
 H0 = 0.3  # [m] the ball set's drop height
 CASE = "table1_case07"  # brass 260, d = 6.35 mm, on S7 tool steel, t = 10 d
 CASE_SPHERE, CASE_PLATE = r.Sphere(r.MATERIALS["brass_260"], 6.35e-3), r.Plate(r.MATERIALS["s7_tool_steel"], 63.5e-3)
+#: The FMUs' Table 3 default pair, which the shipped SSD binds as numbers (resources/<DEFAULT_SET>.ssv).
+DEFAULT_SPHERE = r.Sphere(r.MATERIALS["s2_tool_steel"], 6.35e-3)
+DEFAULT_PLATE = r.Plate(r.MATERIALS["al_6061"], 6.35e-3)
 STEP = 1e-3  # [s] the SSD's default communication step
 N = 4  # contacts compared (the Table 1 case bounces four times within the 1 s default experiment)
 SSV = "http://ssp-standard.org/SSP1/SystemStructureParameterValues"
@@ -225,22 +230,32 @@ def test_fmpy_master_ssp1_and_ssp2_agree(fmpy_runs):
     np.testing.assert_allclose(fmpy_runs["1.0"]["t_impact"][:N], fmpy_runs["2.0"]["t_impact"][:N], rtol=1e-12)
 
 
-def test_custom_set_equals_the_preset_pair(ssps):
-    """custom.ssv spells out S2 tool steel on Al 6061; the preset pair names them: the same bounces."""
+def test_default_custom_and_preset_pair_sets_agree(ssps, fmpy_default):
+    """The default set writes S2 tool steel on Al 6061 out as numbers (materials left 'custom'), custom.ssv
+    names both materials 'custom' with the same numbers, the preset pair names the presets by item
+    (ssv:Enumeration): the same bounces, and the default's are the package's at each contact's speed."""
+    from restitution.cosim import ball_bounces
+    from restitution.cosim.ssp import run_ssp
+    from restitution.fmu.ssp import PRESET_PAIR_SET
+
+    for alternative in ("custom", PRESET_PAIR_SET):
+        run = ball_bounces(run_ssp(ssps["1.0"], bindings={"impact": f"resources/{alternative}.ssv"}), G)
+        # same FMU, same values reaching the same code: a few roundings of the presets' numbers at most
+        np.testing.assert_allclose(run["e_applied"][:N], fmpy_default["e_applied"][:N], rtol=1e-14)
+    params = {**DEFAULT_SPHERE.params(), **DEFAULT_PLATE.params()}
+    for k in range(N):
+        v = fmpy_default["v_impact"][k]
+        tol = float(tolerances(np.array([v]), {n: np.array([x]) for n, x in params.items()})[0]["e"][0])
+        assert abs(fmpy_default["e_applied"][k] - float(r.impact(v, **params).e)) <= tol, k
+
+
+@pytest.fixture(scope="module")
+def fmpy_default(ssps):
+    """The shipped BallOnPlate.ssp (SSP 1.0) as it is, its default binding, through restitution.cosim.ssp."""
     from restitution.cosim import ball_bounces
     from restitution.cosim.ssp import run_ssp
 
-    custom = ball_bounces(run_ssp(ssps["1.0"], bindings={"impact": "resources/custom.ssv"}), G)
-    preset = ball_bounces(run_ssp(ssps["1.0"]), G)
-    np.testing.assert_allclose(custom["e_applied"][:N], preset["e_applied"][:N], rtol=1e-14)
-
-
-def codes_copy(ssps, out: Path) -> Path:
-    """BallOnPlate.ssp bound to CASE with every Enumeration written as its Integer code (the FMU's value of
-    the item): what libcosim 0.0.6 and ecos 0.7.2 can read."""
-    from restitution.fmu.ssp import build_ssp
-
-    return build_ssp("1.0", ssps["out"] / "fmi2", out, impact_set=CASE, enumeration_codes=True)
+    return ball_bounces(run_ssp(ssps["1.0"]), G)
 
 
 LIBCOSIM_CHILD = textwrap.dedent('''
@@ -270,7 +285,7 @@ LIBCOSIM_CHILD = textwrap.dedent('''
                 columns[key].append(value)
     print("RESULT " + json.dumps(columns))
 ''')
-#: What the libcosim run records, as ecos's CSV names it.
+#: What the host runs record, as ecos's CSV names it.
 RECORD = {"ball": ["t_impact", "v_impact", "t_rebound", "v_rebound", "e_applied"],
           "impact": ["plate.t", "sphere.used.E", "plate.used.E"]}
 
@@ -281,52 +296,76 @@ def _distinct(column) -> np.ndarray:
     return column[keep]
 
 
-def test_libcosim_runs_the_ssp(ssps, tmp_path):
-    if importlib.util.find_spec("libcosimpy") is None:
-        pytest.skip("libcosimpy (OSP libcosim) not installed")
-    cfg = {"ssp": str(ssps["1.0"]), "dir": str(tmp_path / "as_shipped"), "step": STEP, "stop": 1.0}
-    proc = subprocess.run([sys.executable, "-c", LIBCOSIM_CHILD, json.dumps(cfg)], capture_output=True, text=True,
-                          timeout=300)
-    # libcosim 0.0.6 cannot read <ssv:Enumeration>: its SSP parser aborts (the SSP is valid: test above)
-    assert proc.returncode != 0 and "ssp_parser.cpp" in proc.stderr, proc.stderr[-2000:]
-    cfg.update(ssp=str(codes_copy(ssps, tmp_path / "codes.ssp")), dir=str(tmp_path / "codes"),
-               record=RECORD)
-    proc = subprocess.run([sys.executable, "-c", LIBCOSIM_CHILD, json.dumps(cfg)], capture_output=True, text=True,
-                          timeout=300)
-    assert proc.returncode == 0, proc.stderr[-3000:]
-    columns = json.loads(next(x for x in proc.stdout.splitlines() if x.startswith("RESULT "))[len("RESULT "):])
-    _check_run_with_default_materials({k: np.array(v) for k, v in columns.items()}, resolution=0.0)
-
-
-def _check_run_with_default_materials(column: dict, resolution: float):
-    """A run of the Integer-code copy bound to CASE by a host that applies the Real parameters but sets no
-    FMI Enumeration variable, even from an Integer (libcosim 0.0.6, ecos 0.7.2): plate.t is the case's, the
-    materials stay the FMUs' defaults (S2 tool steel on Al 6061). ``resolution``: how finely the host wrote
-    its values (ecos's CSV: 6 decimals)."""
-    assert column["impact::plate.t"][-1] == pytest.approx(10 * 6.35e-3, abs=resolution)
-    assert column["impact::sphere.used.E"][-1] == r.MATERIALS["s2_tool_steel"].E
-    assert column["impact::plate.used.E"][-1] == r.MATERIALS["al_6061"].E
-    sphere, plate = r.Sphere(r.MATERIALS["s2_tool_steel"], 6.35e-3), r.Plate(r.MATERIALS["al_6061"], 63.5e-3)
-    params = {**sphere.params(), **plate.params()}
+def _check_fixed_step_host(column: dict, reference: dict, resolution: float):
+    """A run of the shipped SSP (default binding) by a fixed-step master without event handling (libcosim
+    0.0.6, ecos 0.7.2) against the closed forms and the package. ``reference``: the fmpy master's bounces
+    of the same SSP (tested against the closed form above); ``resolution``: how finely the host wrote its
+    values (ecos's CSV: 6 decimals, so 5e-7; libcosim: 0)."""
+    assert column["impact::plate.t"][-1] == pytest.approx(6.35e-3, abs=resolution)
+    assert column["impact::sphere.used.E"][-1] == pytest.approx(r.MATERIALS["s2_tool_steel"].E, rel=1e-6)
+    assert column["impact::plate.used.E"][-1] == pytest.approx(r.MATERIALS["al_6061"].E, rel=1e-6)
+    params = {**DEFAULT_SPHERE.params(), **DEFAULT_PLATE.params()}
     t_impact, v_impact, t_rebound, v_rebound, e_applied = (
         _distinct(column[f"ball::{n}"])  # the first sample holds the start values
         for n in ("t_impact", "v_impact", "t_rebound", "v_rebound", "e_applied"))
     assert t_impact.size >= N
-    # closed form (1e-12: a few roundings), or the CSV's 6 decimals
+    # free fall from rest: closed form (1e-12: a few roundings), or the CSV's 6 decimals
     assert t_impact[0] == pytest.approx(math.sqrt(2 * H0 / G), rel=1e-12, abs=resolution)
     # each flight is the free flight of the rebound: t_next = t_rebound + 2 v_rebound / g
     np.testing.assert_allclose(t_impact[1:N], t_rebound[:N - 1] + 2 * v_rebound[:N - 1] / G, rtol=1e-12,
                                atol=4 * resolution)
     for k in range(N):
         assert 0.0 <= t_rebound[k] - t_impact[k] <= STEP + 2 * resolution, k  # wait mode: <= one step at the plate
-        # both hosts pass the COR one step late (the speed at the last communication point before the
-        # contact, at most g h below the impact speed); e falls with the speed, so it lies between e at the
-        # impact speed and e at g h less
-        high, low = (float(r.impact(v, **params).e) for v in (v_impact[k] - G * STEP, v_impact[k]))
-        tol = max(float(tolerances(np.array([v]), {n: np.array([x]) for n, x in params.items()})[0]["e"][0])
-                  for v in (v_impact[k] - G * STEP, v_impact[k]))
-        slack = tol + 2 * resolution
-        assert low - slack <= e_applied[k] <= high + slack, (k, e_applied[k], low, high)
+        # Both masters step the FMUs side by side and pass the outputs at communication points only: the
+        # impact FMU's e comes from the v_approach of the last communication point before the contact,
+        # the ball's closed-form speed there, v_impact - g (t_impact - t_c), at most g h below v_impact.
+        t_c = math.floor(t_impact[k] / STEP * (1 + 1e-12)) * STEP
+        v_c = v_impact[k] - G * (t_impact[k] - t_c)
+        e = float(r.impact(v_c, **params).e)
+        tol = float(tolerances(np.array([v_c]), {n: np.array([x]) for n, x in params.items()})[0]["e"][0])
+        assert abs(e_applied[k] - e) <= tol + 2 * resolution, (k, e_applied[k], e)
+    # that lag moves each later contact by far less than a step from the event-exact master's
+    # (|de| <= 1e-3 here, so 2 v |de| / g <= 5e-4 s per flight, summed over N flights)
+    np.testing.assert_allclose(t_impact[:N], reference["t_impact"][:N], rtol=0, atol=STEP)
+
+
+def test_libcosim_runs_the_shipped_ssp(ssps, fmpy_default, tmp_path):
+    """libcosim applies both bindings of the SSD (ball.ssv and the Real-only default set): shown on a copy
+    whose default set says plate.t = 10 d and whose ball set says h0 = 0.2 m."""
+    if importlib.util.find_spec("libcosimpy") is None:
+        pytest.skip("libcosimpy (OSP libcosim) not installed")
+
+    def run(ssp, folder, record):
+        cfg = {"ssp": str(ssp), "dir": str(tmp_path / folder), "step": STEP, "stop": 1.0, "record": record}
+        proc = subprocess.run([sys.executable, "-c", LIBCOSIM_CHILD, json.dumps(cfg)], capture_output=True,
+                              text=True, timeout=300)
+        assert proc.returncode == 0, proc.stderr[-3000:]
+        result = next(x for x in proc.stdout.splitlines() if x.startswith("RESULT "))[len("RESULT "):]
+        return {k: np.array(v) for k, v in json.loads(result).items()}
+
+    _check_fixed_step_host(run(ssps["1.0"], "as_shipped", RECORD), fmpy_default, resolution=0.0)
+    changed = run(_changed_bindings(ssps["1.0"], tmp_path / "changed.ssp"), "changed",
+                  {"ball": ["h0"], "impact": ["plate.t"]})
+    assert (changed["ball::h0"][-1], changed["impact::plate.t"][-1]) == (0.2, 63.5e-3)
+
+
+def _changed_bindings(src: Path, dst: Path) -> Path:
+    """A copy of the SSP whose default set gives plate.t = 63.5 mm and whose ball set gives h0 = 0.2 m."""
+    from restitution.fmu.ssp import DEFAULT_SET
+
+    def change(name, data):
+        if name == f"resources/{DEFAULT_SET}.ssv":
+            changed = data.replace(b'"plate.t">\n      <ssv:Real value="0.00635"',
+                                   b'"plate.t">\n      <ssv:Real value="0.0635"')
+        elif name == "resources/ball.ssv":
+            changed = data.replace(b'name="h0">\n      <ssv:Real value="0.3"',
+                                   b'name="h0">\n      <ssv:Real value="0.2"')
+        else:
+            return data
+        assert changed != data, name
+        return changed
+
+    return _rewrite(src, dst, change)
 
 
 @pytest.fixture(scope="module")
@@ -336,24 +375,31 @@ def ecos(tmp_path_factory):
     return ecos_engine(tmp_path_factory.mktemp("ecos"))
 
 
-def test_ecos_runs_the_ssp(ssps, ecos, tmp_path):
-    exe, env = ecos.exe, ecos.env
-
-    def simulate(ssp, cwd):  # ecos applies the parameter sets of the name it is given only
-        cwd.mkdir()
-        return subprocess.run([str(exe), "simulate", "--path", str(ssp), "--stepSize", repr(STEP), "--stopTime",
-                               "1.0", "--parameterSet", CASE, "--logLevel", "warn"], cwd=cwd, capture_output=True, text=True, timeout=300,
-                              env=env)
-
-    proc = simulate(ssps["1.0"], tmp_path / "as_shipped")
-    assert "Unknown XML node in ssv:Parameter" in proc.stdout + proc.stderr  # ecos 0.7.2 reads no Enumeration
-    ssp = codes_copy(ssps, tmp_path / "codes.ssp")
-    proc = simulate(ssp, tmp_path / "codes")
+def _ecos_simulate(ecos, ssp: Path, cwd: Path, parameter_set: str) -> dict:
+    cwd.mkdir()
+    proc = subprocess.run([str(ecos.exe), "simulate", "--path", str(ssp), "--stepSize", repr(STEP), "--stopTime",
+                           "1.0", "--parameterSet", parameter_set, "--logLevel", "warn"], cwd=cwd,
+                          capture_output=True, text=True, timeout=300, env=ecos.env)
     assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-2000:]
-    lines = (tmp_path / "codes" / "codes.csv").read_text().splitlines()
+    lines = (cwd / f"{ssp.stem}.csv").read_text().splitlines()
     header = [c.strip().rsplit("[", 1)[0] for c in lines[0].split(",")]
     data = np.array([[float(x) for x in line.split(",")] for line in lines[1:] if line.strip()])
-    _check_run_with_default_materials({name: data[:, i] for i, name in enumerate(header)}, resolution=5e-7)
+    return {name: data[:, i] for i, name in enumerate(header)}
+
+
+def test_ecos_runs_the_shipped_ssp(ssps, fmpy_default, ecos, tmp_path):
+    """ecos applies only the parameter sets named by --parameterSet (the SSV's name): given the default set's
+    name it applies that set and not ball.ssv, whose values are the BouncingBall FMU's own defaults, so the
+    shipped SSP runs as bound. Shown on the copy with changed bindings."""
+    from restitution.fmu.ssp import DEFAULT_SET
+
+    _check_fixed_step_host(_ecos_simulate(ecos, ssps["1.0"], tmp_path / "as_shipped", DEFAULT_SET), fmpy_default,
+                           resolution=5e-7)
+    changed = _changed_bindings(ssps["1.0"], tmp_path / "changed.ssp")
+    impact_set = _ecos_simulate(ecos, changed, tmp_path / "impact_set", DEFAULT_SET)
+    assert (impact_set["ball::h0"][-1], impact_set["impact::plate.t"][-1]) == (0.3, 63.5e-3)
+    ball_set = _ecos_simulate(ecos, changed, tmp_path / "ball_set", "ball")
+    assert (ball_set["ball::h0"][-1], ball_set["impact::plate.t"][-1]) == (0.2, 6.35e-3)
 
 
 def test_an_ssp_whose_fmus_are_missing_is_skipped_with_a_line(ssps, tmp_path):

@@ -49,12 +49,10 @@ def _variables(fmus: dict, fmi_version: str | None, version: str) -> dict:
     return variables
 
 
-def build_ssp(version: str, fmu_dir: Path, out: Path, impact_set: str = DEFAULT_SET,
-              enumeration_codes: bool = False) -> Path:
+def build_ssp(version: str, fmu_dir: Path, out: Path, impact_set: str = DEFAULT_SET) -> Path:
     """Write the SSP of ``version`` ("1.0" or "2.0") to ``out`` from ``fmu_dir``/BouncingBall.fmu and
     SpherePlateImpact.fmu (FMI 2.0 FMUs for SSP 1.0, FMI 3.0 for SSP 2.0), the impact component bound to
-    ``resources/<impact_set>.ssv``. ``enumeration_codes``: Enumerations as Integer codes in every SSV, for
-    the hosts that read no ``<ssv:Enumeration>`` (libcosim 0.0.6, ecos 0.7.2)."""
+    ``resources/<impact_set>.ssv`` (default: the Real-only set every importer reads, :mod:`.ssv`)."""
     fmi_version, _float = check_version(version)
     fmus = {name: Path(fmu_dir) / f"{model}.fmu" for name, model in MODELS.items()}
     variables = _variables(fmus, fmi_version, version)
@@ -71,7 +69,7 @@ def build_ssp(version: str, fmu_dir: Path, out: Path, impact_set: str = DEFAULT_
     entries = [(SSD_ENTRY, system_structure(version, components, description=description))]
     entries += [(f"resources/{MODELS[name]}.fmu", fmus[name].read_bytes()) for name in MODELS]
     sets = [("ball", BALL_SET)] + [("impact", pset) for pset in impact_sets]
-    entries += [(pset.entry, write_parameter_set(pset, variables[name], version, enumeration_codes))
+    entries += [(pset.entry, write_parameter_set(pset, variables[name], version))
                 for name, pset in sets]
     Path(out).parent.mkdir(parents=True, exist_ok=True)
     return deterministic_zip(Path(out), entries)

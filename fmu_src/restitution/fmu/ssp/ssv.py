@@ -1,11 +1,17 @@
 """The SSV parameter sets shipped in the SSP (``resources/*.ssv``) and writing them.
 
-One set per material pair of the paper's experiments: the 17 cases of Table 1 (Marinack et al., spheres
-of 4.76 and 6.35 mm on thick plates: t = 10 d, a half-space for the plate-wave term, since the cases give
-no thickness) and the Table 3 pair the FMUs default to (S2 tool steel, d = 6.35 mm, on Al 6061,
-t = d); each names its materials by enumeration item (``<ssv:Enumeration value="s7_tool_steel"/>``),
-never by code. ``custom`` sets every property explicitly with its unit (the same S2-on-Al 6061 values,
-so it must give what the preset pair gives). ``ball`` holds the ball's drop: h0, g, contact_mode, v_min.
+The set SystemStructure.ssd binds by default, :data:`DEFAULT_SET`, holds Real parameters only: E, nu, Sy,
+rho of both bodies, d and t of the Table 3 pair the FMUs default to (S2 tool steel, d = 6.35 mm, on Al
+6061, t = d), written out from the presets. The FMUs' materials default to ``custom`` (those numbers are
+used), so the default binding needs no enumeration and every importer that reads ``ssv:Real`` applies it
+(libcosim 0.0.6 and ecos 0.7.2 read no ``ssv:Enumeration``: docs/ssp.md).
+
+The alternative sets name their materials by enumeration item (``<ssv:Enumeration
+value="s7_tool_steel"/>``), never by code: one per material pair of the paper's experiments, the 17
+cases of Table 1 (Marinack et al., spheres of 4.76 and 6.35 mm on thick plates: t = 10 d, a half-space
+for the plate-wave term, since the cases give no thickness) and the Table 3 pair by preset name; and
+``custom``, the default set's numbers with both materials named ``custom``. ``ball`` holds the ball's
+drop: h0, g, contact_mode, v_min (the BouncingBall FMU's own defaults, written out).
 
 The Real values of a set are written with the unit of the variable they set (the FMU's
 modelDescription.xml), which the set declares in its ``<ssv:Units>``.
@@ -19,7 +25,7 @@ from ...materials import ALIASES, MATERIALS, TABLE1_CASES
 from .xml_common import check_version, enumeration_items, enumerations_element, tag, to_bytes, unit_of, \
     units_element
 
-__all__ = ["ParameterSet", "impact_parameter_sets", "BALL_SET", "DEFAULT_SET", "write_parameter_set"]
+__all__ = ["ParameterSet", "impact_parameter_sets", "BALL_SET", "DEFAULT_SET", "PRESET_PAIR_SET", "write_parameter_set"]
 
 #: Table 1 gives no plate thickness; the experiments dropped the spheres on thick plates [m per m of d].
 TABLE1_THICKNESS_OVER_D = 10.0
@@ -51,34 +57,41 @@ def _pair(name, description, sphere, d, plate, t) -> ParameterSet:
                                             "plate.material": _preset(plate), "plate.t": float(t)})
 
 
-def _custom() -> ParameterSet:
+def _table3_properties(name: str, description: str, material_names: bool) -> ParameterSet:
+    """The Table 3 pair's E, nu, Sy, rho of both bodies, d and t, from the presets; ``material_names``:
+    also both materials set to the item ``custom`` (an ``ssv:Enumeration``)."""
     sphere_key, d, plate_key, t = TABLE3_DEFAULT
-    values = {"sphere.material": "custom", "plate.material": "custom"}
+    values = {"sphere.material": "custom", "plate.material": "custom"} if material_names else {}
     for body, key in (("sphere", sphere_key), ("plate", plate_key)):
         material = MATERIALS[key]
         values.update({f"{body}.E": material.E, f"{body}.nu": material.nu, f"{body}.Sy": material.Sy,
                        f"{body}.rho": material.rho})
     values.update({"sphere.d": d, "plate.t": t})
-    return ParameterSet("custom", "Every property given explicitly with its unit (materials 'custom'): here "
-                                  "the values of S2 tool steel, d = 6.35 mm, on Al 6061, t = 6.35 mm", values)
+    return ParameterSet(name, description, values)
 
 
 def impact_parameter_sets() -> list[ParameterSet]:
-    """SpherePlateImpact's sets: the Table 3 default pair, the 17 Table 1 cases, custom (module doc)."""
+    """SpherePlateImpact's sets: the Table 3 pair as numbers (the default) and by preset name, the 17
+    Table 1 cases, custom (module doc)."""
     sphere, d, plate, t = TABLE3_DEFAULT
-    sets = [_pair(DEFAULT_SET, "Green (2022) Table 3 pair, the FMUs' defaults: S2 tool steel sphere, d = 6.35 mm, "
-                               "on Al 6061, t = 6.35 mm", sphere, d, plate, t)]
+    pair_text = "S2 tool steel sphere, d = 6.35 mm, on Al 6061, t = 6.35 mm"
+    sets = [_table3_properties(DEFAULT_SET, f"Green (2022) Table 3 pair, the FMUs' defaults, every property a "
+                                            f"number with its unit (materials left 'custom'): {pair_text}", False),
+            _pair(PRESET_PAIR_SET, f"Green (2022) Table 3 pair by preset name: {pair_text}", sphere, d, plate, t)]
     for case, (sphere, d, plate) in sorted(TABLE1_CASES.items()):
         t = TABLE1_THICKNESS_OVER_D * d
         sets.append(_pair(f"table1_case{case:02d}",
                           f"Green (2022) Table 1 case {case}: {MATERIALS[sphere].name} sphere, d = {d * 1e3:g} mm, "
                           f"on {MATERIALS[plate].name} (thickness not given: t = {TABLE1_THICKNESS_OVER_D:g} d)",
                           sphere, d, plate, t))
-    return sets + [_custom()]
+    return sets + [_table3_properties("custom", "Every property given explicitly with its unit, both materials "
+                                                f"named 'custom': here the values of {pair_text}", True)]
 
 
-#: The set SystemStructure.ssd binds to the impact component.
-DEFAULT_SET = "table3_s2_tool_steel_on_al_6061"
+#: The set SystemStructure.ssd binds to the impact component: Real parameters only (module doc).
+DEFAULT_SET = "table3_s2_tool_steel_on_al_6061_properties"
+#: The same pair by preset name (``ssv:Enumeration``), an alternative set.
+PRESET_PAIR_SET = "table3_s2_tool_steel_on_al_6061"
 #: The ball's set: dropped from 0.3 m under standard gravity, waiting at the plate for the COR
 #: (contact_mode 1 = wait), at rest below 0.1 m/s. contact_mode is an Integer in the FMI 2.0 FMU and an
 #: Enumeration in the FMI 3.0 one: there the code is written as its item's name ("wait").
@@ -140,6 +153,6 @@ def parameter_set_element(pset: ParameterSet, variables: dict, version: str, enu
     return root
 
 
-def write_parameter_set(pset: ParameterSet, variables: dict, version: str, enumeration_codes: bool = False) -> bytes:
-    """The SSV file of ``pset`` (see :func:`parameter_set_element`)."""
-    return to_bytes(parameter_set_element(pset, variables, version, enumeration_codes))
+def write_parameter_set(pset: ParameterSet, variables: dict, version: str) -> bytes:
+    """The SSV file of ``pset`` (see :func:`parameter_set_element`), enumerations by item name."""
+    return to_bytes(parameter_set_element(pset, variables, version))
