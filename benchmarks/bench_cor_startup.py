@@ -38,7 +38,10 @@ _COUNT = ("import atexit, sys\n"
 
 
 def _env() -> dict:
-    return {**os.environ, "PYTHONPATH": os.pathsep.join([str(ROOT / "fmu_src"), os.environ.get("PYTHONPATH", "")])}
+    """The children's environment: the package's sources first, and bytecode caches written and read as
+    for a user (an inherited PYTHONDONTWRITEBYTECODE made every run compile the package's modules again)."""
+    env = {key: value for key, value in os.environ.items() if key != "PYTHONDONTWRITEBYTECODE"}
+    return env | {"PYTHONPATH": os.pathsep.join([str(ROOT / "fmu_src"), os.environ.get("PYTHONPATH", "")])}
 
 
 def wall(args: list[str]) -> float:

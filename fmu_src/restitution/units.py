@@ -4,7 +4,8 @@ reader of every front end (the command lines' options, sweeps, scene files, the 
 A dimensional value is a string "<number> <unit>", or a bare number in SI units
 (``thickness = 0.00318`` is 3.18 mm), as everywhere in the package. Dimensionless values (Poisson's
 ratio, tolerances) are plain numbers. Units are read by pint, so any unit of the right kind works
-(``"0.125 in"``, ``"1 ft"``, ``"2.7 g/cm3"``, ``"9.81 m/s2"``);
+(``"0.125 in"``, ``"1 ft"``, ``"2.7 g/cm3"``, ``"9.81 m/s2"``; the common ones, :data:`_SI_FACTOR`, are
+converted with pint's factors without loading pint);
 a digit right after a unit's letters is its exponent (``m3`` is m**3). Everything is converted to SI
 on load. The command lines and the sweep read with the same parser (:func:`split_quantity`,
 :func:`convert_quantity`, :func:`read_quantity`), where a fraction (``"1/4 in"``) is a number too;
@@ -100,6 +101,23 @@ _FRACTION = re.compile(r"^\s*([-+]?[0-9]+)\s*/\s*([0-9]+)(?![0-9.eE])\s*(\S(?:.*
 _EXPONENT = re.compile(r"(?<=[A-Za-zµμ])([0-9]+)\b")
 
 
+#: Each kind's common units, as written, and pint's factor to SI for each, to the last bit: read without pint,
+#: whose registry takes over a second to build (``restitution cor`` with "6.35 mm" took 1.5 s, 0.3 s without).
+#: pint converts by one multiplication, ``number * factor``, and so does :func:`convert_quantity` with these
+#: factors, which makes the result the same float. Some of pint's factors are not the decimal one: its chain of
+#: definitions (foot = 12 inch, inch = yard / 36, ...) rounds, hence ft and g/cm3 below;
+#: tests/cli/test_units_fast_path.py checks every entry against pint. Any other unit or spelling is read by pint.
+_SI_FACTOR = {
+    "length": {"m": 1, "mm": 0.001, "cm": 0.01, "nm": 1e-09, "km": 1000.0, "in": 0.0254, "ft": 0.30479999999999996,
+               "um": 1e-06, "\u00b5m": 1e-06, "\u03bcm": 1e-06},  # micro: u, the micro sign, the Greek mu
+    "pressure": {"Pa": 1, "kPa": 1000.0, "MPa": 1000000.0, "GPa": 1000000000.0},
+    "density": {"kg/m3": 1, "g/cm3": 999.9999999999999},
+    "speed": {"m/s": 1, "mm/s": 0.001, "cm/s": 0.01, "km/h": 0.2777777777777778},
+    "acceleration": {"m/s2": 1},
+    "time": {"s": 1, "ms": 0.001, "us": 1e-06, "ns": 1e-09},
+}
+
+
 @lru_cache(maxsize=1)
 def _registry():
     import pint
@@ -131,6 +149,9 @@ def convert_quantity(name: str, text: str, number: float, unit: str, kind: str) 
     """SI value of ``number`` in ``unit`` for a quantity of ``kind``; ``text`` is the value as written and
     ``name`` what the messages call the quantity. Raises :class:`UnitError` for an unknown unit or a
     unit of another kind."""
+    factor = _SI_FACTOR[kind].get(unit)
+    if factor is not None:
+        return _finite(text, number * factor)
     ureg = _registry()
     try:
         given = ureg.parse_units(_pint_units(unit))
@@ -143,7 +164,12 @@ def convert_quantity(name: str, text: str, number: float, unit: str, kind: str) 
                      f"{given.dimensionality}" if given.dimensionality else "a dimensionless number")
         raise UnitError(f"{text!r}: {unit} is a unit of {other}, but {name} is a {kind} "
                         f"(units: {EXAMPLES[kind]})")
-    si = float(ureg.Quantity(number, given).to(target).magnitude)
+    return _finite(text, ureg.Quantity(number, given).to(target).magnitude)
+
+
+def _finite(text: str, si) -> float:
+    """``si`` as a float, UnitError if it is not finite (``"1e308 km"``)."""
+    si = float(si)
     if not math.isfinite(si):
         raise UnitError(f"{text!r} is not finite")
     return si
