@@ -183,3 +183,25 @@ def test_the_build_refuses_a_slave_that_registers_unlike_the_table(built):
         "\0", 'name="sphere.nu" valueReference="1"')
     with pytest.raises(fmu_build.BuildError, match=r"first difference at position 1.*sphere\.nu"):
         python_fmu._check_registration("SpherePlateImpact", swapped)
+
+
+def test_the_bundled_package_imports_neither_the_host_side_readers_nor_pint():
+    """The pythonfmu FMUs bundle the package's top-level modules but the host-side readers
+    (HOST_ONLY_MODULES). A copy loaded from resources/ is imported whole, so no bundled module may import a
+    reader at its top; and none may import pint anywhere, lazily included, or the guard's loader requires
+    it in a plain C host (it reads every import of the bundled files)."""
+    import ast
+
+    from restitution.fmu.builders.sources import HOST_ONLY_MODULES, PACKAGE
+
+    readers = {name[:-3] for name in HOST_ONLY_MODULES}
+    bundled = sorted(p for p in PACKAGE.glob("*.py") if p.name not in HOST_ONLY_MODULES)
+    assert len(bundled) > 10 and readers <= {p.stem for p in PACKAGE.glob("*.py")}
+    for path in bundled:
+        tree = ast.parse(path.read_text(encoding="utf-8"))
+        top = {n.module.split(".")[0] for n in tree.body if isinstance(n, ast.ImportFrom) and n.level == 1 and n.module}
+        assert not top & readers, (path.name, top & readers)
+        everywhere = {a.name.split(".")[0] for n in ast.walk(tree) if isinstance(n, ast.Import) for a in n.names}
+        everywhere |= {n.module.split(".")[0] for n in ast.walk(tree)
+                       if isinstance(n, ast.ImportFrom) and n.level == 0 and n.module}
+        assert "pint" not in everywhere, path.name

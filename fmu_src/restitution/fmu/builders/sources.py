@@ -33,9 +33,11 @@ BUILD_INFO = "resources/build_info.json"
 #: guard's loader require those packages at start-up in a plain C host (python_env.txt require=).
 BUNDLED_SUBDIRS = {"data"}
 #: Modules at the package's top that read a user's text (a value with its unit, an option, a material by
-#: name): host side only, the FMUs never pass text. Not bundled: units.py would make the guard's loader
-#: require pint (its lazy import counts), which a plain C host need not have.
-HOST_ONLY_MODULES = {"units.py", "inputs.py", "options.py"}
+#: name) and the command that uses them: host side only, the FMUs never pass text. Not bundled: units.py
+#: would make the guard's loader require pint (its lazy import counts), which a plain C host need not
+#: have; and a copy loaded from resources/ is imported whole, so nothing bundled may import these at its
+#: top (tests/fmu/test_package.py checks both).
+HOST_ONLY_MODULES = {"units.py", "inputs.py", "options.py", "cor.py"}
 #: Of fmu/, the slaves need only the interface tables (pure data): these files, and models/*/variables.py.
 BUNDLED_FMU_FILES = {"__init__.py", "table.py"}
 
