@@ -29,9 +29,9 @@ def test_inverse_gives_e_back_through_the_integrated_clamped_law(e):
     assert _clamped_rebound(clamped_damping_ratio(e)) == pytest.approx(e, rel=1e-8, abs=1e-10)
 
 
-def test_the_unclamped_map_overshoots_as_the_issue_states():
+def test_the_unclamped_map_overshoots_on_a_contact_that_cannot_pull():
     """The linear oscillator's formula, applied to a contact that cannot pull, gives back a higher e: about
-    +10 % at e = 0.5 and about +30 % at e = 0.3 (issue 46), the rebound integrated here."""
+    +10 % at e = 0.5 and about +30 % at e = 0.3, the rebound integrated here."""
     over = {e: _clamped_rebound(unclamped_damping_ratio(e)) / e - 1.0 for e in (0.3, 0.5, 0.9)}
     assert 0.08 < over[0.5] < 0.12 and 0.25 < over[0.3] < 0.35 and 0.0 < over[0.9] < 0.01, over
 
