@@ -104,10 +104,11 @@ def _term(coord, a: float) -> str:
     return f"{coord.name}^{a:.3g}" if coord.log else f"exp({a:.3g} {coord.name})"
 
 
-def combinations(problem: Problem, x, cov, corr, fitted: list[int]) -> tuple:
-    """For each group of fitted parameters linked by |correlation| > CORRELATED: the determined combination
-    (stiff eigenvector of the group's Hessian, the other parameters profiled: inv of the covariance block)
-    and the undetermined direction (the sloppy one)."""
+def combinations(problem, x, cov, corr, fitted: list[int]) -> tuple:
+    """For each group of fitted parameters of ``problem`` (a :class:`restitution.fit.likelihood.Problem`)
+    linked by |correlation| > CORRELATED: the determined combination (stiff eigenvector of the group's
+    Hessian, the other parameters profiled: inv of the covariance block) and the undetermined direction
+    (the sloppy one)."""
     groups, seen = [], set()
     for i in range(len(fitted)):
         if i in seen:

@@ -87,8 +87,8 @@ def chosen_ball_fmu(ball_fmu=None, rebuild: bool = False, log=None) -> Path:
 
     path = default_fmu(rebuild=rebuild, log=log).parent / "fmi3" / "BouncingBall.fmu"
     if not path.is_file():
-        raise ValueError(f"no native FMI 3.0 BouncingBall.fmu could be built here (it needs a C compiler): "
-                         f"give --ball-fmu PATH, or use simulation.master = \"closed_form\"")
+        raise ValueError("no native FMI 3.0 BouncingBall.fmu could be built here (it needs a C compiler): "
+                         "give --ball-fmu PATH, or use simulation.master = \"closed_form\"")
     return check_event_ball_fmu(path)
 
 
@@ -135,7 +135,7 @@ def _contacts(instance, ball, scene: Scene, drop: Drop, rebound):
 def _run_drop(instance, scene: Scene, drop: Drop, params: dict, read_names, read_cols,
               interrupt: DeferredInterrupt | None = None, ball=None) -> DropResult:
     sim = scene.simulation
-    g, v_min = sim.gravity, sim.v_min
+    g = sim.gravity
     # Reset, then set the parameters and the first impact's speed in initialization mode: the
     # evaluation at the exit from initialization mode is then the first impact's, not a wasted one.
     v_first = math.sqrt(2.0 * g * drop.drop_height)

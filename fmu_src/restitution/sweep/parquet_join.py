@@ -13,7 +13,6 @@ from __future__ import annotations
 import errno
 import os
 import struct
-from pathlib import Path
 
 __all__ = ["read_footer", "join_parquet", "key_value", "JoinError"]
 
