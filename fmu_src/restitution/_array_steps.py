@@ -77,11 +77,9 @@ def _zener_where_needed(lam, needed, method, rtol, skipped_tau0):
     """(e_ze, 1 - e_ze, tau0) of arrays, computed only where the plate-wave effect is needed;
     (1, 0, ``skipped_tau0``) elsewhere."""
     lam = np.asarray(lam)  # float already: Eq. (12) of float arrays
-    if needed is True:  # the auto skip's one True (every case needs Zener), "on": no mask to read
-        return zener_solution(lam, method, rtol)
+    if needed is True or np.all(needed):  # elementwise methods: same values as the masked evaluation, no
+        return zener_solution(lam, method, rtol)  # gather/scatter (the auto skip's one True: no mask to read)
     needed = np.broadcast_to(needed, lam.shape)
-    if needed.all():  # elementwise methods: same values as the masked evaluation, no gather/scatter
-        return zener_solution(lam, method, rtol)
     e_ze, d_ze, tau0 = np.ones(lam.shape), np.zeros(lam.shape), np.full(lam.shape, skipped_tau0)
     if needed.any():
         e_ze[needed], d_ze[needed], tau0[needed] = zener_solution(lam[needed], method, rtol)
@@ -91,11 +89,9 @@ def _zener_where_needed(lam, needed, method, rtol, skipped_tau0):
 def _zener_restitution_where_needed(lam, needed, method, rtol):
     """e_ze of arrays alone (:func:`_zener_where_needed`'s first value, by the same operations)."""
     lam = np.asarray(lam)
-    if needed is True:
+    if needed is True or np.all(needed):
         return zener_restitution_only(lam, method, rtol)
     needed = np.broadcast_to(needed, lam.shape)
-    if needed.all():
-        return zener_restitution_only(lam, method, rtol)
     e_ze = np.ones(lam.shape)
     if needed.any():
         e_ze[needed] = zener_restitution_only(lam[needed], method, rtol)
