@@ -146,47 +146,16 @@ def _restitution_e45_array(v_star, eps_y):
     and where the power overflows (loss = inf) e = 1 - inf is floored at 0 as the scalar form's capped
     exponent is; numpy's floating-point flags for both are not raised to the caller."""
     shape = np.broadcast_shapes(v_star.shape, np.shape(eps_y))
-    if eps_y.__class__ is float and v_star.size > _BLOCK and v_star.flags.c_contiguous:
-        return _restitution_e45_blocks(v_star, eps_y)
-    e = np.empty(shape)
+    clamped = np.maximum(v_star, 1.0, out=np.empty(shape))
     with np.errstate(divide="ignore", over="ignore", under="ignore"):
-        _e45_into(v_star, 9.5 * eps_y, 0.0361 * eps_y ** -0.114, np.empty(shape), e)
-    return e
-
-
-def _e45_into(v_star, exponent, coefficient, clamped, e):
-    """Eq. (8) of the array ``v_star`` into ``e``, with ``clamped`` (V* clamped at 1) as the other work array,
-    both of the broadcast shape; ``exponent`` = 9.5 eps_y and ``coefficient`` = 0.0361 eps_y^-0.114, scalars or
-    arrays. The caller silences numpy's flags (log of 0, the power's overflow and underflow)."""
-    np.maximum(v_star, 1.0, out=clamped)
-    loss = np.subtract(clamped, 1.0, out=e)
-    np.log(loss, out=loss)  # -inf at V* <= 1
-    loss *= exponent
-    np.exp(loss, out=loss)  # (V* - 1)^(9.5 eps_y)
-    loss *= np.log(clamped, out=clamped)
-    loss *= coefficient
-    np.subtract(1.0, loss, out=loss)
-    np.maximum(loss, 0.0, out=loss)
-
-
-#: Cases per block of :func:`_restitution_e45_blocks`: its two arrays (256 kB each) stay in the cache.
-_BLOCK = 32768
-
-
-def _restitution_e45_blocks(v_star, eps_y):
-    """:func:`_restitution_e45_array` of a contiguous array of many V* and one eps_y (a Python float): the
-    same operations on the same numbers (:func:`_e45_into`), block by block, the clamped V* in one
-    block-sized buffer and the loss in the result's own memory, so that the ten passes of a block run in
-    the cache instead of streaming two whole arrays through memory ten times."""
-    e = np.empty(v_star.shape)
-    cases, out = v_star.reshape(-1), e.reshape(-1)
-    clamped = np.empty(min(_BLOCK, cases.size))
-    exponent, coefficient = 9.5 * eps_y, 0.0361 * eps_y ** -0.114
-    with np.errstate(divide="ignore", over="ignore", under="ignore"):
-        for start in range(0, cases.size, _BLOCK):
-            block = out[start:start + _BLOCK]
-            _e45_into(cases[start:start + _BLOCK], exponent, coefficient, clamped[:block.size], block)
-    return e
+        loss = np.subtract(clamped, 1.0)
+        np.log(loss, out=loss)  # -inf at V* <= 1
+        loss *= 9.5 * eps_y
+        np.exp(loss, out=loss)  # (V* - 1)^(9.5 eps_y)
+        loss *= np.log(clamped, out=clamped)
+        loss *= 0.0361 * eps_y ** -0.114
+        e = np.subtract(1.0, loss, out=loss)
+    return np.maximum(e, 0.0, out=e)
 
 
 _LOG_E45_COEFFICIENT = math.log(0.0361)

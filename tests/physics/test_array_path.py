@@ -274,21 +274,3 @@ def test_auto_skip_of_small_losses_by_one_comparison_selects_what_the_subtractio
     assert_agree(got, one_by_one(v, params, edge, effect_tolerance=0.75), v, params, "tolerance 0.75",
                  effect_tolerance=0.75)
 
-
-def test_e45_in_blocks_is_the_whole_array_form_bit_for_bit():
-    """Eq. (8) of many speeds and one eps_y runs block by block (jgm._BLOCK cases at a time, in the cache):
-    the same numpy operations on each case as the whole-array form, so every value is the same double
-    (issue 47 keeps every output of impact() bit-identical; elementwise ufuncs give a case the same result
-    whatever block it is in). The whole-array form is reached by a strided view (not contiguous); the
-    speeds cover V* <= 1, the join, the fit range, beyond it (e floored at 0) and a length that is not a
-    multiple of the block; the mpmath test above holds both to the printed equation."""
-    rng = np.random.default_rng(47)
-    n = 2 * jgm._BLOCK + 11
-    v_star = np.concatenate([[0.0, 1.0, np.nextafter(1.0, 2.0), 1e12], 10.0 ** rng.uniform(-1.0, 6.0, n - 4)])
-    strided = np.repeat(v_star, 2)[::2]
-    assert not strided.flags.c_contiguous and np.array_equal(strided, v_star)
-    for eps_y in (3.6e-3, 10.0):
-        blocks = jgm.restitution_e45(v_star, eps_y)
-        whole = jgm.restitution_e45(strided, eps_y)
-        assert blocks.shape == v_star.shape and blocks.flags.owndata
-        assert blocks.tobytes() == whole.tobytes(), eps_y
