@@ -273,4 +273,3 @@ def test_auto_skip_of_small_losses_by_one_comparison_selects_what_the_subtractio
     got = r.impact(v, **params, plate_edge_distance=edge, effect_tolerance=0.75)
     assert_agree(got, one_by_one(v, params, edge, effect_tolerance=0.75), v, params, "tolerance 0.75",
                  effect_tolerance=0.75)
-
