@@ -13,6 +13,10 @@ with random approach speeds, log-uniform from 0.2 to 5 m/s, the default options 
   paper's fit of e_ze, Eq. 13, and 20) with the parameter terms computed once. Before timing, its e and
   v_rebound are compared with impact()'s under the same equations (``zener_method="paper_fit"``, both
   effects on; the benchmark stops if they differ beyond rounding).
+* ``result arrays alone``: no physics, only what the default result's arrays cost to make: each of
+  ImpactResult's real fields (17) as one product v * c and each flag (7) as one comparison v < c, into
+  fresh arrays as impact() returns them (owned, writable, one per field). No goal: it is the part of the
+  first side's cost that any implementation returning those arrays pays, printed beside the floor.
 
 The sides take turns (the first rotating), ``--repeats`` times each, CPU time of this thread
 (``time.thread_time``: page faults of fresh arrays included); a ratio is the median of the per-turn ratios.
@@ -44,7 +48,7 @@ from harness import cpu_name  # noqa: E402
 GOALS = {"impact": 2.0, "impact e, v_rebound": 1.2}  #: each side / the numpy floor, at most
 DIAMETER = 6.35e-3  #: sphere diameter [m], also the plate's thickness
 SPHERE, PLATE = "s2_tool_steel", "al_6061"
-SIDES = ("impact", "impact e, v_rebound", "numpy floor")
+SIDES = ("impact", "impact e, v_rebound", "numpy floor", "result arrays alone")
 
 
 def cases(n: int, seed: int = 2026):
@@ -70,6 +74,15 @@ def disagreement(v, params) -> float:
                float(np.max(np.abs(v_rebound - ref.v_rebound) - 1e-12 * np.maximum(1.0, np.abs(ref.v_rebound)))), 0.0)
 
 
+def result_arrays_alone(v) -> list:
+    """The arrays of a default ImpactResult of the speeds ``v`` without its physics: one fresh product per
+    real field and one fresh comparison per flag."""
+    from restitution.model import RECORD_FLAGS, RECORD_REALS
+
+    flags = len(RECORD_FLAGS) - 1  # "valid" is a property of the result, not an array it holds
+    return [v * 1.5 for _ in RECORD_REALS] + [v < 1.0 for _ in range(flags)]
+
+
 def measure(n: int, repeats: int) -> dict:
     import restitution
 
@@ -80,7 +93,8 @@ def measure(n: int, repeats: int) -> dict:
     terms = numpy_floor.floor_terms(params)
     run = {"impact": lambda: restitution.impact(v, **params),
            "impact e, v_rebound": lambda: restitution.impact(v, **params, outputs=("e", "v_rebound")),
-           "numpy floor": lambda: numpy_floor.e_and_rebound(v, terms)}
+           "numpy floor": lambda: numpy_floor.e_and_rebound(v, terms),
+           "result arrays alone": lambda: result_arrays_alone(v)}
     times = {side: [] for side in SIDES}
     for side in SIDES:
         run[side]()  # warm-up
@@ -90,7 +104,8 @@ def measure(n: int, repeats: int) -> dict:
             start = time.thread_time()
             run[side]()
             times[side].append(time.thread_time() - start)
-    ratios = {side: statistics.median(a / b for a, b in zip(times[side], times["numpy floor"])) for side in GOALS}
+    ratios = {side: statistics.median(a / b for a, b in zip(times[side], times["numpy floor"]))
+              for side in (*GOALS, "result arrays alone")}
     return {"cases": n, "seconds": {side: statistics.median(t) for side, t in times.items()}, "ratios": ratios,
             "load": os.getloadavg()}
 
@@ -103,6 +118,9 @@ def report(m: dict) -> str:
         ratio = m["ratios"][side]
         lines.append(f"{side} / numpy floor, {m['cases']:.3g} cases: {ratio:.2f}x "
                      f"(goal <= {goal:g}x: {'met' if ratio <= goal else 'NOT met'})")
+    lines.append(f"result arrays alone / numpy floor, {m['cases']:.3g} cases: {m['ratios']['result arrays alone']:.2f}x "
+                 f"(no goal: the 17 real and 7 flag arrays of the default result made fresh, no physics; "
+                 f"{sec['result arrays alone']:.4g} s)")
     return "\n".join(lines)
 
 

@@ -36,6 +36,8 @@ def _skip_small_loss(e_ep, tolerance):
     if np.ndim(e_ep) == 0:
         return where(1.0 - e_ep < tolerance, 1.0, e_ep)
     threshold = _loss_threshold(tolerance)
+    if threshold is not None and e_ep.size and e_ep.max() <= threshold:  # no case to skip: one reduction, no mask
+        return e_ep  # (NaN: max is NaN, not <= threshold, and the mask decides)
     np.copyto(e_ep, 1.0, where=(e_ep > threshold) if threshold is not None else np.subtract(1.0, e_ep) < tolerance)
     return e_ep
 
@@ -75,9 +77,9 @@ def _zener_where_needed(lam, needed, method, rtol, skipped_tau0):
     """(e_ze, 1 - e_ze, tau0) of arrays, computed only where the plate-wave effect is needed;
     (1, 0, ``skipped_tau0``) elsewhere."""
     lam = np.asarray(lam)  # float already: Eq. (12) of float arrays
+    if needed is True or np.all(needed):  # elementwise methods: same values as the masked evaluation, no
+        return zener_solution(lam, method, rtol)  # gather/scatter (the auto skip's one True: no mask to read)
     needed = np.broadcast_to(needed, lam.shape)
-    if needed.all():  # elementwise methods: same values as the masked evaluation, no gather/scatter
-        return zener_solution(lam, method, rtol)
     e_ze, d_ze, tau0 = np.ones(lam.shape), np.zeros(lam.shape), np.full(lam.shape, skipped_tau0)
     if needed.any():
         e_ze[needed], d_ze[needed], tau0[needed] = zener_solution(lam[needed], method, rtol)
@@ -87,9 +89,9 @@ def _zener_where_needed(lam, needed, method, rtol, skipped_tau0):
 def _zener_restitution_where_needed(lam, needed, method, rtol):
     """e_ze of arrays alone (:func:`_zener_where_needed`'s first value, by the same operations)."""
     lam = np.asarray(lam)
-    needed = np.broadcast_to(needed, lam.shape)
-    if needed.all():
+    if needed is True or np.all(needed):
         return zener_restitution_only(lam, method, rtol)
+    needed = np.broadcast_to(needed, lam.shape)
     e_ze = np.ones(lam.shape)
     if needed.any():
         e_ze[needed] = zener_restitution_only(lam[needed], method, rtol)

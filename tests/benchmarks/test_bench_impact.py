@@ -20,6 +20,21 @@ def test_quick_run_prints_the_sides_and_the_ratios(tmp_path):
         match = re.search(rf"^{side} / numpy floor, 1e\+04 cases: ({NUMBER})x \(goal <= {goal}x: (met|NOT met)\)$",
                           out, re.M)
         assert match and float(match.group(1)) > 0, out
+    assert re.search(rf"^result arrays alone / numpy floor, 1e\+04 cases: {NUMBER}x \(no goal: ", out, re.M), out
+
+
+def test_the_result_arrays_alone_are_as_many_and_of_the_kinds_impact_returns():
+    """The side without physics makes one fresh array per field of the default ImpactResult, of its kind
+    (float for the reals, bool for the flags), counted from the result impact() returns."""
+    import bench_impact
+    import restitution
+
+    v, params = bench_impact.cases(100), bench_impact.parameters()
+    fields = vars(restitution.impact(v, **params))
+    arrays = bench_impact.result_arrays_alone(v)
+    assert len(arrays) == len(fields)
+    assert sorted(a.dtype.kind for a in arrays) == sorted(np.asarray(x).dtype.kind for x in fields.values())
+    assert all(a.shape == v.shape and a.flags.owndata for a in arrays)
 
 
 def test_the_numpy_floor_is_the_model_on_e_and_v_rebound():

@@ -145,3 +145,17 @@ def test_values_not_all_finite_give_none():
         values = np.r_[np.random.default_rng(1).random(N), bad]
         assert osx.moments_and_order_statistics(values, [N // 2], Scratch()) is None
     assert osx.moments_and_order_statistics(np.array([1.0, np.nan]), [0], Scratch()) is None  # small too
+
+
+@pytest.mark.parametrize("values", [
+    np.array([]), np.array([np.nan]), np.array([3.0, np.nan, 1.0, np.nan, 3.0, -0.0, 0.0]),
+    np.random.default_rng(7).integers(0, 5, 40).astype(float), np.random.default_rng(8).integers(0, 300, 2000),
+    np.arange(12.0).reshape(3, 4)[::-1]], ids=["empty", "nan", "nans and zeros", "few floats", "ints", "2-D"])
+def test_distinct_is_numpys_unique(values):
+    """distinct() gives np.unique's distinct values and inverse (numpy's own, the reference: the same sorted
+    numbers, one NaN for any NaNs), without importing numpy.ma."""
+    want, want_inverse = np.unique(values, return_inverse=True)
+    got, inverse = osx.distinct(values, return_inverse=True)
+    assert np.array_equal(got, want, equal_nan=True) and got.dtype == want.dtype
+    assert np.array_equal(inverse, want_inverse.ravel())
+    assert np.array_equal(osx.distinct(values), want, equal_nan=True)

@@ -26,7 +26,7 @@ import math
 
 import numpy as np
 
-__all__ = ["order_statistics", "moments_and_order_statistics", "Scratch"]
+__all__ = ["order_statistics", "moments_and_order_statistics", "Scratch", "distinct"]
 
 #: Equal-width bins a level counts into (a 16 kB count array; smooth data of 10^6 values leaves a few
 #: hundred in the bin of each rank).
@@ -144,7 +144,7 @@ def _from_shifted(values, ranks, scratch, work, bins, lo, hi) -> np.ndarray:
     np.copyto(bins, work, casting="unsafe")  # truncation: the floor of a number in [0, BINS - 1]
     ends = np.cumsum(np.bincount(bins, minlength=BINS))
     which = np.searchsorted(ends, ranks, side="right")  # the bin holding each rank
-    picked = np.unique(which)
+    picked = distinct(which)
     if (ends[picked] - np.where(picked > 0, ends[picked - 1], 0)).sum() > n // CROWDED:
         return np.partition(values, ranks)[ranks]  # the wanted bins hold much: counting won little
     # every wanted bin's members copied out before any is selected from: a nested level reuses the scratch
@@ -165,3 +165,23 @@ def _span(values: np.ndarray, ranks: np.ndarray) -> tuple[float, float]:
     low = max(0, int(ranks.min() * sample.size // n) - MARGIN)
     high = min(last, int(ranks.max() * sample.size // n) + 1 + MARGIN)
     return float(sample[low]), float(sample[high])
+
+
+def distinct(values: np.ndarray, return_inverse: bool = False):
+    """The distinct values of ``values`` (flattened), sorted (one NaN, last, for any NaNs), and with ``return_inverse``
+    also the position of each value among them: ``np.unique``'s results, without its check for a masked
+    array, which imports numpy.ma (0.03 s with bytecode caches, 0.2 s without) for the few values a
+    summary's statistics ask it to sort."""
+    values = np.asarray(values).ravel()
+    order = np.argsort(values, kind="stable") if return_inverse else None
+    ordered = values[order] if return_inverse else np.sort(values)
+    first = np.empty(ordered.size, dtype=bool)
+    first[:1] = True
+    np.not_equal(ordered[1:], ordered[:-1], out=first[1:])
+    if ordered.dtype.kind == "f" and ordered.size and ordered[-1] != ordered[-1]:  # NaNs, sorted last: one kept
+        first[int(np.argmax(ordered != ordered)) + 1:] = False
+    if not return_inverse:
+        return ordered[first]
+    inverse = np.empty(values.size, dtype=np.intp)
+    inverse[order] = np.cumsum(first) - 1
+    return ordered[first], inverse

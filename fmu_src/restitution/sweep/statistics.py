@@ -22,7 +22,7 @@ import numpy as np
 from ..assumptions import E_NEGATIVE_MEANING, meaning_lines
 from ..fmu.models.sphere_plate_impact.variables import TABLE
 from ..output_files import write_json
-from .order_statistics import Scratch, moments_and_order_statistics, order_statistics
+from .order_statistics import Scratch, distinct, moments_and_order_statistics, order_statistics
 from .student_t import t975
 from .spec import OUTPUTS, T_OVER_D, pair_label
 from .table import VALIDITY, table_counts
@@ -48,7 +48,7 @@ def _student_t975(dof: np.ndarray) -> np.ndarray:
     """The 97.5 % quantile of Student's t with ``dof`` degrees of freedom (NaN where dof < 1), once per
     distinct dof (:func:`~.student_t.t975`: plain Python, where scipy.special's import took 0.3 s)."""
     dof = np.asarray(dof, dtype=float)
-    values, inverse = np.unique(dof, return_inverse=True)
+    values, inverse = distinct(dof, return_inverse=True)
     return np.array([t975(d) for d in values])[inverse.ravel()].reshape(dof.shape)
 
 
