@@ -6,8 +6,9 @@
  * the build command: POSIX threads, or a slim reader/writer lock on Windows. RST_FRONT_NO_LOCK leaves
  * it out for a platform with neither. With POSIX threads and a compiler with the GCC/Clang __atomic
  * builtins (gcc, clang, zig cc) the lock is a word taken with one compare-and-swap and given back with
- * one exchange where no other thread wants it (the common case: FMI asks nothing of a host that calls
- * one instance from several threads); a thread that finds it taken waits on a POSIX condition variable
+ * a plain release store and a read of the waiters' count where no other thread wants it (the common
+ * case: FMI asks nothing of a host that calls one instance from several threads; an exchange would cost
+ * a locked instruction per call); a thread that finds it taken waits on a POSIX condition variable
  * (RST_LOCK_ATOMIC, below). Elsewhere it is a plain pthread mutex. */
 #if !defined(RST_FRONT_NO_LOCK)
 #if defined(_WIN32)
@@ -167,7 +168,8 @@ struct rst_instance {
     rst_message *pending;     /* in the order they were logged */
     rst_message **pending_end;
 #if defined(RST_LOCK_ATOMIC)
-    int lock_word;            /* 0 free, 1 held, 2 held and a thread may be waiting for it */
+    int lock_word;            /* 0 free, 1 held */
+    int waiting;              /* threads waiting for the word (changed under `lock`, read by whoever frees it) */
     pthread_mutex_t lock;     /* guards the waiting: threads that found the word taken wait on `waiters` */
     pthread_cond_t waiters;
 #elif defined(RST_LOCK_PTHREAD)
@@ -194,6 +196,8 @@ typedef struct {
 /* Converters between the version's value arrays and the core's doubles: elements first ... first + n - 1
  * of `values`, a whole run per call (a get or set of many values pays one indirect call per run, not one
  * per value). RST_CONVERTERS defines a pair from the conversion of one element. */
+/* A NULL converter: the values are doubles already (FMI 2.0 Real, FMI 3.0 Float64), read and written
+ * without a call per run (the commonest get and set). */
 typedef void (*rst_read_fn)(const void *values, size_t first, size_t n, double out[]);
 typedef void (*rst_write_fn)(void *values, size_t first, size_t n, const double in[]);
 #define RST_CONVERTERS(read_name, write_name, c_type, to_double, from_double)                   \
@@ -329,7 +333,8 @@ static inline void front_release(rst_instance *inst)
 {
     inst->in_call = 0;
 #if defined(RST_LOCK_ATOMIC)
-    if (__atomic_exchange_n(&inst->lock_word, 0, __ATOMIC_RELEASE) == 2)
+    __atomic_store_n(&inst->lock_word, 0, __ATOMIC_RELEASE);
+    if (__atomic_load_n(&inst->waiting, __ATOMIC_RELAXED) != 0)
         front_wake_waiter(inst);
 #elif defined(RST_LOCK_PTHREAD)
     pthread_mutex_unlock(&inst->lock);

@@ -139,7 +139,7 @@ static int check_set(rst_instance *inst, const char *function, rst_vr vr, unsign
     char text[40], buffer[80];
     if (!check_vr(inst, function, vr, kinds))
         return 0;
-    if (is_time(inst, vr)) {
+    if (vr >= inst->model->n_variables) { /* what check_vr accepts beyond the table: time */
         rst_log(inst, RST_ERROR, "%s: time is the independent variable and cannot be set", function);
         return 0;
     }
@@ -222,7 +222,9 @@ rst_status front_set(void *c, const char *function, unsigned int kinds, const rs
             LEAVE(RST_ERROR);
         }
     }
-    if (n > 0) /* (values may be NULL then) */
+    if (n > 0 && read == NULL) /* doubles: copied, so that the values checked are the values stored */
+        memcpy(all, values, n * sizeof(double));
+    else if (n > 0) /* (values may be NULL then) */
         read(values, 0, n, all);
     status = set_checked(inst, function, kinds, vr, n, all);
     if (all != buffer)
@@ -277,12 +279,14 @@ rst_status front_read(rst_instance *inst, const char *function, unsigned int kin
     rst_status status = RST_OK;
     for (i0 = 0; i0 < n; i0 += CHUNK) {
         size_t m = n - i0 < CHUNK ? n - i0 : CHUNK;
-        rst_status s = get_chunk(inst, function, kinds, vr + i0, m, buffer);
+        /* doubles (write NULL) straight into the host's array: on an error its values are undefined */
+        rst_status s = get_chunk(inst, function, kinds, vr + i0, m, write == NULL ? (double *)values + i0 : buffer);
         if (s > status)
             status = s;
         if (s >= RST_ERROR)
             return status;
-        write(values, i0, m, buffer);
+        if (write != NULL)
+            write(values, i0, m, buffer);
     }
     return status;
 }
