@@ -11,8 +11,6 @@
 /* ------------------------------------------------------------------------------------------------ */
 /* Accessors for backends                                                                           */
 /* ------------------------------------------------------------------------------------------------ */
-double *rst_store(rst_instance *inst) { return inst->store; }
-void *rst_backend(rst_instance *inst) { return inst->backend; }
 const char *rst_instance_name(const rst_instance *inst) { return inst->name; }
 rst_mode rst_mode_of(const rst_instance *inst) { return inst->mode; }
 double rst_start_time(const rst_instance *inst) { return inst->has_start ? inst->start_time : 0.0; }
@@ -103,14 +101,4 @@ int front_refuse_mode(rst_instance *inst, const char *function)
             front_mode_name(inst, inst->mode, buffer, sizeof buffer), inst->api->standard,
             inst->model_exchange ? "model-exchange" : "co-simulation");
     return 0;
-}
-
-/* A backend's answer: RST_ERROR puts the instance into the error mode, RST_FATAL latches it. */
-rst_status front_backend_status(rst_instance *inst, rst_status status)
-{
-    if (status == RST_FATAL)
-        inst->mode = RST_MODE_FATAL;
-    else if (status == RST_ERROR)
-        inst->mode = RST_MODE_ERROR;
-    return status;
 }

@@ -58,7 +58,7 @@ static rst_status read_vector(rst_instance *inst, const char *function, const un
     if (inst->model->get_outputs != NULL)
         return front_read(inst, function, RST_AS_REAL, vrs, n, out, NULL);
     for (i = 0; i < n; i++)
-        out[i] = inst->store[vrs[i]];
+        out[i] = inst->head.store[vrs[i]];
     return RST_OK;
 }
 
@@ -154,7 +154,7 @@ rst_status front_set_continuous_states(void *c, const char *function, const doub
             LEAVE(RST_ERROR);
         }
     for (i = 0; i < n; i++)
-        inst->store[inst->model->state_vrs[i]] = x[i];
+        inst->head.store[inst->model->state_vrs[i]] = x[i];
     if (inst->model->set != NULL && n > 0)
         status = front_backend_status(inst, inst->model->set(inst, RST_REAL, inst->model->state_vrs, n, x));
     LEAVE(status);

@@ -32,7 +32,6 @@
 #define front_unlock_and_deliver RST_PREFIXED(front_unlock_and_deliver)
 #define front_refuse_mode RST_PREFIXED(front_refuse_mode)
 #define front_mode_name RST_PREFIXED(front_mode_name)
-#define front_backend_status RST_PREFIXED(front_backend_status)
 #define front_in_range RST_PREFIXED(front_in_range)
 #define front_describe_value RST_PREFIXED(front_describe_value)
 #define front_type_name RST_PREFIXED(front_type_name)
@@ -138,6 +137,7 @@ typedef void *(*rst_allocate_fn)(size_t n, size_t size); /* zeroed, as calloc */
 typedef void (*rst_release_fn)(void *pointer);
 
 struct rst_instance {
+    rst_instance_head head; /* first: the store and the backend data, which backends read inline (rst_front.h) */
     unsigned int magic;
     const rst_model *model;
     const rst_api *api;
@@ -162,8 +162,6 @@ struct rst_instance {
     rst_status last_step_status;
     size_t n_state;     /* state variables of the table */
     rst_state *states;  /* FMU states made by this instance, to tell ours from any other pointer */
-    double *store;
-    void *backend;
     int in_call;              /* set while a call holds the instance: its messages wait in `pending` */
     rst_message *pending;     /* in the order they were logged */
     rst_message **pending_end;
@@ -223,7 +221,6 @@ void front_unlock_and_deliver(rst_instance *inst); /* unlocks, then delivers the
 int front_refuse_mode(rst_instance *inst, const char *function); /* logs why the mode refuses; 0 */
 /* The mode as messages name it; `buffer` holds the text of the modes that name a function. */
 const char *front_mode_name(const rst_instance *inst, rst_mode mode, char *buffer, size_t size);
-rst_status front_backend_status(rst_instance *inst, rst_status status);       /* Error, Fatal: change mode */
 
 /* Values (rst_values.c). */
 void front_reset_store(rst_instance *inst); /* every variable back to its start value */
@@ -306,6 +303,16 @@ rst_status front_serialized_size(void *c, const char *function, void *state, siz
 rst_status front_serialize(void *c, const char *function, void *state, unsigned char bytes[], size_t size);
 rst_status front_deserialize(void *c, const char *function, const unsigned char bytes[], size_t size,
                              void **state);
+
+/* A backend's answer: RST_ERROR puts the instance into the error mode, RST_FATAL latches it. */
+static inline rst_status front_backend_status(rst_instance *inst, rst_status status)
+{
+    if (status == RST_FATAL)
+        inst->mode = RST_MODE_FATAL;
+    else if (status == RST_ERROR)
+        inst->mode = RST_MODE_ERROR;
+    return status;
+}
 
 /* NULL unless c is one of our live instances. */
 static inline rst_instance *front_instance(void *c)

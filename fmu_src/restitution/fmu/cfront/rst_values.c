@@ -18,7 +18,7 @@ void front_reset_store(rst_instance *inst)
 {
     size_t i;
     for (i = 0; i < inst->model->n_variables; i++)
-        inst->store[i] = inst->model->variables[i].start;
+        inst->head.store[i] = inst->model->variables[i].start;
 }
 
 void front_describe_value(rst_type type, double value, char *out, size_t size)
@@ -92,8 +92,8 @@ double rst_time(const rst_instance *inst)
     return inst->last_time;
 }
 
-/* Is `vr` a variable of one of the `kinds` (time included)? Logs why not. */
-static int check_vr(rst_instance *inst, const char *function, rst_vr vr, unsigned int kinds)
+/* check_vr beyond its common case: time, or a value reference refused (logged). */
+static int check_other_vr(rst_instance *inst, const char *function, rst_vr vr, unsigned int kinds)
 {
     const rst_variable *var;
     if (is_time(inst, vr)) {
@@ -116,6 +116,15 @@ static int check_vr(rst_instance *inst, const char *function, rst_vr vr, unsigne
         return 0;
     }
     return 1;
+}
+
+/* Is `vr` a variable of one of the `kinds` (time included)? Logs why not. The common case (a variable of
+ * the table, of a kind asked for) inline, without the messages. */
+static int check_vr(rst_instance *inst, const char *function, rst_vr vr, unsigned int kinds)
+{
+    if (vr < inst->model->n_variables && (kinds & (unsigned int)access_of(&inst->model->variables[vr])))
+        return 1;
+    return check_other_vr(inst, function, vr, kinds);
 }
 
 /* May the host set `var` in the current mode? (Inputs and parameters in instantiated and
@@ -161,7 +170,7 @@ static int check_set(rst_instance *inst, const char *function, rst_vr vr, unsign
     /* The value the variable holds, bit for bit, was checked when the variable got it (its start value,
      * inside its declared range; a set call; a validated FMU state): hosts that set every input at every
      * step pay the range and the backend's checks for the values that changed only. */
-    if (memcmp(&value, &inst->store[vr], sizeof value) == 0)
+    if (memcmp(&value, &inst->head.store[vr], sizeof value) == 0)
         return 1;
     if (!front_in_range(var, value)) {
         front_describe_value(var->type, value, text, sizeof text);
@@ -184,7 +193,7 @@ static rst_status set_checked(rst_instance *inst, const char *function, unsigned
         if (!check_set(inst, function, vr[i], kinds, values[i]))
             return RST_ERROR;
     for (i = 0; i < n; i++)
-        inst->store[vr[i]] = values[i];
+        inst->head.store[vr[i]] = values[i];
     if (inst->model->set == NULL || n == 0)
         return RST_OK;
     /* the kinds of one call are of one storage type (Integer and Enumeration are both integers) */
@@ -251,7 +260,7 @@ static rst_status get_chunk(rst_instance *inst, const char *function, unsigned i
             out[i] = rst_time(inst);
             continue;
         }
-        out[i] = inst->store[vr[i]];
+        out[i] = inst->head.store[vr[i]];
         if (computed_by_backend && (var->causality == RST_OUTPUT || var->causality == RST_LOCAL ||
                                     var->causality == RST_CALCULATEDPARAMETER)) {
             position[n_outputs] = i;
