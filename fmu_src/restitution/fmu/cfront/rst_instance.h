@@ -32,7 +32,6 @@
 #define front_unlock_and_deliver RST_PREFIXED(front_unlock_and_deliver)
 #define front_refuse_mode RST_PREFIXED(front_refuse_mode)
 #define front_mode_name RST_PREFIXED(front_mode_name)
-#define front_in_range RST_PREFIXED(front_in_range)
 #define front_describe_value RST_PREFIXED(front_describe_value)
 #define front_type_name RST_PREFIXED(front_type_name)
 #define front_reset_store RST_PREFIXED(front_reset_store)
@@ -75,6 +74,8 @@
 #define front_serialize RST_PREFIXED(front_serialize)
 #define front_deserialize RST_PREFIXED(front_deserialize)
 #endif
+
+#include <math.h>
 
 #if defined(RST_LOCK_PTHREAD)
 #include <pthread.h>
@@ -228,7 +229,6 @@ void front_reset_store(rst_instance *inst); /* every variable back to its start 
  * value to `write`: inputs and parameters from the store, what the model computes from the backend. */
 rst_status front_read(rst_instance *inst, const char *function, unsigned int kinds, const rst_vr vr[], size_t n,
                       void *values, rst_write_fn write);
-int front_in_range(const rst_variable *var, double value);
 void front_describe_value(rst_type type, double value, char *out, size_t size);
 const char *front_type_name(rst_type type);
 
@@ -303,6 +303,21 @@ rst_status front_serialized_size(void *c, const char *function, void *state, siz
 rst_status front_serialize(void *c, const char *function, void *state, unsigned char bytes[], size_t size);
 rst_status front_deserialize(void *c, const char *function, const unsigned char bytes[], size_t size,
                              void **state);
+
+/* Is `value` inside the variable's declared range? (Reals: finite too.) Inline: a set checks every
+ * value it changes. */
+static inline int front_in_range(const rst_variable *var, double value)
+{
+    if (var->type == RST_BOOLEAN)
+        return value == 0.0 || value == 1.0;
+    if (!isfinite(value))
+        return 0;
+    if (var->low_open ? !(value > var->low) : !(value >= var->low))
+        return 0;
+    if (var->high_open ? !(value < var->high) : !(value <= var->high))
+        return 0;
+    return 1;
+}
 
 /* A backend's answer: RST_ERROR puts the instance into the error mode, RST_FATAL latches it. */
 static inline rst_status front_backend_status(rst_instance *inst, rst_status status)

@@ -36,20 +36,6 @@ const char *front_type_name(rst_type type)
     return type == RST_REAL ? "Real" : type == RST_INTEGER ? "Integer" : "Boolean";
 }
 
-/* Is `value` inside the variable's declared range? (Reals: finite too.) */
-int front_in_range(const rst_variable *var, double value)
-{
-    if (var->type == RST_BOOLEAN)
-        return value == 0.0 || value == 1.0;
-    if (!isfinite(value))
-        return 0;
-    if (var->low_open ? !(value > var->low) : !(value >= var->low))
-        return 0;
-    if (var->high_open ? !(value < var->high) : !(value <= var->high))
-        return 0;
-    return 1;
-}
-
 /* The access kind of a variable: its type, or Enumeration for an Integer with named codes. */
 static rst_access access_of(const rst_variable *var)
 {
@@ -120,7 +106,7 @@ static int check_other_vr(rst_instance *inst, const char *function, rst_vr vr, u
 
 /* Is `vr` a variable of one of the `kinds` (time included)? Logs why not. The common case (a variable of
  * the table, of a kind asked for) inline, without the messages. */
-static int check_vr(rst_instance *inst, const char *function, rst_vr vr, unsigned int kinds)
+static inline int check_vr(rst_instance *inst, const char *function, rst_vr vr, unsigned int kinds)
 {
     if (vr < inst->model->n_variables && (kinds & (unsigned int)access_of(&inst->model->variables[vr])))
         return 1;
@@ -221,6 +207,7 @@ rst_status front_set(void *c, const char *function, unsigned int kinds, const rs
 {
     double buffer[CHUNK], *all = buffer;
     rst_status status;
+    size_t i;
     ENTER(function, SET_MODES)
     if (!check_counts(inst, function, vr, n, values, n_values))
         LEAVE(RST_ERROR);
@@ -231,8 +218,9 @@ rst_status front_set(void *c, const char *function, unsigned int kinds, const rs
             LEAVE(RST_ERROR);
         }
     }
-    if (n > 0 && read == NULL) /* doubles: copied, so that the values checked are the values stored */
-        memcpy(all, values, n * sizeof(double));
+    if (read == NULL) /* doubles: copied (so that the values checked are those stored), a few: no memcpy call */
+        for (i = 0; i < n; i++)
+            all[i] = ((const double *)values)[i];
     else if (n > 0) /* (values may be NULL then) */
         read(values, 0, n, all);
     status = set_checked(inst, function, kinds, vr, n, all);
@@ -286,6 +274,8 @@ rst_status front_read(rst_instance *inst, const char *function, unsigned int kin
     size_t i0;
     double buffer[CHUNK];
     rst_status status = RST_OK;
+    if (write == NULL && n <= CHUNK) /* the commonest get: a few doubles, one run */
+        return get_chunk(inst, function, kinds, vr, n, (double *)values);
     for (i0 = 0; i0 < n; i0 += CHUNK) {
         size_t m = n - i0 < CHUNK ? n - i0 : CHUNK;
         /* doubles (write NULL) straight into the host's array: on an error its values are undefined */
