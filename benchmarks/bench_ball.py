@@ -185,7 +185,7 @@ def page(lines: list[str], seconds: float, reps: int, command: str, reference: s
         "The step is 1 ms, the Reference ball's fixed internal (explicit Euler) step, so that it makes one solver "
         "step per DoStep and what is compared is mostly the two FMI fronts; ours moves the ball in closed form. "
         "Every call of ours passes the checks of [host_contract.md](host_contract.md) and takes the instance's "
-        "lock (one compare-and-swap and one exchange where no other thread holds it); the Reference FMUs' calls "
+        "lock (one compare-and-swap and a plain store where no other thread holds it); the Reference FMUs' calls "
         "take no lock.",
         "",
         "```",

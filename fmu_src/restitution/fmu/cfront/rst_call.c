@@ -6,12 +6,11 @@
 #include "rst_instance.h"
 
 #include <stdio.h>
+#include <time.h>
 
 /* ------------------------------------------------------------------------------------------------ */
 /* Accessors for backends                                                                           */
 /* ------------------------------------------------------------------------------------------------ */
-double *rst_store(rst_instance *inst) { return inst->store; }
-void *rst_backend(rst_instance *inst) { return inst->backend; }
 const char *rst_instance_name(const rst_instance *inst) { return inst->name; }
 rst_mode rst_mode_of(const rst_instance *inst) { return inst->mode; }
 double rst_start_time(const rst_instance *inst) { return inst->has_start ? inst->start_time : 0.0; }
@@ -42,20 +41,36 @@ const char *front_mode_name(const rst_instance *inst, rst_mode mode, char *buffe
 /* Entering and leaving a call                                                                      */
 /* ------------------------------------------------------------------------------------------------ */
 #if defined(RST_LOCK_ATOMIC)
-/* The lock word is taken (1 or 2): mark it 2 (a thread waits: whoever gives it back wakes one) and wait
- * until the exchange finds it free. A waiter woken takes the word as 2, so the waiters still there are
- * woken in turn; a thread that takes a word freed in between (1) leaves it at 2 for the waiter it
- * skipped ahead of. */
+/* The longest a waiter sleeps before it looks at the word again [ns]: the bound on the one wake-up that
+ * can be missed (see front_wake_waiter). */
+#define WAIT_RECHECK_NS 1000000L
+
+/* The lock word is taken: count this thread among the waiting (under `lock`), then take the word as
+ * soon as it is free, sleeping on `waiters` in between. */
 void front_lock_contended(rst_instance *inst)
 {
+    int free_word = 0;
     pthread_mutex_lock(&inst->lock);
-    while (__atomic_exchange_n(&inst->lock_word, 2, __ATOMIC_ACQUIRE) != 0)
-        pthread_cond_wait(&inst->waiters, &inst->lock);
+    __atomic_add_fetch(&inst->waiting, 1, __ATOMIC_SEQ_CST);
+    while (!__atomic_compare_exchange_n(&inst->lock_word, &free_word, 1, 0, __ATOMIC_ACQUIRE, __ATOMIC_RELAXED)) {
+        struct timespec until;
+        free_word = 0;
+        clock_gettime(CLOCK_REALTIME, &until);
+        until.tv_nsec += WAIT_RECHECK_NS;
+        if (until.tv_nsec >= 1000000000L) {
+            until.tv_sec += 1;
+            until.tv_nsec -= 1000000000L;
+        }
+        pthread_cond_timedwait(&inst->waiters, &inst->lock, &until);
+    }
+    __atomic_sub_fetch(&inst->waiting, 1, __ATOMIC_SEQ_CST);
     pthread_mutex_unlock(&inst->lock);
 }
 
-/* A waiter marked the word 2 under `lock` before it waits, and waits without letting go of `lock` in
- * between, so taking `lock` here finds it waiting (or gone with the word): no wake-up is lost. */
+/* After the word was freed and a waiter counted: wake one. Taking `lock` orders this after a waiter's
+ * check of the word (it then sleeps, and is woken) or before it (it then finds the word free). Giving
+ * the word back reads the count without a fence (the point of the plain store): a count raised just
+ * then may be read as 0 and that waiter not woken; it looks again after WAIT_RECHECK_NS. */
 void front_wake_waiter(rst_instance *inst)
 {
     pthread_mutex_lock(&inst->lock);
@@ -86,14 +101,4 @@ int front_refuse_mode(rst_instance *inst, const char *function)
             front_mode_name(inst, inst->mode, buffer, sizeof buffer), inst->api->standard,
             inst->model_exchange ? "model-exchange" : "co-simulation");
     return 0;
-}
-
-/* A backend's answer: RST_ERROR puts the instance into the error mode, RST_FATAL latches it. */
-rst_status front_backend_status(rst_instance *inst, rst_status status)
-{
-    if (status == RST_FATAL)
-        inst->mode = RST_MODE_FATAL;
-    else if (status == RST_ERROR)
-        inst->mode = RST_MODE_ERROR;
-    return status;
 }

@@ -47,11 +47,6 @@ static int check_vector(rst_instance *inst, const char *function, const void *ar
     return 1;
 }
 
-static void write_double(void *values, size_t first, size_t n, const double in[])
-{
-    memcpy((double *)values + first, in, n * sizeof *in);
-}
-
 /* Reads the model's variables `vrs` (its states, derivatives or indicators: Reals of its table) as a get
  * call does. A model that computes everything into the store (no get_outputs hook, BouncingBall) has them
  * copied from it: an integrator reads them at every right-hand-side evaluation, and they need none of a get
@@ -61,9 +56,9 @@ static rst_status read_vector(rst_instance *inst, const char *function, const un
 {
     size_t i;
     if (inst->model->get_outputs != NULL)
-        return front_read(inst, function, RST_AS_REAL, vrs, n, out, write_double);
+        return front_read(inst, function, RST_AS_REAL, vrs, n, out, NULL);
     for (i = 0; i < n; i++)
-        out[i] = inst->store[vrs[i]];
+        out[i] = inst->head.store[vrs[i]];
     return RST_OK;
 }
 
@@ -159,7 +154,7 @@ rst_status front_set_continuous_states(void *c, const char *function, const doub
             LEAVE(RST_ERROR);
         }
     for (i = 0; i < n; i++)
-        inst->store[inst->model->state_vrs[i]] = x[i];
+        inst->head.store[inst->model->state_vrs[i]] = x[i];
     if (inst->model->set != NULL && n > 0)
         status = front_backend_status(inst, inst->model->set(inst, RST_REAL, inst->model->state_vrs, n, x));
     LEAVE(status);

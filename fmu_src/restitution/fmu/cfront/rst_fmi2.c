@@ -33,18 +33,15 @@ static const rst_api FMI2 = {
     "fmi2", "FMI 2.0", "GUID", "fmi2GetFMUstate", "fmi2SetFMUstate", "fmi2DeSerializeFMUstate",
     "fmi2SerializedFMUstateSize", {"Real", "Integer", "Boolean", "Integer"}, 0, emit};
 
-/* Converters between FMI 2.0's arrays and the core's doubles. */
-static double real_to_double(fmi2Real x) { return x; }
+/* Converters between FMI 2.0's arrays and the core's doubles (a Real is one: no converter). */
 static double integer_to_double(fmi2Integer x) { return (double)x; }
 static double boolean_to_double(fmi2Boolean x) { return (double)x; }
-static fmi2Real double_to_real(double x) { return x; }
 /* an Integer or Boolean held as a double, converted without undefined behaviour for any double */
 static fmi2Integer double_to_integer(double x)
 {
     return (x >= -2147483648.0 && x <= 2147483647.0) ? (fmi2Integer)x : 0;
 }
 static fmi2Boolean double_to_boolean(double x) { return x != 0.0 && !isnan(x); }
-RST_CONVERTERS(read_real, write_real, fmi2Real, real_to_double, double_to_real)
 RST_CONVERTERS(read_integer, write_integer, fmi2Integer, integer_to_double, double_to_integer)
 RST_CONVERTERS(read_boolean, write_boolean, fmi2Boolean, boolean_to_double, double_to_boolean)
 
@@ -154,7 +151,7 @@ fmi2Status fmi2Reset(fmi2Component c) { return (fmi2Status)front_reset(c, "fmi2R
 
 fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2Real value[])
 {
-    return (fmi2Status)front_get(c, "fmi2GetReal", RST_AS_REAL, vr, n, value, n, write_real);
+    return (fmi2Status)front_get(c, "fmi2GetReal", RST_AS_REAL, vr, n, value, n, NULL);
 }
 
 fmi2Status fmi2GetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2Integer value[])
@@ -175,7 +172,7 @@ fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t 
 
 fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2Real value[])
 {
-    return (fmi2Status)front_set(c, "fmi2SetReal", RST_AS_REAL, vr, n, value, n, read_real);
+    return (fmi2Status)front_set(c, "fmi2SetReal", RST_AS_REAL, vr, n, value, n, NULL);
 }
 
 fmi2Status fmi2SetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2Integer value[])

@@ -30,12 +30,10 @@ static const rst_api FMI3 = {
     "fmi3", "FMI 3.0", "instantiation token", "fmi3GetFMUState", "fmi3SetFMUState", "fmi3DeserializeFMUState",
     "fmi3SerializedFMUStateSize", {"Float64", "Int32", "Boolean", "Enumeration"}, 1, emit};
 
-/* Converters between FMI 3.0's arrays and the core's doubles. */
-static double float64_to_double(fmi3Float64 x) { return x; }
+/* Converters between FMI 3.0's arrays and the core's doubles (a Float64 is one: no converter). */
 static double int32_to_double(fmi3Int32 x) { return (double)x; }
 static double int64_to_double(fmi3Int64 x) { return (double)x; }
 static double boolean_to_double(fmi3Boolean x) { return x ? 1.0 : 0.0; }
-static fmi3Float64 double_to_float64(double x) { return x; }
 /* integers held as doubles, converted without undefined behaviour for any double */
 static fmi3Int32 double_to_int32(double x)
 {
@@ -46,7 +44,6 @@ static fmi3Int64 double_to_int64(double x)
     return (x >= -9223372036854775808.0 && x < 9223372036854775808.0) ? (fmi3Int64)x : 0;
 }
 static fmi3Boolean double_to_boolean(double x) { return x != 0.0 && !isnan(x); }
-RST_CONVERTERS(read_float64, write_float64, fmi3Float64, float64_to_double, double_to_float64)
 RST_CONVERTERS(read_int32, write_int32, fmi3Int32, int32_to_double, double_to_int32)
 RST_CONVERTERS(read_int64, write_int64, fmi3Int64, int64_to_double, double_to_int64)
 RST_CONVERTERS(read_boolean, write_boolean, fmi3Boolean, boolean_to_double, double_to_boolean)
@@ -240,11 +237,11 @@ fmi3Status fmi3Reset(fmi3Instance instance) { return (fmi3Status)front_reset(ins
                                              nValueReferences, 1);                                             \
     }
 
-GET(Float64, RST_AS_REAL, fmi3Float64, write_float64)
+GET(Float64, RST_AS_REAL, fmi3Float64, NULL)
 GET(Int32, RST_AS_INTEGER, fmi3Int32, write_int32)
 GET(Int64, RST_AS_ENUMERATION, fmi3Int64, write_int64) /* Enumerations are got and set as Int64 */
 GET(Boolean, RST_AS_BOOLEAN, fmi3Boolean, write_boolean)
-SET(Float64, RST_AS_REAL, fmi3Float64, read_float64)
+SET(Float64, RST_AS_REAL, fmi3Float64, NULL)
 SET(Int32, RST_AS_INTEGER, fmi3Int32, read_int32)
 SET(Int64, RST_AS_ENUMERATION, fmi3Int64, read_int64)
 SET(Boolean, RST_AS_BOOLEAN, fmi3Boolean, read_boolean)

@@ -30,8 +30,6 @@
 #define rst_is_model_exchange RST_PREFIXED(rst_is_model_exchange)
 #define rst_event_mode_used RST_PREFIXED(rst_event_mode_used)
 #define rst_time RST_PREFIXED(rst_time)
-#define rst_store RST_PREFIXED(rst_store)
-#define rst_backend RST_PREFIXED(rst_backend)
 #define rst_instance_name RST_PREFIXED(rst_instance_name)
 #define rst_mode_of RST_PREFIXED(rst_mode_of)
 #define rst_start_time RST_PREFIXED(rst_start_time)
@@ -159,8 +157,14 @@ typedef struct {
 extern const rst_model RST_MODEL;
 
 /* For backends. */
-double *rst_store(rst_instance *inst);         /* every variable by value reference */
-void *rst_backend(rst_instance *inst);         /* the backend's zeroed backend_size bytes */
+/* What every instance begins with: what a backend reads at nearly every call, read inline (a call
+ * into the front per read would cost more than the read). Nothing else of an instance is public. */
+typedef struct {
+    double *store; /* every variable by value reference */
+    void *backend; /* the backend's zeroed backend_size bytes */
+} rst_instance_head;
+static inline double *rst_store(rst_instance *inst) { return ((rst_instance_head *)(void *)inst)->store; }
+static inline void *rst_backend(rst_instance *inst) { return ((rst_instance_head *)(void *)inst)->backend; }
 const char *rst_instance_name(const rst_instance *inst);
 rst_mode rst_mode_of(const rst_instance *inst);
 double rst_start_time(const rst_instance *inst); /* from fmi2SetupExperiment or fmi3EnterInitializationMode (0 before) */

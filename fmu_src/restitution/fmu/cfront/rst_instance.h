@@ -6,8 +6,9 @@
  * the build command: POSIX threads, or a slim reader/writer lock on Windows. RST_FRONT_NO_LOCK leaves
  * it out for a platform with neither. With POSIX threads and a compiler with the GCC/Clang __atomic
  * builtins (gcc, clang, zig cc) the lock is a word taken with one compare-and-swap and given back with
- * one exchange where no other thread wants it (the common case: FMI asks nothing of a host that calls
- * one instance from several threads); a thread that finds it taken waits on a POSIX condition variable
+ * a plain release store and a read of the waiters' count where no other thread wants it (the common
+ * case: FMI asks nothing of a host that calls one instance from several threads; an exchange would cost
+ * a locked instruction per call); a thread that finds it taken waits on a POSIX condition variable
  * (RST_LOCK_ATOMIC, below). Elsewhere it is a plain pthread mutex. */
 #if !defined(RST_FRONT_NO_LOCK)
 #if defined(_WIN32)
@@ -31,8 +32,6 @@
 #define front_unlock_and_deliver RST_PREFIXED(front_unlock_and_deliver)
 #define front_refuse_mode RST_PREFIXED(front_refuse_mode)
 #define front_mode_name RST_PREFIXED(front_mode_name)
-#define front_backend_status RST_PREFIXED(front_backend_status)
-#define front_in_range RST_PREFIXED(front_in_range)
 #define front_describe_value RST_PREFIXED(front_describe_value)
 #define front_type_name RST_PREFIXED(front_type_name)
 #define front_reset_store RST_PREFIXED(front_reset_store)
@@ -75,6 +74,8 @@
 #define front_serialize RST_PREFIXED(front_serialize)
 #define front_deserialize RST_PREFIXED(front_deserialize)
 #endif
+
+#include <math.h>
 
 #if defined(RST_LOCK_PTHREAD)
 #include <pthread.h>
@@ -137,6 +138,7 @@ typedef void *(*rst_allocate_fn)(size_t n, size_t size); /* zeroed, as calloc */
 typedef void (*rst_release_fn)(void *pointer);
 
 struct rst_instance {
+    rst_instance_head head; /* first: the store and the backend data, which backends read inline (rst_front.h) */
     unsigned int magic;
     const rst_model *model;
     const rst_api *api;
@@ -161,13 +163,12 @@ struct rst_instance {
     rst_status last_step_status;
     size_t n_state;     /* state variables of the table */
     rst_state *states;  /* FMU states made by this instance, to tell ours from any other pointer */
-    double *store;
-    void *backend;
     int in_call;              /* set while a call holds the instance: its messages wait in `pending` */
     rst_message *pending;     /* in the order they were logged */
     rst_message **pending_end;
 #if defined(RST_LOCK_ATOMIC)
-    int lock_word;            /* 0 free, 1 held, 2 held and a thread may be waiting for it */
+    int lock_word;            /* 0 free, 1 held */
+    int waiting;              /* threads waiting for the word (changed under `lock`, read by whoever frees it) */
     pthread_mutex_t lock;     /* guards the waiting: threads that found the word taken wait on `waiters` */
     pthread_cond_t waiters;
 #elif defined(RST_LOCK_PTHREAD)
@@ -194,6 +195,8 @@ typedef struct {
 /* Converters between the version's value arrays and the core's doubles: elements first ... first + n - 1
  * of `values`, a whole run per call (a get or set of many values pays one indirect call per run, not one
  * per value). RST_CONVERTERS defines a pair from the conversion of one element. */
+/* A NULL converter: the values are doubles already (FMI 2.0 Real, FMI 3.0 Float64), read and written
+ * without a call per run (the commonest get and set). */
 typedef void (*rst_read_fn)(const void *values, size_t first, size_t n, double out[]);
 typedef void (*rst_write_fn)(void *values, size_t first, size_t n, const double in[]);
 #define RST_CONVERTERS(read_name, write_name, c_type, to_double, from_double)                   \
@@ -219,7 +222,6 @@ void front_unlock_and_deliver(rst_instance *inst); /* unlocks, then delivers the
 int front_refuse_mode(rst_instance *inst, const char *function); /* logs why the mode refuses; 0 */
 /* The mode as messages name it; `buffer` holds the text of the modes that name a function. */
 const char *front_mode_name(const rst_instance *inst, rst_mode mode, char *buffer, size_t size);
-rst_status front_backend_status(rst_instance *inst, rst_status status);       /* Error, Fatal: change mode */
 
 /* Values (rst_values.c). */
 void front_reset_store(rst_instance *inst); /* every variable back to its start value */
@@ -227,7 +229,6 @@ void front_reset_store(rst_instance *inst); /* every variable back to its start 
  * value to `write`: inputs and parameters from the store, what the model computes from the backend. */
 rst_status front_read(rst_instance *inst, const char *function, unsigned int kinds, const rst_vr vr[], size_t n,
                       void *values, rst_write_fn write);
-int front_in_range(const rst_variable *var, double value);
 void front_describe_value(rst_type type, double value, char *out, size_t size);
 const char *front_type_name(rst_type type);
 
@@ -303,6 +304,31 @@ rst_status front_serialize(void *c, const char *function, void *state, unsigned 
 rst_status front_deserialize(void *c, const char *function, const unsigned char bytes[], size_t size,
                              void **state);
 
+/* Is `value` inside the variable's declared range? (Reals: finite too.) Inline: a set checks every
+ * value it changes. */
+static inline int front_in_range(const rst_variable *var, double value)
+{
+    if (var->type == RST_BOOLEAN)
+        return value == 0.0 || value == 1.0;
+    if (!isfinite(value))
+        return 0;
+    if (var->low_open ? !(value > var->low) : !(value >= var->low))
+        return 0;
+    if (var->high_open ? !(value < var->high) : !(value <= var->high))
+        return 0;
+    return 1;
+}
+
+/* A backend's answer: RST_ERROR puts the instance into the error mode, RST_FATAL latches it. */
+static inline rst_status front_backend_status(rst_instance *inst, rst_status status)
+{
+    if (status == RST_FATAL)
+        inst->mode = RST_MODE_FATAL;
+    else if (status == RST_ERROR)
+        inst->mode = RST_MODE_ERROR;
+    return status;
+}
+
 /* NULL unless c is one of our live instances. */
 static inline rst_instance *front_instance(void *c)
 {
@@ -329,7 +355,8 @@ static inline void front_release(rst_instance *inst)
 {
     inst->in_call = 0;
 #if defined(RST_LOCK_ATOMIC)
-    if (__atomic_exchange_n(&inst->lock_word, 0, __ATOMIC_RELEASE) == 2)
+    __atomic_store_n(&inst->lock_word, 0, __ATOMIC_RELEASE);
+    if (__atomic_load_n(&inst->waiting, __ATOMIC_RELAXED) != 0)
         front_wake_waiter(inst);
 #elif defined(RST_LOCK_PTHREAD)
     pthread_mutex_unlock(&inst->lock);

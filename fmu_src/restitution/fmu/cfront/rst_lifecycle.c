@@ -85,8 +85,8 @@ static void free_memory(rst_instance *inst)
     pthread_mutex_destroy(&inst->lock);
 #endif
     inst->magic = 0;
-    release(inst->backend);
-    release(inst->store);
+    release(inst->head.backend);
+    release(inst->head.store);
     release(inst->name);
     release(inst);
 }
@@ -113,20 +113,20 @@ rst_instance *front_new_instance(const rst_api *api, void (*host_logger)(void), 
     inst->mode = RST_MODE_INSTANTIATED;
     inst->last_step_status = RST_OK;
     inst->name = (char *)allocate(strlen(name) + 1, 1);
-    inst->store = (double *)allocate(model->n_variables ? model->n_variables : 1, sizeof(double));
-    inst->backend = allocate(model->backend_size ? model->backend_size : 1, 1);
-    if (inst->name == NULL || inst->store == NULL || inst->backend == NULL) {
+    inst->head.store = (double *)allocate(model->n_variables ? model->n_variables : 1, sizeof(double));
+    inst->head.backend = allocate(model->backend_size ? model->backend_size : 1, 1);
+    if (inst->name == NULL || inst->head.store == NULL || inst->head.backend == NULL) {
         char message[80];
         snprintf(message, sizeof message, "%s: out of memory", function);
         api->emit(host_logger, environment, name, RST_ERROR, "logStatusError", message);
         if (inst->name) release(inst->name);
-        if (inst->store) release(inst->store);
-        if (inst->backend) release(inst->backend);
+        if (inst->head.store) release(inst->head.store);
+        if (inst->head.backend) release(inst->head.backend);
         release(inst);
         return NULL;
     }
     strcpy(inst->name, name);
-    memset(inst->backend, 0, model->backend_size ? model->backend_size : 1);
+    memset(inst->head.backend, 0, model->backend_size ? model->backend_size : 1);
     for (i = 0; i < model->n_variables; i++)
         inst->n_state += model->variables[i].state != 0;
     inst->pending_end = &inst->pending;

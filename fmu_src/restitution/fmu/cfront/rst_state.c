@@ -114,7 +114,7 @@ rst_status front_get_state(void *c, const char *function, void **FMUstate)
     s->last_time = inst->last_time;
     for (i = 0; i < inst->model->n_variables; i++)
         if (inst->model->variables[i].state)
-            s->values[k++] = inst->store[i];
+            s->values[k++] = inst->head.store[i];
     *FMUstate = s;
     LEAVE(status);
 }
@@ -196,7 +196,7 @@ rst_status front_set_state(void *c, const char *function, void *FMUstate)
         LEAVE(RST_ERROR);
     for (i = 0; i < inst->model->n_variables; i++)
         if (inst->model->variables[i].state)
-            inst->store[i] = s->values[k++];
+            inst->head.store[i] = s->values[k++];
     inst->mode = (rst_mode)s->mode;
     inst->has_start = (int)s->has_start;
     inst->has_time = (int)s->has_time;

@@ -18,7 +18,7 @@ void front_reset_store(rst_instance *inst)
 {
     size_t i;
     for (i = 0; i < inst->model->n_variables; i++)
-        inst->store[i] = inst->model->variables[i].start;
+        inst->head.store[i] = inst->model->variables[i].start;
 }
 
 void front_describe_value(rst_type type, double value, char *out, size_t size)
@@ -34,20 +34,6 @@ void front_describe_value(rst_type type, double value, char *out, size_t size)
 const char *front_type_name(rst_type type)
 {
     return type == RST_REAL ? "Real" : type == RST_INTEGER ? "Integer" : "Boolean";
-}
-
-/* Is `value` inside the variable's declared range? (Reals: finite too.) */
-int front_in_range(const rst_variable *var, double value)
-{
-    if (var->type == RST_BOOLEAN)
-        return value == 0.0 || value == 1.0;
-    if (!isfinite(value))
-        return 0;
-    if (var->low_open ? !(value > var->low) : !(value >= var->low))
-        return 0;
-    if (var->high_open ? !(value < var->high) : !(value <= var->high))
-        return 0;
-    return 1;
 }
 
 /* The access kind of a variable: its type, or Enumeration for an Integer with named codes. */
@@ -92,8 +78,8 @@ double rst_time(const rst_instance *inst)
     return inst->last_time;
 }
 
-/* Is `vr` a variable of one of the `kinds` (time included)? Logs why not. */
-static int check_vr(rst_instance *inst, const char *function, rst_vr vr, unsigned int kinds)
+/* check_vr beyond its common case: time, or a value reference refused (logged). */
+static int check_other_vr(rst_instance *inst, const char *function, rst_vr vr, unsigned int kinds)
 {
     const rst_variable *var;
     if (is_time(inst, vr)) {
@@ -118,6 +104,15 @@ static int check_vr(rst_instance *inst, const char *function, rst_vr vr, unsigne
     return 1;
 }
 
+/* Is `vr` a variable of one of the `kinds` (time included)? Logs why not. The common case (a variable of
+ * the table, of a kind asked for) inline, without the messages. */
+static inline int check_vr(rst_instance *inst, const char *function, rst_vr vr, unsigned int kinds)
+{
+    if (vr < inst->model->n_variables && (kinds & (unsigned int)access_of(&inst->model->variables[vr])))
+        return 1;
+    return check_other_vr(inst, function, vr, kinds);
+}
+
 /* May the host set `var` in the current mode? (Inputs and parameters in instantiated and
  * initialization mode; in step mode and event mode inputs and tunable parameters only; in
  * continuous-time mode inputs only.) */
@@ -139,7 +134,7 @@ static int check_set(rst_instance *inst, const char *function, rst_vr vr, unsign
     char text[40], buffer[80];
     if (!check_vr(inst, function, vr, kinds))
         return 0;
-    if (is_time(inst, vr)) {
+    if (vr >= inst->model->n_variables) { /* what check_vr accepts beyond the table: time */
         rst_log(inst, RST_ERROR, "%s: time is the independent variable and cannot be set", function);
         return 0;
     }
@@ -161,7 +156,7 @@ static int check_set(rst_instance *inst, const char *function, rst_vr vr, unsign
     /* The value the variable holds, bit for bit, was checked when the variable got it (its start value,
      * inside its declared range; a set call; a validated FMU state): hosts that set every input at every
      * step pay the range and the backend's checks for the values that changed only. */
-    if (memcmp(&value, &inst->store[vr], sizeof value) == 0)
+    if (memcmp(&value, &inst->head.store[vr], sizeof value) == 0)
         return 1;
     if (!front_in_range(var, value)) {
         front_describe_value(var->type, value, text, sizeof text);
@@ -184,7 +179,7 @@ static rst_status set_checked(rst_instance *inst, const char *function, unsigned
         if (!check_set(inst, function, vr[i], kinds, values[i]))
             return RST_ERROR;
     for (i = 0; i < n; i++)
-        inst->store[vr[i]] = values[i];
+        inst->head.store[vr[i]] = values[i];
     if (inst->model->set == NULL || n == 0)
         return RST_OK;
     /* the kinds of one call are of one storage type (Integer and Enumeration are both integers) */
@@ -212,6 +207,7 @@ rst_status front_set(void *c, const char *function, unsigned int kinds, const rs
 {
     double buffer[CHUNK], *all = buffer;
     rst_status status;
+    size_t i;
     ENTER(function, SET_MODES)
     if (!check_counts(inst, function, vr, n, values, n_values))
         LEAVE(RST_ERROR);
@@ -222,7 +218,10 @@ rst_status front_set(void *c, const char *function, unsigned int kinds, const rs
             LEAVE(RST_ERROR);
         }
     }
-    if (n > 0) /* (values may be NULL then) */
+    if (read == NULL) /* doubles: copied (so that the values checked are those stored), a few: no memcpy call */
+        for (i = 0; i < n; i++)
+            all[i] = ((const double *)values)[i];
+    else if (n > 0) /* (values may be NULL then) */
         read(values, 0, n, all);
     status = set_checked(inst, function, kinds, vr, n, all);
     if (all != buffer)
@@ -249,7 +248,7 @@ static rst_status get_chunk(rst_instance *inst, const char *function, unsigned i
             out[i] = rst_time(inst);
             continue;
         }
-        out[i] = inst->store[vr[i]];
+        out[i] = inst->head.store[vr[i]];
         if (computed_by_backend && (var->causality == RST_OUTPUT || var->causality == RST_LOCAL ||
                                     var->causality == RST_CALCULATEDPARAMETER)) {
             position[n_outputs] = i;
@@ -275,14 +274,18 @@ rst_status front_read(rst_instance *inst, const char *function, unsigned int kin
     size_t i0;
     double buffer[CHUNK];
     rst_status status = RST_OK;
+    if (write == NULL && n <= CHUNK) /* the commonest get: a few doubles, one run */
+        return get_chunk(inst, function, kinds, vr, n, (double *)values);
     for (i0 = 0; i0 < n; i0 += CHUNK) {
         size_t m = n - i0 < CHUNK ? n - i0 : CHUNK;
-        rst_status s = get_chunk(inst, function, kinds, vr + i0, m, buffer);
+        /* doubles (write NULL) straight into the host's array: on an error its values are undefined */
+        rst_status s = get_chunk(inst, function, kinds, vr + i0, m, write == NULL ? (double *)values + i0 : buffer);
         if (s > status)
             status = s;
         if (s >= RST_ERROR)
             return status;
-        write(values, i0, m, buffer);
+        if (write != NULL)
+            write(values, i0, m, buffer);
     }
     return status;
 }

@@ -108,9 +108,8 @@ static int departure_to_log(const impact_backend *b)
            || (rst_impact_edge_monitored(&b->cache.terms) && !(b->warned & EDGE));
 }
 
-static void evaluate(rst_instance *inst)
+static void evaluate(rst_instance *inst, impact_backend *b)
 {
-    impact_backend *b = (impact_backend *)rst_backend(inst);
     char message[256], inputs[1024];
     if (!b->stale)
         return;
@@ -170,7 +169,7 @@ static rst_status set(rst_instance *inst, rst_type type, const rst_vr vr[], size
 
 static rst_status exit_initialization(rst_instance *inst)
 {
-    evaluate(inst);
+    evaluate(inst, (impact_backend *)rst_backend(inst));
     return RST_OK;
 }
 
@@ -178,22 +177,24 @@ static rst_status get_outputs(rst_instance *inst, rst_type type, const rst_vr vr
                               double values[])
 {
     impact_backend *b = (impact_backend *)rst_backend(inst);
+    const double *store = rst_store(inst); /* once: the accessors are calls into the front */
     size_t i;
     (void)type;
-    evaluate(inst);
+    evaluate(inst, b);
     for (i = 0; i < n && b->rest_stale; i++)
         if (vr[i] != RST_SPHEREPLATEIMPACT_VR_E && vr[i] != RST_SPHEREPLATEIMPACT_VR_V_REBOUND)
             evaluate_rest(inst, b);
     for (i = 0; i < n; i++)
-        values[i] = rst_store(inst)[vr[i]];
+        values[i] = store[vr[i]];
     return RST_OK;
 }
 
 static rst_status do_step(rst_instance *inst, double t, double h)
 {
+    impact_backend *b = (impact_backend *)rst_backend(inst);
     (void)t, (void)h;
-    evaluate(inst);
-    if (((impact_backend *)rst_backend(inst))->failed) {
+    evaluate(inst, b);
+    if (b->failed) {
         rst_log(inst, RST_DISCARD, "%sDoStep discarded: the model could not be evaluated for the current inputs "
                 "(see the error above)", rst_fmi_prefix(inst));
         return RST_DISCARD;
