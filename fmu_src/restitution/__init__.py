@@ -5,15 +5,13 @@ model (Eqs. 1-8) fused with Zener's plate-wave model (Eqs. 9-13a) by Eq. (20).
 Plain numpy/scipy functions; nothing here knows about FMI. Start with :func:`impact`. Physical
 inputs are SI numbers or pint Quantities of any compatible unit (:mod:`restitution.quantities`).
 """
-from .about import VERSION as __version__
-from .domain import DOMAIN, DomainWarning, check_in_domain
+from .domain import DOMAIN, DomainWarning, check_in_domain, check_nonnegative
 from .fusion import apparent_restitution, equivalent_plate_mass, velocities_after_impact
 from .jgm import (critical_velocity, effective_modulus, poisson_coefficient, restitution_e44,
                   restitution_e45, yield_strain)
 from .materials import (BRITTLE_SY, MATERIALS, TABLE1_CASES, TABLE4_CASES, Material, Plate, Sphere,
                         table4_case)
 from .quantities import with_units
-from .validation import check_nonnegative
 from .model import EFFECT_MODES, RESTITUTION_MODELS, ImpactResult, ImpactTerms, impact, impact_at, impact_terms
 from .zener import (TAU0_HERTZ, ZENER_METHODS, inelasticity_parameter, zener_linear, zener_paper_fit,
                     zener_restitution)
@@ -40,3 +38,13 @@ __all__ = [
     "restitution_e44", "restitution_e45", "yield_strain", "inelasticity_parameter",
     "zener_linear", "zener_paper_fit", "zener_restitution", "__version__",
 ]
+
+
+def __getattr__(name):
+    """``restitution.__version__`` (:data:`restitution.about.VERSION`), read when asked: a command that does
+    not show it (``restitution cor``) does not load :mod:`restitution.about`."""
+    if name == "__version__":
+        from .about import VERSION
+
+        return VERSION
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -1,6 +1,7 @@
 """The steps of :func:`restitution.model.impact`'s pipeline that only its array mode takes: owned result
-arrays, the masks of the effect modes' skips and of speed 0, Zener computed where needed.
-The pipeline itself (one code for floats and arrays) stays in :mod:`restitution.model`."""
+arrays, the masks of the effect modes' skips and of speed 0 (Zener where a mask holds is
+:func:`restitution.zener.zener_solution_where`). The pipeline itself (one code for floats and arrays)
+stays in :mod:`restitution.model`."""
 from __future__ import annotations
 
 import math
@@ -10,7 +11,6 @@ from functools import lru_cache
 import numpy as np
 
 from ._num import where
-from .zener import zener_restitution_only, zener_solution
 
 
 def _own_array(x, shape, dtype):
@@ -71,28 +71,3 @@ def _waves_needed(lam, tolerance, slope_bound):
     if lam.size and slope_bound * lam.min() >= tolerance:
         return True
     return slope_bound * lam >= tolerance
-
-
-def _zener_where_needed(lam, needed, method, rtol, skipped_tau0):
-    """(e_ze, 1 - e_ze, tau0) of arrays, computed only where the plate-wave effect is needed;
-    (1, 0, ``skipped_tau0``) elsewhere."""
-    lam = np.asarray(lam)  # float already: Eq. (12) of float arrays
-    if needed is True or np.all(needed):  # elementwise methods: same values as the masked evaluation, no
-        return zener_solution(lam, method, rtol)  # gather/scatter (the auto skip's one True: no mask to read)
-    needed = np.broadcast_to(needed, lam.shape)
-    e_ze, d_ze, tau0 = np.ones(lam.shape), np.zeros(lam.shape), np.full(lam.shape, skipped_tau0)
-    if needed.any():
-        e_ze[needed], d_ze[needed], tau0[needed] = zener_solution(lam[needed], method, rtol)
-    return e_ze, d_ze, tau0
-
-
-def _zener_restitution_where_needed(lam, needed, method, rtol):
-    """e_ze of arrays alone (:func:`_zener_where_needed`'s first value, by the same operations)."""
-    lam = np.asarray(lam)
-    if needed is True or np.all(needed):
-        return zener_restitution_only(lam, method, rtol)
-    needed = np.broadcast_to(needed, lam.shape)
-    e_ze = np.ones(lam.shape)
-    if needed.any():
-        e_ze[needed] = zener_restitution_only(lam[needed], method, rtol)
-    return e_ze

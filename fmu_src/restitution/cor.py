@@ -19,8 +19,8 @@ from .assumptions import E_NEGATIVE_MEANING, VALID_MEANING
 from .fmu.models.sphere_plate_impact.variables import TABLE
 from .model import ZENER_METHODS, impact, published
 from .zener import WAVE_DELAY_LIMIT
-from .inputs import IMPACT_QUANTITIES, impact_inputs
-from .options import BARE_NUMBER_RULE, ArgumentParser, add_impact_options, material_from_args
+from .inputs import IMPACT_QUANTITIES, impact_inputs, material_from_args
+from .options import BARE_NUMBER_RULE, ArgumentParser, add_impact_options
 from .units import OptionError
 from .output_files import (EXIT_IO_ERROR, EXIT_REFUSED, OutputPathError, atomic_write, check_output,
                            finish_stdout)

@@ -1,4 +1,7 @@
-"""The model's domain: the values of each physical input that every front end accepts (the package's
+"""The values each input of the model may take, in one place: the checks every value passes (finite, of
+the right sign, nu in [0, 0.5], one of an option's words: :func:`check_positive` and its siblings, the
+words in :data:`RESTITUTION_MODELS`, :data:`ZENER_METHODS`, :data:`EFFECT_MODES`), and the model's domain:
+the values of each physical input that every front end accepts (the package's
 objects and :func:`restitution.impact`, the FMUs, scenes, sweeps, ``restitution cor`` and ``fit``),
 and the one-line refusal of a value outside it, with the unit the value was likely meant in:
 
@@ -18,7 +21,18 @@ import numpy as np
 from ._num import is_scalar
 
 __all__ = ["DOMAIN", "PREFIXED", "TYPICAL", "DomainWarning", "slipped_prefix", "outside_text", "outside_domain",
-           "check_in_domain", "warn_outside_domain", "number_text"]
+           "check_in_domain", "warn_outside_domain", "number_text", "RESTITUTION_MODELS", "ZENER_METHODS",
+           "EFFECT_MODES", "check_positive", "check_nonnegative", "check_nonnegative_or_infinite", "check_poisson",
+           "check_choice"]
+
+# The words of restitution.impact()'s named options, in order (an option's integer code in the FMUs is its
+# word's position): the interface tables and the command lines list them, model and zener act on them.
+#: ``restitution_model``: the elastoplastic COR by Eq. (45) or Eq. (44) of JGM.
+RESTITUTION_MODELS = ("e45", "e44")
+#: ``zener_method``: how Zener's (e_ze, tau0) is found (:mod:`restitution.zener`).
+ZENER_METHODS = ("exact", "paper_fit", "linear", "ode")
+#: ``plasticity`` and ``plate_waves``: each effect off, on, or on where it matters.
+EFFECT_MODES = ("off", "on", "auto")
 
 #: The domain the FMUs declare (min/max in modelDescription.xml) and the property tests cover, per
 #: argument of :func:`restitution.impact`: (low, high) [SI], both included; nu has its own [0, 0.5].
@@ -112,4 +126,66 @@ def warn_outside_domain(label: str, key: str, value, unit: str, stacklevel: int 
     if message:
         warnings.warn(f"{message} (outside the domain the FMUs, the objects and the command lines accept; "
                       f"impact() computes it anyway)", DomainWarning, stacklevel=stacklevel + 1)
+    return value
+
+
+# --- the checks every value passes: a ValueError naming the parameter, its value and the allowed range
+def _check(name, value, unit, ok_scalar, ok_array, allowed):
+    if is_scalar(value):
+        v = float(value)
+        if not ok_scalar(v):
+            raise ValueError(f"{name} = {v!r}{unit} is outside the allowed range: {allowed}")
+        return v
+    arr = np.asarray(value, dtype=float)
+    if arr.size and ok_scalar(float(arr.min())) and ok_scalar(float(arr.max())):
+        # every range allowed here is an interval, so its two ends decide for the whole array: two
+        # reductions instead of an elementwise mask (NaN propagates through min and max: refused, and
+        # the mask below finds it)
+        return arr
+    with np.errstate(invalid="ignore"):
+        good = ok_array(arr)
+    if not np.all(good):
+        bad_value = float(arr[~good].flat[0]) if arr.ndim else float(arr)
+        raise ValueError(f"{name} = {bad_value!r}{unit} is outside the allowed range: {allowed}")
+    return arr
+
+
+def check_positive(name: str, value, unit: str = ""):
+    """Require finite values > 0."""
+    if value.__class__ is float and 0.0 < value < math.inf:  # fast path, same result
+        return value
+    u = f" {unit}" if unit else ""
+    return _check(name, value, u, lambda v: math.isfinite(v) and v > 0.0,
+                  lambda a: np.isfinite(a) & (a > 0.0), "finite and > 0")
+
+
+def check_nonnegative(name: str, value, unit: str = ""):
+    """Require finite values >= 0."""
+    if value.__class__ is float and 0.0 <= value < math.inf:  # fast path, same result
+        return value
+    u = f" {unit}" if unit else ""
+    return _check(name, value, u, lambda v: math.isfinite(v) and v >= 0.0,
+                  lambda a: np.isfinite(a) & (a >= 0.0), "finite and >= 0")
+
+
+def check_nonnegative_or_infinite(name: str, value, unit: str = "", allowed: str = ">= 0"):
+    """Require values >= 0, +inf included (NaN refused); ``allowed`` says what the range means."""
+    if value.__class__ is float and value >= 0.0:  # fast path, same result
+        return value
+    u = f" {unit}" if unit else ""
+    return _check(name, value, u, lambda v: v >= 0.0, lambda a: a >= 0.0, allowed)
+
+
+def check_poisson(name: str, value):
+    """Require a Poisson's ratio in [0, 0.5] (0.5: incompressible; the model uses nu only through
+    E' = E/(1 - nu^2), Eq. 1, and C(nu), Eq. 2, both finite there)."""
+    if value.__class__ is float and 0.0 <= value <= 0.5:  # fast path, same result
+        return value
+    return _check(name, value, "", lambda v: 0.0 <= v <= 0.5,
+                  lambda a: (a >= 0.0) & (a <= 0.5), "0 <= nu <= 0.5")
+
+
+def check_choice(name: str, value, choices):
+    if value not in choices:
+        raise ValueError(f"{name} = {value!r} is not one of {sorted(choices)}")
     return value

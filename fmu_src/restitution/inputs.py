@@ -19,12 +19,14 @@ import math
 from ._num import decimal_like
 from .domain import number_text, outside_text, slipped_prefix
 from .fmu.models.sphere_plate_impact.variables import TABLE
+from .options import MATERIAL_PROPERTIES, MAX_BARE_LENGTH, PLAUSIBLE_T_OVER_D
 from .units import (ECHO_CHARS, EXAMPLES, QUANTITIES, OptionError, UnitError, convert_quantity, echo, read_quantity,
                     short_enough, shorten_quoted, split_quantity)
 
 __all__ = ["QuantityError", "ROWS", "unit_of", "quantity", "quantities", "outside", "material", "input_quantity",
            "input_reading", "positive_quantity", "MATERIAL_PROPERTIES", "read_material_file", "custom_material",
-           "check_plausible_lengths", "MAX_BARE_LENGTH", "PLAUSIBLE_T_OVER_D", "IMPACT_QUANTITIES", "impact_inputs"]
+           "material_from_args", "check_plausible_lengths", "MAX_BARE_LENGTH", "PLAUSIBLE_T_OVER_D", "IMPACT_QUANTITIES",
+           "impact_inputs"]
 
 #: FMU name -> row of the interface table, for every input and parameter.
 ROWS = {v.name: v for v in TABLE.settable}
@@ -158,10 +160,7 @@ def positive_quantity(option: str, text: str, unit: str, kind: str) -> float:
     return value
 
 
-# --- materials given by their properties ------------------------------------------------------
-#: A material's properties as options and file keys (``--plate-E``, ``E = "69 GPa"``): key -> help.
-MATERIAL_PROPERTIES = {"E": "elastic modulus, e.g. \"115 GPa\"", "nu": "Poisson's ratio, e.g. 0.31",
-                       "Sy": "yield strength, e.g. \"69 MPa\"", "rho": "density, e.g. \"8960 kg/m3\""}
+# --- materials given by their properties (MATERIAL_PROPERTIES: restitution.options) -------------
 #: The keys a material file may hold besides the properties.
 _FILE_TEXT_KEYS = ("name", "source")
 
@@ -234,13 +233,15 @@ def custom_material(role: str, key: str | None = None, path=None, given: dict | 
         raise OptionError(f"--{role}: {exc}") from None
 
 
-# --- lengths a person slipped on -------------------------------------------------------------
-#: The largest sphere diameter and plate thickness taken as a bare number [m] without --allow-implausible.
-MAX_BARE_LENGTH = 0.5
-#: The plate's thickness over the sphere's diameter taken without --allow-implausible when either was a bare number.
-PLAUSIBLE_T_OVER_D = (0.01, 100.0)
+def material_from_args(args, role: str):
+    """(the :class:`~restitution.Material`, its label in reports) of the options of
+    :func:`restitution.options.add_material_options`."""
+    given = {key: getattr(args, f"{role}_{key}") for key in MATERIAL_PROPERTIES}
+    return custom_material(role, getattr(args, role), getattr(args, f"{role}_material"),
+                           {k: v for k, v in given.items() if v is not None})
 
 
+# --- lengths a person slipped on (the rule's numbers: restitution.options) --------------------
 def check_plausible_lengths(d, t, allow: bool = False) -> None:
     """OptionError for a likely slip of a bare length: ``d`` and ``t`` are (as shown, e.g. "--d 10";
     SI value; whether it was a bare number), or None where not given. A bare diameter or thickness

@@ -14,9 +14,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 
-from .domain import check_in_domain
+from .domain import check_in_domain, check_poisson, check_positive
 from .quantities import to_si
-from .validation import check_poisson, check_positive
 
 __all__ = ["Material", "Sphere", "Plate", "BRITTLE_SY", "MATERIALS", "ALIASES", "TABLE4_CASES", "table4_case"]
 

@@ -1,14 +1,23 @@
 """The command lines' option declarations (``restitution cor``, ``fit``, ``sweep``, ``scene``): argparse's
 parser whose refusals are one short line, the material options and the rule for bare-number lengths in
-the --help epilogs. Reading the values is :mod:`restitution.inputs`'s."""
+the --help epilogs, with its numbers. Reading the values (and holding them to that rule) is
+:mod:`restitution.inputs`'s, which reads what is declared here: declaring options loads no reader."""
 from __future__ import annotations
 
 import argparse
 
-from .inputs import MATERIAL_PROPERTIES, MAX_BARE_LENGTH, PLAUSIBLE_T_OVER_D, custom_material
 from .units import shorten_quoted
 
-__all__ = ["ArgumentParser", "add_material_options", "add_impact_options", "material_from_args", "BARE_NUMBER_RULE"]
+__all__ = ["ArgumentParser", "add_material_options", "add_impact_options", "BARE_NUMBER_RULE", "MATERIAL_PROPERTIES",
+           "MAX_BARE_LENGTH", "PLAUSIBLE_T_OVER_D"]
+
+#: A material's properties as options and file keys (``--plate-E``, ``E = "69 GPa"``): key -> help.
+MATERIAL_PROPERTIES = {"E": "elastic modulus, e.g. \"115 GPa\"", "nu": "Poisson's ratio, e.g. 0.31",
+                       "Sy": "yield strength, e.g. \"69 MPa\"", "rho": "density, e.g. \"8960 kg/m3\""}
+#: The largest sphere diameter and plate thickness taken as a bare number [m] without --allow-implausible.
+MAX_BARE_LENGTH = 0.5
+#: The plate's thickness over the sphere's diameter taken without --allow-implausible when either was a bare number.
+PLAUSIBLE_T_OVER_D = (0.01, 100.0)
 
 
 class ArgumentParser(argparse.ArgumentParser):
@@ -41,14 +50,6 @@ def add_material_options(parser, role: str, required_help: str = "") -> None:
                        "a string with its unit) and optionally name, source")
     for key, what in MATERIAL_PROPERTIES.items():
         group.add_argument(f"--{role}-{key}", metavar="VALUE", dest=f"{role}_{key}", help=f"{role} {what}")
-
-
-def material_from_args(args, role: str):
-    """(the :class:`~restitution.Material`, its label in reports) of the options of
-    :func:`add_material_options`."""
-    given = {key: getattr(args, f"{role}_{key}") for key in MATERIAL_PROPERTIES}
-    return custom_material(role, getattr(args, role), getattr(args, f"{role}_material"),
-                           {k: v for k, v in given.items() if v is not None})
 
 
 #: The rule, for --help epilogs.

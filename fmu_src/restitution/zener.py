@@ -16,6 +16,7 @@ import math
 import numpy as np
 
 from ._num import exp, expm1, is_scalar, minimum, sqrt, where
+from .domain import ZENER_METHODS
 from .quantities import si_only, with_units
 from .jgm import reduced_modulus
 from .zener_exact import zener_exact_restitution, zener_exact_solution
@@ -25,11 +26,11 @@ __all__ = [
     "lambda_material_factor", "lambda_speed_factor", "lambda_from_root", "hertz_stiffness", "time_scale",
     "time_scale_factor", "time_scale_from_root", "zener_paper_fit", "zener_paper_fit_deficit", "zener_linear",
     "zener_linear_deficit", "zener_linear_fit", "zener_ode", "zener_restitution", "zener_restitution_only", "zener_solution",
+    "zener_solution_where", "zener_restitution_where",
     "contact_duration", "WAVE_DELAY_LIMIT", "wave_delay", "waves_concurrent", "dilatational_wave_speed",
     "dilatational_slowness", "edge_echo_time", "edge_echo_ratio", "edge_echo_ratio_from_time", "edge_clear",
 ]
 
-ZENER_METHODS = ("exact", "paper_fit", "linear", "ode")
 #: Largest lambda Zener (and the paper's fits) studied [1].
 LAMBDA_STUDIED_MAX = 1.5
 #: tau0 at lambda = 0 (Hertz impact on a half-space): 2 (5/4)^(2/5) (2/5) B(2/5, 1/2) [1].
@@ -329,6 +330,31 @@ def zener_restitution_only(lam, method: str = "exact", rtol: float = 1e-10):
     if method == "paper_fit":
         return _paper_fit_restitution(lam)
     return zener_solution(lam, method, rtol)[0]
+
+
+def zener_solution_where(lam, needed, method: str, rtol: float, skipped_tau0):
+    """:func:`zener_solution` of an array ``lam`` [1], computed only where the mask ``needed`` holds (or
+    everywhere, for one True); (1, 0, ``skipped_tau0``) elsewhere: ``plate_waves="auto"`` on arrays."""
+    lam = np.asarray(lam)  # float already: Eq. (12) of float arrays
+    needed = np.broadcast_to(needed, lam.shape)
+    if needed.all():  # elementwise methods: same values as the masked evaluation, no gather/scatter
+        return zener_solution(lam, method, rtol)
+    e_ze, d_ze, tau0 = np.ones(lam.shape), np.zeros(lam.shape), np.full(lam.shape, skipped_tau0)
+    if needed.any():
+        e_ze[needed], d_ze[needed], tau0[needed] = zener_solution(lam[needed], method, rtol)
+    return e_ze, d_ze, tau0
+
+
+def zener_restitution_where(lam, needed, method: str, rtol: float):
+    """e_ze of an array alone (:func:`zener_solution_where`'s first value, by the same operations)."""
+    lam = np.asarray(lam)
+    needed = np.broadcast_to(needed, lam.shape)
+    if needed.all():
+        return zener_restitution_only(lam, method, rtol)
+    e_ze = np.ones(lam.shape)
+    if needed.any():
+        e_ze[needed] = zener_restitution_only(lam[needed], method, rtol)
+    return e_ze
 
 
 def zener_restitution(lam, method: str = "exact", rtol: float = 1e-10):

@@ -49,8 +49,6 @@ from importlib.resources import files
 
 import numpy as np
 
-from ._num import log
-
 __all__ = ["zener_exact", "zener_exact_solution", "LAMBDA_TABLE_MAX", "E_INF", "TAU0_LAMBDA0"]
 
 _DATA_NAME = "zener_table.npz"
@@ -150,7 +148,10 @@ def _asym(lam):
             b1, b2 = c[k] + z2 * b1 - b2, b1
         g = c[0] + 0.5 * z2 * b1 - b2
         e = E_INF * (1.0 / lam) ** 5
-        tau0 = lam * (5.0 * log(lam) + g)
+        # ln of a float (what the scalar paths pass) by the C library, of an array by numpy, as
+        # restitution._num.log does: this module imports nothing of the package, so the ODE solver
+        # (restitution.zener_ode) uses this form above its range without a chain of imports
+        tau0 = lam * (5.0 * (math.log(lam) if lam.__class__ is float else np.log(lam)) + g)
     return e, 1.0 - e, tau0
 
 

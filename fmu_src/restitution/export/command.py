@@ -18,8 +18,8 @@ import math
 import sys
 
 from ..model import ZENER_METHODS
-from ..inputs import impact_inputs, input_reading
-from ..options import BARE_NUMBER_RULE, ArgumentParser, add_impact_options, material_from_args
+from ..inputs import impact_inputs, input_reading, material_from_args
+from ..options import BARE_NUMBER_RULE, ArgumentParser, add_impact_options
 from ..units import OptionError, echo, read_quantity
 from ..output_files import (EXIT_IO_ERROR, EXIT_REFUSED, OutputPathError, atomic_write, check_output, check_outputs,
                             finish_stdout)

@@ -15,8 +15,8 @@ import argparse
 import sys
 from pathlib import Path
 
-from ..inputs import check_plausible_lengths, input_reading, positive_quantity
-from ..options import BARE_NUMBER_RULE, ArgumentParser, add_material_options, material_from_args
+from ..inputs import check_plausible_lengths, input_reading, material_from_args, positive_quantity
+from ..options import BARE_NUMBER_RULE, ArgumentParser, add_material_options
 from ..units import OptionError
 from ..output_files import (EXIT_IO_ERROR, EXIT_REFUSED, OutputPathError, check_output, check_outputs,
                             finish_stdout)

@@ -41,7 +41,7 @@ UNITS = {name: unit for name, (_key, unit, _kind) in zip(PARAMETER_NAMES, PARAME
 #: "auto" by less than that tolerance.
 FIT_OPTIONS = {"plasticity": "on", "plate_waves": "on"}
 
-#: Poisson's ratio: [0, 0.5] (:func:`restitution.validation.check_poisson`); the fit stays just below 0.5.
+#: Poisson's ratio: [0, 0.5] (:func:`restitution.domain.check_poisson`); the fit stays just below 0.5.
 _NU_DOMAIN = (0.0, 0.5)
 
 

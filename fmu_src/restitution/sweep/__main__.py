@@ -175,8 +175,7 @@ def build_spec(args) -> tuple[SweepSpec, dict]:
 def _material_values(args) -> dict:
     """The fixed values (SI, by FMU name) of --sphere/--plate, --ROLE-material and --ROLE-E ...: a
     material's four properties; refused with --pair, which names both materials."""
-    from ..inputs import MATERIAL_PROPERTIES
-    from ..options import material_from_args
+    from ..inputs import MATERIAL_PROPERTIES, material_from_args
 
     out = {}
     for role in ("sphere", "plate"):

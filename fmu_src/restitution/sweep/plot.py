@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from ..output_files import atomic_write
-from .spec import T_OVER_D, pair_label
+from .columns import INPUT_NAMES, T_OVER_D, pair_label
 from ..inputs import unit_of
 
 __all__ = ["plot_cor_map", "plot_random", "NoPlot", "plot_kind", "map_axes"]
@@ -262,7 +262,6 @@ def map_axes(cols, spec=None) -> list:
     axes first (a curve of e for one, a map for two). :class:`NoPlot` when the table keeps none."""
     if "v_approach" in cols and T_OVER_D in cols:
         return ["v_approach", T_OVER_D]
-    from .spec import INPUT_NAMES
 
     n = np.size(cols["e"])
     ok = np.asarray(cols["ok"], dtype=bool) if "ok" in cols else np.isfinite(np.asarray(cols["e"], dtype=float))

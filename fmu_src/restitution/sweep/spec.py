@@ -26,9 +26,11 @@ from pathlib import Path
 
 import numpy as np
 
-from ..fmu.models.sphere_plate_impact.variables import MATERIAL_SELECTORS, TABLE, fmu_values
-from ..materials import MATERIALS, TABLE4_CASES, table4_case
+from ..fmu.models.sphere_plate_impact.variables import fmu_values
+from ..materials import MATERIALS
 from ..inputs import ROWS, QuantityError, outside
+from .columns import (CODES, INPUT_NAMES, INPUTS, INTEGER_INPUTS, OUTPUT_NAMES, OUTPUTS,  # noqa: F401
+                      SETTABLE, START, T_OVER_D, is_one_value_view, pair_label, resolve_pair)  # (named here too)
 from .values import (MAX_AXIS_VALUES, axis_form, axis_size, draw_standard, from_standard,  # noqa: F401 (axis_size)
                      parse_distribution, parse_values, range_ends, range_size, range_values)
 
@@ -40,24 +42,7 @@ class SizeError(ValueError):
     """A sweep refused before any work by the size guard: an axis too long to build, or a table too
     big for the memory budget and for the disk (the message gives the numbers)."""
 
-#: The FMU's inputs and parameters a sweep sets: all but the material selectors (a sweep gives the
-#: materials as pairs and sets their properties, the selectors stay custom).
-SETTABLE = tuple(v for v in TABLE.settable if v.name not in MATERIAL_SELECTORS)
-#: (FMU name, impact() keyword, FMI type, start value) of each of them.
-INPUTS = tuple((v.name, v.key, v.type, v.start) for v in SETTABLE)
-INPUT_NAMES = tuple(row[0] for row in INPUTS)
-START = {row[0]: row[3] for row in INPUTS}
-INTEGER_INPUTS = tuple(row[0] for row in INPUTS if row[2] == "Integer")
 
-#: Integer-coded parameters: the words accepted for each code (as in the FMU's descriptions).
-CODES = {v.name: v.codes for v in SETTABLE if v.choices is not None}
-
-#: (FMU name, ImpactResult field, FMI type): the FMU's outputs, as restitution.model.published gives them.
-OUTPUTS = tuple((v.name, v.key, v.type) for v in TABLE.outputs)
-OUTPUT_NAMES = tuple(row[0] for row in OUTPUTS)
-
-#: Derived axis: plate.t = t_over_d * sphere.d.
-T_OVER_D = "t_over_d"
 #: Material-property inputs a material pair sets.
 PAIR_INPUTS = tuple(fmu_values(**MATERIALS["s2_tool_steel"].params("sphere"), **MATERIALS["al_6061"].params("plate")))
 #: Largest ``samples`` and ``seed`` a spec accepts.
@@ -82,38 +67,9 @@ def canonical_name(name: str) -> str:
                      f"({', '.join(INPUT_NAMES)}) or {T_OVER_D!r}")
 
 
-# --- material pairs -------------------------------------------------------------------
-def resolve_pair(pair: str):
-    """(sphere Material, plate Material) of ``"sphere_key/plate_key"`` (keys of
-    :data:`restitution.MATERIALS`) or ``"table4:A1"`` (Green 2022 Table 4 cases)."""
-    text = pair.strip()
-    if text.lower().startswith("table4:"):
-        case = text.split(":", 1)[1].strip().upper()
-        if case not in TABLE4_CASES:
-            raise ValueError(f"pair {pair!r}: Table 4 cases are {', '.join(TABLE4_CASES)}")
-        return table4_case(case)
-    sphere, sep, plate = text.partition("/")
-    if not sep:
-        raise ValueError(f"pair {pair!r}: write it as sphere_material/plate_material, e.g. s2_tool_steel/al_6061")
-    missing = [k for k in (sphere.strip(), plate.strip()) if k not in MATERIALS]
-    if missing:
-        raise ValueError(f"pair {pair!r}: unknown material(s) {missing}; known: {', '.join(sorted(MATERIALS))}")
-    return MATERIALS[sphere.strip()], MATERIALS[plate.strip()]
-
-
 def _pair_values(pair: str) -> dict:
     sphere, plate = resolve_pair(pair)
     return fmu_values(**sphere.params("sphere"), **plate.params("plate"))
-
-
-def pair_label(pair: str) -> str:
-    """Readable name of a pair: 'S2 tool steel on Aluminum 6061'."""
-    if not pair:
-        return "sphere and plate as set"
-    if pair.lower().startswith("table4:"):
-        return f"Table 4 case {pair.split(':', 1)[1].strip().upper()}"
-    sphere, plate = resolve_pair(pair)
-    return f"{sphere.name} on {plate.name}"
 
 
 # --- the spec --------------------------------------------------------------------------
@@ -125,13 +81,6 @@ def _section(section: str):
     except QuantityError as exc:
         exc.section = exc.section or section
         raise
-
-
-def is_one_value_view(column: np.ndarray) -> bool:
-    """Whether ``column`` (1-d, more than one case) is a view of one value (stride 0), as
-    :meth:`SweepSpec.cases` gives a column that holds one value over its range: what can be checked,
-    sent and evaluated once for the whole range."""
-    return column.ndim == 1 and column.size > 1 and column.strides[0] == 0
 
 
 @dataclass

@@ -24,8 +24,7 @@ from ..fmu.models.sphere_plate_impact.variables import TABLE
 from ..output_files import write_json
 from .order_statistics import Scratch, distinct, moments_and_order_statistics, order_statistics
 from .student_t import t975
-from .spec import OUTPUTS, T_OVER_D, pair_label
-from .table import VALIDITY, table_counts
+from .columns import OUTPUTS, T_OVER_D, VALIDITY, pair_label, table_counts
 from ..inputs import unit_of
 
 __all__ = ["SweepStatistics", "UNITS", "MAIN_OUTPUTS", "PERCENTILES", "describe", "write_summary"]

@@ -18,8 +18,8 @@ import numpy as np
 from ..fmu.models.sphere_plate_impact.variables import TABLE
 from ..output_files import atomic_write as write_atomic
 from . import arrow_arrays
-from .spec import (INPUT_NAMES, INTEGER_INPUTS, OUTPUT_NAMES, OUTPUTS as _OUTPUT_TYPES, T_OVER_D, SweepSpec,
-                   is_one_value_view)
+from .columns import (INPUT_NAMES, INTEGER_INPUTS, OUTPUT_NAMES, OUTPUTS as _OUTPUT_TYPES, T_OVER_D, VALIDITY,
+                      is_one_value_view, table_counts)
 
 __all__ = ["COLUMNS", "VALIDITY", "PackedColumns", "read_table", "table_counts", "assemble",
            "keep_columns", "TableBuilder", "write_atomic", "write_csv_rows", "chunk_table", "pair_codes",
@@ -48,26 +48,11 @@ def csv_header(names) -> str:
 
 
 #: Validity columns every table keeps, whatever ``columns`` asks for (with ``case``, ``pair`` and ``ok``).
-VALIDITY = ("valid", "jgm.in_range", "zener.in_range")
-
-
 _ALWAYS = ("case", "pair", *VALIDITY, "ok")
 
 
 #: Rows converted to text at a time when a table is written as CSV (bounds the memory it takes).
 CSV_BLOCK = 65_536
-
-
-def table_counts(columns: dict) -> dict:
-    """Cases, evaluated cases (``ok``), cases inside the validated ranges (``valid``) and evaluated
-    cases outside each range (``valid``, ``jgm.in_range``, ``zener.in_range`` false), as ints."""
-    n = int(np.size(columns["case"]))
-    ok = np.asarray(columns["ok"], dtype=bool) if "ok" in columns else np.ones(n, dtype=bool)
-    counts = {"cases": n, "ok": int(np.count_nonzero(ok)),
-              "inside": int(np.count_nonzero(columns["valid"])) if "valid" in columns else n}
-    for flag in VALIDITY:
-        counts[flag] = int(np.count_nonzero(ok & ~np.asarray(columns[flag], dtype=bool))) if flag in columns else 0
-    return counts
 
 
 class PackedColumns:
@@ -120,7 +105,7 @@ def _column_type(name: str):
     return float
 
 
-def assemble(spec: SweepSpec, parts: list, keep) -> dict:
+def assemble(spec, parts: list, keep) -> dict:
     """The table from consecutive chunks (each a dict of columns or a :class:`PackedColumns`), as
     :class:`TableBuilder` makes it. ``parts`` is consumed: each chunk is dropped once copied."""
     rows = sum(part.rows if isinstance(part, PackedColumns) else int(np.size(part["case"])) for part in parts)
@@ -149,7 +134,7 @@ class TableBuilder:
     read-only view of that value (:func:`~restitution.sweep.spec.is_one_value_view`): no memory, as in
     the chunks. A chunk that is the whole table gives its own arrays (no copy)."""
 
-    def __init__(self, spec: SweepSpec, keep, rows: int):
+    def __init__(self, spec, keep, rows: int):
         self.spec, self.rows = spec, rows
         self.names = [c for c in COLUMNS if keep is None or c in keep]
         self.filled = {}  #: start -> stop of each chunk added
@@ -254,11 +239,11 @@ def _schema(names, arrays):
                       for name, a in zip(names, arrays)])
 
 
-def _pair_labels(spec: SweepSpec):
+def _pair_labels(spec):
     return arrow_arrays.labels([*spec.pairs, ""])  # the last: no pairs (index -1)
 
 
-def chunk_table(spec: SweepSpec, columns: dict | None, keep):
+def chunk_table(spec, columns: dict | None, keep):
     """One chunk's columns (as :meth:`SweepSpec.cases` and the back ends give them; None: no rows) as a
     pyarrow Table of the table's columns at their types, ``pair`` dictionary-encoded with the spec's
     pair labels as the dictionary (the same in every chunk). Columns that hold one value (views of it,
@@ -306,7 +291,7 @@ def _constant_array(value: np.ndarray, rows: int):
     return array
 
 
-def pair_codes(spec: SweepSpec, column) -> np.ndarray:
+def pair_codes(spec, column) -> np.ndarray:
     """The spec's pair index (-1: no pairs) of each row of a ``pair`` column read from a Parquet file
     (dictionary-encoded: its labels matched to the spec's, whatever dictionary the file kept)."""
     import pyarrow as pa

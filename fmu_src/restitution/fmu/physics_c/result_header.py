@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import sys
 
-from ...model import EDGE_ECHO_PUBLISHED_MAX, RECORD_FLAGS, RECORD_REALS
+from ...record import EDGE_ECHO_PUBLISHED_MAX, RECORD_FLAGS, RECORD_REALS
 
 __all__ = ["RESULT_HEADER", "result_header"]
 

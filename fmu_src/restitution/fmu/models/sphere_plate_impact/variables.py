@@ -10,8 +10,7 @@ from __future__ import annotations
 import math
 
 from ....materials import ALIASES, MATERIALS
-from ....domain import DOMAIN
-from ....model import EFFECT_MODES, RESTITUTION_MODELS, ZENER_METHODS
+from ....domain import DOMAIN, EFFECT_MODES, RESTITUTION_MODELS, ZENER_METHODS
 from ...table import Table, calculated_parameter, input_, output, parameter
 
 _BALL, _PLATE = MATERIALS["s2_tool_steel"], MATERIALS["al_6061"]
