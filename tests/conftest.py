@@ -84,7 +84,7 @@ def host_fmi3(tmp_path_factory):
     machine's platform only (seconds; the session's built_fmus builds every platform)."""
     from fmpy import platform_tuple
 
-    from restitution.fmu.builders.compile import NativeBuildSkipped
+    from restitution.fmu.builders.toolchains import NativeBuildSkipped
     from restitution.fmu.builders.native import build_native_one
 
     out = tmp_path_factory.mktemp("fmi3_host")
@@ -134,7 +134,7 @@ def fmi3_ball_fmu(built_fmus) -> Path:
 def host_native_fmus(tmp_path_factory) -> Path:
     """A folder with the native FMUs for this machine's platform only (gcc, seconds: no zig): fmi2/ (linux64)
     and fmi3/ (x86_64-linux) BouncingBall.fmu and SpherePlateImpact.fmu. Skips where they cannot be built."""
-    from restitution.fmu.builders.compile import NativeBuildSkipped
+    from restitution.fmu.builders.toolchains import NativeBuildSkipped
     from restitution.fmu.builders.native import build_native_one
 
     out = tmp_path_factory.mktemp("host_native")

@@ -31,8 +31,10 @@ FMU = PACKAGE / "fmu"
 LAYERS = {"table": 0, "physics_c": 1, "pythonfmu_guard": 1, "models": 1, "describe": 2, "ssp": 2, "compat": 2, "installed": 2, "builders": 3, "__init__": 4, "__main__": 4}
 
 
-def _imports(path: Path, package: str) -> set[str]:
-    """The absolute dotted names ``path`` (a module of ``package``) imports."""
+def _imports(path: Path, package: str, modules=frozenset()) -> set[str]:
+    """The absolute dotted names ``path`` (a module of ``package``) imports. ``from PACKAGE import a, b``
+    where every name is a module of ``modules`` imports those modules, not the package's ``__init__``
+    (which any import of a submodule runs anyway)."""
     found = set()
     for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
         if isinstance(node, ast.Import):
@@ -43,14 +45,17 @@ def _imports(path: Path, package: str) -> set[str]:
                 stem = ".".join(base + ([node.module] if node.module else []))
             else:
                 stem = node.module or ""
-            found.add(stem)
-            found |= {f"{stem}.{alias.name}" for alias in node.names}
+            names = {f"{stem}.{alias.name}" for alias in node.names}
+            if not names <= modules:
+                found.add(stem)
+            found |= names
     return found
 
 
 def _module_package(path: Path) -> str:
-    parts = path.relative_to(PACKAGE.parent).with_suffix("").parts
-    return ".".join(parts if path.name == "__init__.py" else parts[:-1])
+    """The package ``path``'s relative imports start from: its folder's (an ``__init__.py`` is its
+    folder's package itself)."""
+    return ".".join(path.relative_to(PACKAGE.parent).parts[:-1])
 
 
 def _part(dotted: str) -> str | None:
@@ -95,12 +100,16 @@ WINGS = ("cor", "fit", "sweep", "scene", "export")
 _TOP_LEVEL = {"inputs": "readers", "options": "readers", "materials_table": "readers", "command": "top",
               "__main__": "top"}
 #: Most modules on one chain of imports (lazy ones included): 17 before the wings were cut apart (the
-#: cycles broken), 16 after impact(outputs=...) split the array steps out of model.py; 10 once plain data sat
+#: cycles broken), 16 after impact(outputs=...) split the array steps out of model.py; then plain data sat
 #: below the code using it (the result record, the option words, a sweep's columns), Zener's solvers side
 #: by side (the ODE's large-lambda form from zener_exact, which imports nothing of the package), and the
-#: sweep's table, statistics and plots reading its columns, not its spec (docs/layout.md). Four chains are
-#: that deep, one per wing but export, e.g. sweep's __main__ -> run -> result -> plot -> statistics -> inputs
-#: -> the interface table -> materials -> domain -> _num. A ratchet: a deeper chain fails.
+#: sweep's table, statistics and plots read its columns, not its spec. Read right (a package's
+#: ``__init__`` imports relative to itself: they had been dropped), the builders made it 14, 10 once they
+#: sat side by side too: the plan chooses (with the compilers' flags and the products' names beside the
+#: sources), ``products.run`` builds, and the tools import the builder they use, not the package's
+#: ``__init__``. Chains of 10: sweep's __main__ -> compare -> backends -> spec -> values -> inputs -> the
+#: interface table -> materials -> domain -> _num; scene's, through cosim; fit's, through the model
+#: (docs/layout.md). A ratchet: a deeper chain fails.
 MAX_DEPTH = 10
 
 
@@ -147,7 +156,7 @@ def package_graph() -> dict:
     paths = {_module_name(p): p for p in sorted(PACKAGE.rglob("*.py")) if "__pycache__" not in p.parts}
     graph = {}
     for module, path in paths.items():
-        names = _imports(path, _module_package(path))
+        names = _imports(path, _module_package(path), frozenset(paths))
         graph[module] = {n for n in names if n in paths and n != module}
     return graph
 
@@ -229,6 +238,14 @@ def test_a_cycle_is_found():
     graph = package_graph()
     graph["restitution.units"].add("restitution.materials")  # materials imports units: now a circle
     assert ["restitution.materials", "restitution.units"] in cycles(graph)
+
+
+def test_a_packages_init_is_read_with_its_own_imports():
+    """``restitution.fmu``'s ``__init__`` imports its builders (lazily, on first use), and the top
+    package's imports the model: a package's relative imports start at its own folder."""
+    graph = package_graph()
+    assert "restitution.fmu.builders" in graph["restitution.fmu"]
+    assert "restitution.model" in graph["restitution"]
 
 
 def test_the_import_chains_are_no_deeper_than_the_ratchet():

@@ -14,7 +14,7 @@ from pathlib import Path
 import pytest
 
 import restitution as r
-from restitution.fmu.builders import products as fmu_build
+from restitution.fmu.builders import products as fmu_build, sources
 
 ROOT = Path(__file__).resolve().parents[2]
 LOCK = ROOT / "requirements" / "dev.lock"
@@ -64,7 +64,7 @@ def test_built_fmu_is_readable_by_others_and_records_its_sources(built):
     umask = os.umask(0o022)
     os.umask(umask)
     assert mode == 0o666 & ~umask
-    assert fmu_build.recorded_source_hash(fmu) == fmu_build.source_hash("SpherePlateImpact")
+    assert sources.recorded_source_hash(fmu) == sources.source_hash("SpherePlateImpact")
     with zipfile.ZipFile(fmu) as z:
         assert "resources/restitution/model.py" in z.namelist()
         assert not any(n.startswith(("resources/restitution/scene/", "resources/restitution/sweep/",

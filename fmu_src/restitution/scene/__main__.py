@@ -16,7 +16,7 @@ import sys
 from pathlib import Path
 
 from ..extras import MissingExtra, require
-from ..fmu.builders import BuildError
+from ..fmu.builders.products import BuildError
 from ..options import ArgumentParser
 from ..output_files import (EXIT_IO_ERROR, EXIT_REFUSED, OutputPathError, check_output, check_output_dir,
                             check_outputs, describe_os_error)

@@ -69,7 +69,7 @@ def chosen_fmu(fmu=None, rebuild: bool = False, log=None) -> Path:
         from ..cosim.fmu import check_impact_fmu
 
         return check_impact_fmu(fmu)
-    from ..fmu.builders import default_fmu
+    from ..fmu.builders.products import default_fmu
 
     return default_fmu(rebuild=rebuild, log=log)
 
@@ -83,7 +83,7 @@ def chosen_ball_fmu(ball_fmu=None, rebuild: bool = False, log=None) -> Path:
 
     if ball_fmu is not None:
         return check_event_ball_fmu(ball_fmu)
-    from ..fmu.builders import default_fmu
+    from ..fmu.builders.products import default_fmu
 
     path = default_fmu(rebuild=rebuild, log=log).parent / "fmi3" / "BouncingBall.fmu"
     if not path.is_file():

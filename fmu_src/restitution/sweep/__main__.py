@@ -413,7 +413,7 @@ def _impact_fmu(parser, backend: str, fmu):
         parser.error(str(exc))
 
     if backend in ("fmu", "both") and fmu is None:
-        from ..fmu.builders import BuildError, default_fmu
+        from ..fmu.builders.products import BuildError, default_fmu
         try:
             fmu = default_fmu(log=print)
         except BuildError as exc:

@@ -447,7 +447,7 @@ class FmuBackend(Backend):
 
     def __init__(self, fmu=None):
         if fmu is None:
-            from ..fmu.builders import default_fmu
+            from ..fmu.builders.products import default_fmu
             fmu = default_fmu()
         self.path = Path(fmu).resolve()
         data = self.path.read_bytes()

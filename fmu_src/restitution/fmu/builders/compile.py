@@ -14,38 +14,17 @@ from pathlib import Path
 from ..physics_c.result_header import RESULT_HEADER, result_header
 from ..physics_c.zener_table_header import zener_table_header
 from .sources import FRONT, PHYSICS_C
+from .toolchains import CFLAGS
 
-#: The FMI headers fmpy ships, by FMI version (used at build time only; not copied into the FMU: hosts
-#: bring them).
-FMI_HEADERS = {"2.0": ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h"),
-               "3.0": ("fmi3Functions.h", "fmi3FunctionTypes.h", "fmi3PlatformTypes.h")}
 #: The hand-written C sources of the physics (the table header is generated, see :func:`prepare_sources`).
 PHYSICS_SOURCES = ("rst_physics.h", "rst_physics.c")
 TABLE_HEADER = "rst_zener_table.h"
 #: The front's header that prefixes every external name when FMI2_FUNCTION_PREFIX or FMI3_FUNCTION_PREFIX is defined.
 PREFIX_HEADER = "rst_prefix.h"
-#: C99, every warning an error; no contraction of a*b+c into an FMA, so the C rounds as the Python does.
-CFLAGS = ("-std=c99", "-O2", "-Wall", "-Wextra", "-Werror", "-pedantic", "-ffp-contract=off")
 
 
 class CompilerMissing(RuntimeError):
     """The C compiler asked for is not installed."""
-
-
-class NativeBuildSkipped(RuntimeError):
-    """A native FMU (or one of its binaries) cannot be built here; the message says why."""
-
-
-def fmi_include_dir(fmi_version: str = "2.0") -> Path:
-    """fmpy's copy of the FMI C headers of ``fmi_version``."""
-    try:
-        import fmpy
-    except ImportError:
-        raise NativeBuildSkipped(f"fmpy is not installed (its FMI {fmi_version} headers are needed)") from None
-    path = Path(fmpy.__file__).resolve().parent / "c-code"
-    if not all((path / h).is_file() for h in FMI_HEADERS[fmi_version]):
-        raise NativeBuildSkipped(f"FMI {fmi_version} headers not found in {path}")
-    return path
 
 
 def prepare_sources(directory: Path) -> Path:

@@ -44,8 +44,7 @@ from xml.etree import ElementTree
 
 from ...reproducible import write_zip
 from . import toolchains
-from .compile import NativeBuildSkipped, fmi_include_dir
-from .toolchains import Compiler
+from .toolchains import Compiler, NativeBuildSkipped, fmi_include_dir
 from .sources import FRONT, GUARD, front_files
 
 #: The guard's C sources: the front, then the guard's backend (forwarding to pythonfmu) and Python loader.

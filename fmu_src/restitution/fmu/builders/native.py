@@ -28,22 +28,19 @@ from pathlib import Path
 from ...about import VERSION
 from ..describe import fmi2, fmi3
 from ..describe.c_header import c_header, model_info_header
-from ..models import FOLDERS, native_sources, table
+from ..models import native_sources, table
 from . import sources
 from . import toolchains
-from .compile import PHYSICS_SOURCES, NativeBuildSkipped, fmi_include_dir, prepare_sources
+from .compile import PHYSICS_SOURCES, prepare_sources
+from .toolchains import NativeBuildSkipped, fmi_include_dir
 from .files import place, zip_dir
 from .licenses import documentation_files
-from .sources import BUILD_INFO, FRONT, PHYSICS_C, native_source_hash
+from .sources import BACKENDS, BUILD_INFO, FRONT, PHYSICS_C, VERSION_DIRS, native_source_hash
 
-#: The models with a native backend (every one).
-BACKENDS = tuple(FOLDERS)
 #: Models whose backend calls the impact physics (rst_physics.c and the generated Zener table).
 PHYSICS_MODELS = {"SpherePlateImpact"}
 INTERFACE_HEADER = "rst_{model}_interface.h"
 MODEL_INFO_HEADER = "rst_model_info.h"
-#: Where the FMUs of each FMI version go, below the build's output directory.
-VERSION_DIRS = {"2.0": "fmi2", "3.0": "fmi3"}
 
 
 def front_files(fmi_version: str = "2.0") -> list[Path]:

@@ -1,5 +1,5 @@
 """The build plan: which FMUs a build makes, for which platforms, with which compiler; which of them a
-directory lacks or holds stale; and building a plan, a line per product and platform as it goes.
+directory lacks or holds stale (building a plan is :mod:`.products`'s).
 
 * :func:`full_plan`: every FMU of the project, the native ones for every platform (what ``python -m
   restitution.fmu build`` builds, and what :func:`~restitution.fmu.builders.products.default_fmu` keeps
@@ -8,7 +8,7 @@ directory lacks or holds stale; and building a plan, a line per product and plat
   seconds with no zig (its guard is gcc's, for x86_64-linux, the host);
 * :func:`steps`: a plan's products, platforms and compilers, as the build will meet them;
 * :func:`stale`: why a product must be built in a directory (missing, built from other sources, lacking
-  a platform this machine can build), or None; :func:`run`: builds a plan.
+  a platform this machine can build), or None. :func:`restitution.fmu.builders.products.run` builds a plan.
 
 A native FMU records the binaries/ folders it holds (``resources/build_info.json``: ``platforms``); a
 directory whose native FMU lacks one that a compiler here can build (an FMU built where zig was missing,
@@ -23,12 +23,10 @@ from pathlib import Path
 from typing import NamedTuple
 
 from . import toolchains
-from .files import writable_dir
-from .progress import Progress, stderr_line
-from .python_fmu import FMUS, PYTHONFMU_FOLDERS, build_one, toolchain_label
-from .sources import BUILD_INFO, native_source_hash, source_hash
+from .sources import BACKENDS, BUILD_INFO, FMUS, PYTHONFMU_FOLDERS, VERSION_DIRS, native_source_hash, source_hash
+from .toolchains import pythonfmu_label
 
-__all__ = ["Product", "Step", "full_plan", "model_plan", "steps", "stale", "to_build", "run"]
+__all__ = ["Product", "Step", "full_plan", "model_plan", "steps", "stale", "to_build", "zig_targets", "build_info"]
 
 #: The kinds of FMU, with the folder below the output directory and the FMI version of each.
 KINDS = {"pythonfmu": ("", "2.0"), "fmi2": ("fmi2/", "2.0"), "fmi3": ("fmi3/", "3.0")}
@@ -85,8 +83,6 @@ class Step(NamedTuple):
 
 def full_plan() -> list[Product]:
     """Every FMU of the project: the pythonfmu ones, then the native FMI 2.0 and FMI 3.0 ones, every platform."""
-    from .native import BACKENDS, VERSION_DIRS
-
     plan = [Product(model) for model in FMUS]
     return plan + [Product(model, VERSION_DIRS[v]) for v in VERSION_DIRS for model in BACKENDS]
 
@@ -103,7 +99,7 @@ def steps(plan, guard: bool = True) -> list[Step]:
     out = []
     for product in plan:
         if not product.native:
-            out.append(Step(product.name, ", ".join(PYTHONFMU_FOLDERS), "x86_64-linux", toolchain_label(guard)))
+            out.append(Step(product.name, ", ".join(PYTHONFMU_FOLDERS), "x86_64-linux", pythonfmu_label(guard)))
             continue
         for folder in product.planned_folders():
             for target in toolchains.folders(product.fmi_version)[folder]:
@@ -122,7 +118,7 @@ def zig_targets(plan) -> list[toolchains.Platform]:
     return [toolchains.platform(name) for name in dict.fromkeys(names)]
 
 
-def _build_info(fmu: Path) -> dict | None:
+def build_info(fmu: Path) -> dict | None:
     try:
         with zipfile.ZipFile(fmu) as z:
             return json.loads(z.read(BUILD_INFO))
@@ -140,7 +136,7 @@ def stale(product: Product, out_dir) -> str | None:
     fmu = product.path(out_dir)
     if not fmu.is_file():
         return "missing"
-    info = _build_info(fmu)
+    info = build_info(fmu)
     expected = native_source_hash(product.model) if product.native else source_hash(product.model)
     if info is None or info.get("source_hash") != expected:
         return "built from other sources"
@@ -154,51 +150,3 @@ def stale(product: Product, out_dir) -> str | None:
 def to_build(plan, out_dir) -> list[tuple[Product, str]]:
     """(product, why) for each product of ``plan`` that must be built into ``out_dir`` (:func:`stale`)."""
     return [(p, why) for p in plan for why in [stale(p, out_dir)] if why is not None]
-
-
-def _headline(plan, out_dir) -> str:
-    count = f"{len(plan)} FMU{'s' if len(plan) != 1 else ''}"
-    parts = []
-    python = [p.name for p in plan if not p.native]
-    if python:
-        parts.append(f"{', '.join(python)} (pythonfmu)")
-    native = [p for p in plan if p.native]
-    if native:
-        found = {s.platform for s in steps(native) if s.compiler is not None}
-        platforms = [t.name for t in toolchains.PLATFORMS if t.name in found]
-        parts.append(f"{', '.join(p.name for p in native)} (native C for {', '.join(platforms) or 'no platform'})")
-    return f"{count} into {out_dir}: {'; '.join(parts)}"
-
-
-def run(plan, out_dir, guard: bool = True, log=None, progress: Progress | None = None) -> list[Path]:
-    """Build every product of ``plan`` into ``out_dir``, in order; returns the FMUs built. ``log``: every
-    line (the progress and the warnings; default stderr, flushed). A native FMU that cannot be built here
-    is skipped with a warning (the pythonfmu ones stay usable); a pythonfmu one that cannot be built
-    raises :class:`~restitution.fmu.builders.files.BuildError`."""
-    from .compile import NativeBuildSkipped
-    from .native import build_native_one
-
-    say = log if log is not None else stderr_line
-    out_dir = writable_dir(out_dir)  # an unusable --out is one line, before any other
-    progress = progress or Progress(say)
-    progress.expect_zig(zig_targets(plan))
-    start = progress.clock()
-    progress.line(_headline(plan, out_dir))
-    built = []
-    for product in plan:
-        if not product.native:
-            built.append(build_one(product.model, out_dir, guard=guard, log=say, progress=progress))
-            continue
-        begun = progress.clock()
-        try:
-            fmu = build_native_one(product.model, out_dir, log=say, fmi_version=product.fmi_version,
-                                   folders=product.folders, progress=progress)
-        except NativeBuildSkipped as exc:
-            say(f"warning: native FMI {product.fmi_version} {product.model}.fmu not built: {exc}")
-            continue
-        platforms = (_build_info(fmu) or {}).get("platforms", [])
-        progress.line(f"{product.name:<30} validated, binaries/ {', '.join(platforms)}: "
-                      f"{progress.clock() - begun:.1f} s")
-        built.append(fmu)
-    progress.line(f"{len(built)} FMU{'s' if len(built) != 1 else ''} built in {progress.clock() - start:.1f} s")
-    return built

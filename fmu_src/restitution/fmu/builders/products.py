@@ -4,7 +4,7 @@
 
 writes ``DIR/<model>.fmu`` (pythonfmu, :mod:`.python_fmu`), ``DIR/fmi2/<model>.fmu`` and
 ``DIR/fmi3/<model>.fmu`` (native C, :mod:`.native`, for every platform) for every model, a line per
-product and platform as it goes (:mod:`.plan`, :mod:`.progress`). Each builder reads the package only,
+product and platform as it goes (:func:`run`: what :mod:`.plan` chose, told by :mod:`.progress`). Each builder reads the package only,
 never another builder's output.
 """
 from __future__ import annotations
@@ -13,13 +13,15 @@ import os
 from pathlib import Path
 
 from ..installed import installed_dir
-from .files import BuildError
-from .plan import full_plan, model_plan, run, to_build
-from .progress import PREFIX, stderr_line
+from . import toolchains
+from .toolchains import NativeBuildSkipped
+from .files import BuildError, writable_dir
+from .plan import build_info, full_plan, model_plan, steps, to_build, zig_targets
+from .progress import PREFIX, Progress, stderr_line
 from .python_fmu import FMUS, build_one
-from .sources import PACKAGE, recorded_source_hash, source_hash
+from .sources import PACKAGE
 
-__all__ = ["FMUS", "SCOPES", "BuildError", "build_all", "build_one", "default_fmu", "default_fmu_dir"]
+__all__ = ["FMUS", "SCOPES", "BuildError", "build_all", "build_one", "default_fmu", "default_fmu_dir", "run"]
 
 #: What :func:`default_fmu` keeps up to date: "all", every FMU for every platform buildable here (what the
 #: tools that use the directory's other FMUs, fmi2/ and fmi3/, need); "model", ``<model>.fmu`` alone.
@@ -96,3 +98,50 @@ def default_fmu(out_dir: str | Path | None = None, model: str = "SpherePlateImpa
             raise BuildError(f"no usable {fmu.name} at {out} and it cannot be built here ({exc}); "
                              f"pass --fmu PATH to use an existing one") from None
     return fmu
+
+
+def _headline(plan, out_dir) -> str:
+    count = f"{len(plan)} FMU{'s' if len(plan) != 1 else ''}"
+    parts = []
+    python = [p.name for p in plan if not p.native]
+    if python:
+        parts.append(f"{', '.join(python)} (pythonfmu)")
+    native = [p for p in plan if p.native]
+    if native:
+        found = {s.platform for s in steps(native) if s.compiler is not None}
+        platforms = [t.name for t in toolchains.PLATFORMS if t.name in found]
+        parts.append(f"{', '.join(p.name for p in native)} (native C for {', '.join(platforms) or 'no platform'})")
+    return f"{count} into {out_dir}: {'; '.join(parts)}"
+
+
+def run(plan, out_dir, guard: bool = True, log=None, progress: Progress | None = None) -> list[Path]:
+    """Build every product of ``plan`` into ``out_dir``, in order; returns the FMUs built. ``log``: every
+    line (the progress and the warnings; default stderr, flushed). A native FMU that cannot be built here
+    is skipped with a warning (the pythonfmu ones stay usable); a pythonfmu one that cannot be built
+    raises :class:`~restitution.fmu.builders.files.BuildError`."""
+    from .native import build_native_one  # it loads the describers: only when building
+
+    say = log if log is not None else stderr_line
+    out_dir = writable_dir(out_dir)  # an unusable --out is one line, before any other
+    progress = progress or Progress(say)
+    progress.expect_zig(zig_targets(plan))
+    start = progress.clock()
+    progress.line(_headline(plan, out_dir))
+    built = []
+    for product in plan:
+        if not product.native:
+            built.append(build_one(product.model, out_dir, guard=guard, log=say, progress=progress))
+            continue
+        begun = progress.clock()
+        try:
+            fmu = build_native_one(product.model, out_dir, log=say, fmi_version=product.fmi_version,
+                                   folders=product.folders, progress=progress)
+        except NativeBuildSkipped as exc:
+            say(f"warning: native FMI {product.fmi_version} {product.model}.fmu not built: {exc}")
+            continue
+        platforms = (build_info(fmu) or {}).get("platforms", [])
+        progress.line(f"{product.name:<30} validated, binaries/ {', '.join(platforms)}: "
+                      f"{progress.clock() - begun:.1f} s")
+        built.append(fmu)
+    progress.line(f"{len(built)} FMU{'s' if len(built) != 1 else ''} built in {progress.clock() - start:.1f} s")
+    return built

@@ -34,15 +34,14 @@ from xml.etree import ElementTree as ET
 from ..describe import fmi2
 from ..describe.c_header import c_header
 from ..describe.common import generation_date_and_time
-from ..models import FOLDERS, SLAVE_SUPPORT, slave_script, table
+from ..models import SLAVE_SUPPORT, table
 from .files import BuildError, place, rewrite_zip, writable_dir
 from .licenses import documentation_files
-from .sources import BUILD_INFO, PACKAGE, bundle_filter, source_hash
+from .sources import BUILD_INFO, FMUS, PACKAGE, PYTHONFMU_FOLDERS, bundle_filter, source_hash
+from .toolchains import pythonfmu_label as toolchain_label
 
 __all__ = ["FMUS", "build_one", "registered_variables"]
 
-#: FMU model identifier -> pythonfmu slave script (shipped with the package, in the model's folder).
-FMUS = {model: slave_script(model) for model in FOLDERS}
 
 
 def _require_build_tools():
@@ -76,8 +75,6 @@ def _check_registration(model: str, xml_text: str) -> None:
                          f"table {expected[first:first + 1]})")
 
 
-#: The binaries/ folders pythonfmu's own binaries fill (its wheel's; the guard replaces the Linux one).
-PYTHONFMU_FOLDERS = ("linux64", "win64")
 
 
 def _guard_compiler_found() -> bool:
@@ -88,25 +85,6 @@ def _guard_compiler_found() -> bool:
     except ToolchainMissing:
         return False
     return True
-
-
-def toolchain_label(guard: bool = True) -> str:
-    """What builds a pythonfmu FMU here, as the build's lines say it: pythonfmu and its version, and the
-    compiler of the guard (zig for glibc 2.17, else gcc) or why there is none."""
-    from importlib import metadata
-
-    try:
-        label = f"pythonfmu {metadata.version('pythonfmu')}"
-    except metadata.PackageNotFoundError:
-        label = "pythonfmu (not installed)"
-    if not guard:
-        return f"{label}, no guard"
-    from .toolchains import ToolchainMissing, compiler, compiler_label
-
-    try:
-        return f"{label}, guard {compiler_label('x86_64-linux', compiler('x86_64-linux'))}"
-    except ToolchainMissing:
-        return f"{label}, no guard (no gcc or zig)"
 
 
 def build_one(model: str, out_dir: Path, guard: bool = True, log=None, progress=None) -> Path:

@@ -11,7 +11,7 @@ import shutil
 import zipfile
 from pathlib import Path
 
-from ..models import HERE as MODELS, SLAVE_SUPPORT, native_sources, slave_script
+from ..models import FOLDERS, HERE as MODELS, SLAVE_SUPPORT, native_sources, slave_script
 
 FMU_DIR = Path(__file__).resolve().parent.parent
 BUILD_DIR = Path(__file__).resolve().parent
@@ -24,6 +24,14 @@ PHYSICS_C = FMU_DIR / "physics_c"
 #: The front's version layers (one per FMI version; a binary is built with one of them and the core,
 #: every other file of cfront/).
 FRONT_LAYERS = {"2.0": "rst_fmi2.c", "3.0": "rst_fmi3.c"}
+#: FMU model identifier -> pythonfmu slave script (shipped with the package, in the model's folder).
+FMUS = {model: slave_script(model) for model in FOLDERS}
+#: The binaries/ folders pythonfmu's own binaries fill (its wheel's; the guard replaces the Linux one).
+PYTHONFMU_FOLDERS = ("linux64", "win64")
+#: The models with a native backend (every one).
+BACKENDS = tuple(FOLDERS)
+#: Where the FMUs of each FMI version go, below the build's output directory.
+VERSION_DIRS = {"2.0": "fmi2", "3.0": "fmi3"}
 
 #: Where the build records what it was built from, inside the FMU.
 BUILD_INFO = "resources/build_info.json"

@@ -20,7 +20,7 @@ every platform builds on a machine with only Python and gcc. Where a platform's 
 :func:`compiler` raises :class:`ToolchainMissing` with a one-line reason naming what to install, and the
 build skips that platform.
 
-Every build compiles with the project's flags (:data:`restitution.fmu.builders.compile.CFLAGS`: C99, ``-Wall
+Every build compiles with the project's flags (:data:`CFLAGS`: C99, ``-Wall
 -Wextra -Werror -pedantic``, no FMA contraction) and includes the FMI headers as system headers
 (``-isystem``: they are the standard's, and clang warns about two unprototyped callback types in the
 FMI 3.0 ones). Only the FMI functions are exported (hidden visibility on ELF and Mach-O; on Windows the
@@ -47,8 +47,12 @@ import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
-from .compile import CFLAGS
-
+#: C99, every warning an error; no contraction of a*b+c into an FMA, so the C rounds as the Python does.
+CFLAGS = ("-std=c99", "-O2", "-Wall", "-Wextra", "-Werror", "-pedantic", "-ffp-contract=off")
+#: The FMI headers fmpy ships, by FMI version (used at build time only; not copied into the FMU: hosts
+#: bring them).
+FMI_HEADERS = {"2.0": ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h"),
+               "3.0": ("fmi3Functions.h", "fmi3FunctionTypes.h", "fmi3PlatformTypes.h")}
 #: The PyPI package that brings zig, and how to install it.
 ZIG_PACKAGE = "ziglang"
 ZIG_INSTALL = f"pip install {ZIG_PACKAGE}"
@@ -56,6 +60,22 @@ MINGW = "x86_64-w64-mingw32-gcc"
 #: The environment variable that, set to "zig" or "native", makes every build use that compiler only (the
 #: wheel's build sets "zig": the same compiler for every platform, no gcc or mingw-w64).
 COMPILER_CHOICE = "RESTITUTION_COMPILER"
+
+
+class NativeBuildSkipped(RuntimeError):
+    """A native FMU (or one of its binaries) cannot be built here; the message says why."""
+
+
+def fmi_include_dir(fmi_version: str = "2.0") -> Path:
+    """fmpy's copy of the FMI C headers of ``fmi_version``."""
+    try:
+        import fmpy
+    except ImportError:
+        raise NativeBuildSkipped(f"fmpy is not installed (its FMI {fmi_version} headers are needed)") from None
+    path = Path(fmpy.__file__).resolve().parent / "c-code"
+    if not all((path / h).is_file() for h in FMI_HEADERS[fmi_version]):
+        raise NativeBuildSkipped(f"FMI {fmi_version} headers not found in {path}")
+    return path
 
 
 @dataclass(frozen=True)
@@ -365,3 +385,20 @@ def build_binary(name: str, folder: str, fmi_version: str, sources: Path, c_file
             target.parent.mkdir(parents=True, exist_ok=True)
             universal_binary(slices, target)
     return target, [cc.name for cc in compilers]
+
+
+def pythonfmu_label(guard: bool = True) -> str:
+    """What builds a pythonfmu FMU here, as the build's lines say it: pythonfmu and its version, and the
+    compiler of the guard (zig for glibc 2.17, else gcc) or why there is none."""
+    from importlib import metadata
+
+    try:
+        label = f"pythonfmu {metadata.version('pythonfmu')}"
+    except metadata.PackageNotFoundError:
+        label = "pythonfmu (not installed)"
+    if not guard:
+        return f"{label}, no guard"
+    try:
+        return f"{label}, guard {compiler_label('x86_64-linux', compiler('x86_64-linux'))}"
+    except ToolchainMissing:
+        return f"{label}, no guard (no gcc or zig)"
