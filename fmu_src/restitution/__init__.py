@@ -41,10 +41,10 @@ __all__ = [
 
 
 def __getattr__(name):
-    """``restitution.__version__`` (:data:`restitution.about.VERSION`), read when asked: a command that does
-    not show it (``restitution cor``) does not load :mod:`restitution.about`."""
-    if name == "__version__":
-        from .about import VERSION
+    """``restitution.__version__`` (:data:`restitution.about.VERSION`) and ``restitution.about``, loaded when
+    asked: a command that does not show the version (``restitution cor``) does not load the module."""
+    if name in ("__version__", "about"):
+        from .about import VERSION  # the import makes the submodule this package's attribute `about`
 
-        return VERSION
+        return VERSION if name == "__version__" else globals()["about"]
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -298,3 +298,18 @@ def test_declaring_options_loads_no_reader():
     loaded = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.split()
     assert "restitution.options" in loaded and not [m for m in loaded if m == "restitution.inputs"
                                                     or package_layer(m)[0] == "tables"], loaded
+
+
+def test_the_version_module_loads_when_asked_and_stays_an_attribute():
+    """``import restitution`` leaves :mod:`restitution.about` unloaded (``cor`` never shows the version),
+    yet ``restitution.about`` and ``restitution.__version__`` answer as when it was imported at the top;
+    an unknown name is still an AttributeError (run in a child: a fresh interpreter's modules)."""
+    import subprocess
+    import sys
+
+    code = ("import sys, restitution\nloaded = 'restitution.about' in sys.modules\n"
+            "about = restitution.about\nassert about.__name__ == 'restitution.about', about\n"
+            "assert restitution.__version__ == about.VERSION\n"
+            "try:\n    restitution.no_such_name\nexcept AttributeError:\n    print(loaded)\n")
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert result.returncode == 0 and result.stdout.split() == ["False"], result.stderr
