@@ -76,6 +76,18 @@ def reals(s, names):
 
 def report(**values):
     print("REPORT " + json.dumps(values, allow_nan=True), flush=True)
+
+
+LOG3 = []  # (status, message) of every FMI 3.0 logger call (log3: an FMU3Slave's logMessage)
+
+
+def log3(env, status, category, message):
+    LOG3.append((int(status), message.decode("utf-8", "replace")))
+
+
+def report_with_log3(**values):
+    """report(), with the statuses the FMI 3.0 logger saw and its messages in order."""
+    report(**values, statuses_logged=sorted({st for st, _m in LOG3}), messages=[m for _st, m in LOG3])
 '''
 
 

@@ -27,6 +27,7 @@ from restitution.scene.__main__ import main as scene_cli
 from restitution.sweep import SweepSpec, read_table, run_sweep
 from restitution.sweep.__main__ import main as sweep_cli
 from restitution.sweep.parts import RECORD_KEY as RECORD
+from scene_texts import steel_on_aluminium
 
 PYTHON = sys.executable
 ENV = {**os.environ, "PYTHONUNBUFFERED": "1"}
@@ -49,18 +50,7 @@ tolerance = 1e-2
 
 [simulation]
 v_min = "0.05 m/s"
-
-[[plates]]
-name = "plate"
-material = "al_6061"
-thickness = "3.18 mm"
-
-[[balls]]
-name = "ball"
-material = "s2_tool_steel"
-diameter = "6.35 mm"
-drop_heights = {heights}
-"""
+""" + steel_on_aluminium("{heights}")
 
 
 def scene_file(directory: Path, n_drops: int = 5) -> Path:

@@ -296,8 +296,7 @@ FMI3_CODE = """
 import ctypes
 from fmpy.fmi3 import FMU3Slave, fmi3IntermediateUpdateCallback, fmi3LogMessageCallback
 token, others = ARGS[0], ARGS[1:]
-LOG3 = []
-CB = fmi3LogMessageCallback(lambda env, status, category, message: LOG3.append(message.decode("utf-8", "replace")))
+CB = fmi3LogMessageCallback(log3)
 s = FMU3Slave(guid=token, unzipDirectory=UNZIP, modelIdentifier=MD.coSimulation.modelIdentifier, instanceName="identity")
 s.instantiate(loggingOn=True, logMessage=lambda env, status, category, message: None)
 lib = s.dll
@@ -310,7 +309,7 @@ s.exitInitializationMode()
 s.doStep(0.0, 1e-3)
 s.terminate()
 s.freeInstance()
-report(refused=refused, log=LOG3)
+report(refused=refused, log=[m for _status, m in LOG3])
 """
 
 

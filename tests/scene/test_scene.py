@@ -18,6 +18,7 @@ from restitution.scene import SceneError, load_scene, parse_scene, run_scene
 from restitution.scene.__main__ import main
 from restitution.scene.report import MARK_END, MARK_START, compare, report_scene
 from restitution.scene.runner import open_instance
+from scene_texts import steel_on_aluminium
 
 ROOT = Path(__file__).resolve().parents[2]
 SCENES = ROOT / "examples" / "scenes"
@@ -31,18 +32,7 @@ name = "test"
 [outputs]
 requested = ["bounce_heights"]
 tolerance = 1e-6
-
-[[plates]]
-name = "plate"
-material = "al_6061"
-thickness = "3.18 mm"
-
-[[balls]]
-name = "ball"
-material = "s2_tool_steel"
-diameter = "6.35 mm"
-drop_heights = "0.1 m"
-"""
+""" + steel_on_aluminium()
 
 
 def scene_from(text):

@@ -11,6 +11,7 @@ import pytest
 
 from restitution.scene import SceneError, parse_scene, run_scene
 from restitution.scene.__main__ import main
+from scene_texts import steel_on_aluminium
 
 SCENE = """
 [scene]
@@ -22,18 +23,7 @@ requested = ["bounce_heights", "contact_durations"]
 [simulation]
 v_min = "0.05 m/s"
 {extra}
-
-[[plates]]
-name = "plate"
-material = "al_6061"
-thickness = "3.18 mm"
-
-[[balls]]
-name = "ball"
-material = "s2_tool_steel"
-diameter = "6.35 mm"
-drop_heights = ["0.1 m", "0.5 m"]
-"""
+""" + steel_on_aluminium('["0.1 m", "0.5 m"]')
 
 
 def scene_from(extra: str):

@@ -18,6 +18,7 @@ from restitution.scene import SceneError, parse_scene, run_scene
 from restitution.scene.__main__ import main
 from restitution.scene.loader import MAX_BOUNCES
 from terminal import takes_ctrl_c, with_terminal_stderr
+from scene_texts import steel_on_aluminium
 
 PYTHON = sys.executable
 ENV = {**os.environ, "PYTHONUNBUFFERED": "1"}
@@ -33,18 +34,7 @@ tolerance = 1e-2
 [simulation]
 max_bounces = {max_bounces}
 v_min = {v_min}
-
-[[plates]]
-name = "plate"
-material = "al_6061"
-thickness = {thickness}
-
-[[balls]]
-name = "ball"
-material = "s2_tool_steel"
-diameter = {diameter}
-drop_heights = {heights}
-"""
+""" + steel_on_aluminium("{heights}", "{thickness}", "{diameter}")
 
 
 def scene_text(thickness='"3.18 mm"', diameter='"6.35 mm"', heights='"0.1 m"', max_bounces=10000, model="",
