@@ -10,6 +10,8 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 BENCHMARKS = ROOT / "benchmarks"
+#: A number as the benchmarks print it (a regular expression): 0.123, 1e+04.
+NUMBER = r"[0-9.]+(?:e[+-]?\d+)?"
 
 
 def run_benchmark(name: str, *args: str, cwd: Path, timeout: float, env: dict | None = None):

@@ -4,9 +4,8 @@ computes under the same equations (the benchmark stops otherwise). No timing is 
 import re
 
 import numpy as np
-from bench_script import run_benchmark
+from bench_script import NUMBER, run_benchmark
 
-NUMBER = r"[0-9.]+(?:e[+-]?\d+)?"
 
 
 def test_quick_run_prints_the_sides_and_the_ratios(tmp_path):

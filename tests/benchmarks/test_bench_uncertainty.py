@@ -3,9 +3,8 @@ both sides of each measurement and their ratio beside the goal, and the two side
 computed the same statistics of e. No timing is asserted (machines are noisy): the ratios are the
 benchmark's to print."""
 import re
-from bench_script import run_benchmark
+from bench_script import NUMBER, run_benchmark
 
-NUMBER = r"[0-9.]+(?:e[+-]?\d+)?"
 
 
 def test_quick_run_prints_both_sides_and_the_ratio_of_each_measurement(tmp_path):
