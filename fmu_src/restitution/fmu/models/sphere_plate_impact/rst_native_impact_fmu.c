@@ -177,7 +177,7 @@ static rst_status get_outputs(rst_instance *inst, rst_type type, const rst_vr vr
                               double values[])
 {
     impact_backend *b = (impact_backend *)rst_backend(inst);
-    const double *store = rst_store(inst); /* once: the accessors are calls into the front */
+    const double *store = rst_store(inst);
     size_t i;
     (void)type;
     evaluate(inst, b);
