@@ -9,6 +9,8 @@ nested level.
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 
@@ -93,7 +95,6 @@ def test_small_inputs_and_bad_ranks():
 # --- the moments computed in the same passes --------------------------------------------------------
 def _exact_moments(values):
     """The mean and the sum of squared deviations by math.fsum (exactly rounded sums): the reference."""
-    import math
 
     mean = math.fsum(values) / values.size
     mean += math.fsum(values - mean) / values.size  # the residual's exact sum corrects the division
@@ -159,3 +160,15 @@ def test_distinct_is_numpys_unique(values):
     assert np.array_equal(got, want, equal_nan=True) and got.dtype == want.dtype
     assert np.array_equal(inverse, want_inverse.ravel())
     assert np.array_equal(osx.distinct(values), want, equal_nan=True)
+
+
+@pytest.mark.parametrize("n", [0, 1, 7, osx.SQUARE_BLOCK - 1, osx.SQUARE_BLOCK, osx.SQUARE_BLOCK + 1,
+                               3 * osx.SQUARE_BLOCK + 5])
+def test_sum_of_squares_is_the_exact_sum_to_the_pairwise_error(n):
+    """sum(x^2) against math.fsum of the squares (the exactly rounded sum of the rounded squares): the
+    terms are >= 0, so numpy's pairwise sums err by at most about log2(n) ulps of the total, and each
+    block's sum is added once more (n / block more additions): 1e-13 relative bounds both for n < 2^18."""
+    x = np.random.default_rng(n).normal(size=n) * 3.0
+    want = math.fsum((x * x).tolist())
+    assert osx.sum_of_squares(x) == pytest.approx(want, rel=1e-13, abs=0.0)
+    assert osx.sum_of_squares(x[::2]) == pytest.approx(math.fsum((x[::2] * x[::2]).tolist()), rel=1e-13, abs=0.0)
