@@ -200,7 +200,7 @@ def test_fmu_instantiation_leaves_the_hosts_modules_in_place(impact_fmu, monkeyp
     """While the back end creates an instance, every ``restitution`` module of this process stays in
     sys.modules: a Dask worker's other threads import them meanwhile (a task being unpickled), and
     found them missing when the back end set them aside ("No module named 'restitution.sweep'")."""
-    from restitution.sweep import backends
+    from restitution.cosim import fmu as cosim_fmu  # the back end imports quiet_instantiate from there, when it runs
 
     before = {k: v for k, v in sys.modules.items() if k == "restitution" or k.startswith("restitution.")}
     during = []
@@ -209,8 +209,8 @@ def test_fmu_instantiation_leaves_the_hosts_modules_in_place(impact_fmu, monkeyp
         during.append({k: sys.modules.get(k) for k in before})
         return real(slave)
 
-    real = backends.quiet_instantiate
-    monkeypatch.setattr(backends, "quiet_instantiate", watching)
+    real = cosim_fmu.quiet_instantiate
+    monkeypatch.setattr(cosim_fmu, "quiet_instantiate", watching)
     release_fmus()  # a new instance, not one this thread kept from an earlier test
     try:
         res = run_sweep(SweepSpec(pairs=["s2_tool_steel/al_6061"], grid={"v_approach": [1.0]}), "fmu",

@@ -32,7 +32,6 @@ from pathlib import Path
 
 import numpy as np
 
-from ..cosim.fmu import FmiStatusError, quiet_instantiate
 from ..fmu.models.sphere_plate_impact.variables import TABLE
 from ..model import PARAMETERS
 from .spec import CODES, INPUTS, INTEGER_INPUTS, OUTPUTS, SETTABLE, is_one_value_view
@@ -226,7 +225,7 @@ class _LoadedFmu:
     outputs and ok = False)."""
 
     def __init__(self, unzip_dir: str):
-        from ..cosim.fmu import FmuInstance
+        from ..cosim.fmu import FmuInstance  # the FMU back end's (the package's sweeps do without cosim)
         self.unzip_dir = unzip_dir
         self.instance = FmuInstance(unzip_dir, instance_name=f"sweep-{os.getpid()}-{threading.get_ident()}",
                                     unzip_dir=unzip_dir, instantiate=self._instantiate)
@@ -245,6 +244,7 @@ class _LoadedFmu:
             self.code_file = _instantiate_python_fmu(slave, self.unzip_dir)
             self.code = code_fingerprint(Path(self.code_file).parent)
         else:  # a native FMU (C only): its binary is the code that runs
+            from ..cosim.fmu import quiet_instantiate
             quiet_instantiate(slave)
             self.code_file = slave.dll._name
             self.code = hashlib.sha256(Path(self.code_file).read_bytes()).hexdigest()[:12]
@@ -271,6 +271,7 @@ class _LoadedFmu:
                     shutil.rmtree(doomed, ignore_errors=True)
 
     def _evaluate(self, cases: dict, outputs=None) -> dict:
+        from ..cosim.fmu import FmiStatusError
         n = np.size(cases["v_approach"])
         self.reset()
         reals = [name for name, _kw, t, _s in INPUTS if t == "Real"]
@@ -341,6 +342,7 @@ def _instantiate_python_fmu(slave, unzip_dir: str) -> str:
     code the FMU ships: its own copy, or the host's ``restitution`` when every file the FMU ships is the
     same (the FMU's start-up decides, as in any Python host). Nothing is taken out of sys.modules: other
     threads of this process (a Dask worker's) import ``restitution`` modules meanwhile."""
+    from ..cosim.fmu import quiet_instantiate
     from ..fmu.models.restitution_slave_support import SLAVE_PACKAGE, is_shipped_package
 
     resources = os.path.join(unzip_dir, "resources")

@@ -3,7 +3,6 @@ whose workers ignore Ctrl-C and do not inherit pythonfmu's sys.path entries) and
 from __future__ import annotations
 
 import contextlib
-import logging
 import os
 
 __all__ = ["machine_workers", "open_client", "count_workers", "describe_client", "serial_reason"]
@@ -40,6 +39,8 @@ def open_client(scheduler=None, n_workers: int | None = None, threads_per_worker
         with Client(scheduler) as client:
             yield client
         return
+    import logging  # (here: a serial sweep never loads it)
+
     kwargs = dict(n_workers=n_workers or machine_workers(), threads_per_worker=threads_per_worker,
                   processes=True, dashboard_address=None, silence_logs=logging.ERROR)
     kwargs.update(cluster_kwargs)
@@ -61,6 +62,8 @@ def open_client(scheduler=None, n_workers: int | None = None, threads_per_worker
 
 def _silence_logging() -> None:
     """No more log records in this process (a worker about to be stopped)."""
+    import logging
+
     logging.disable(logging.CRITICAL)
 
 
@@ -73,6 +76,8 @@ def _quiet_shutdown():
     heartbeat found the scheduler gone logged a traceback to the terminal after the sweep's own last line
     (seen after an interrupt on a loaded machine). Whatever the sweep had to say is said by then; a failure
     to reach a worker here is of no consequence (it is being stopped)."""
+    import logging
+
     logger = logging.getLogger("distributed")
     level = logger.level
 
