@@ -151,6 +151,12 @@ def impact(v, sphere_E, sphere_nu, sphere_Sy, sphere_rho, sphere_d,
 
     ``impact(v, *p, **o)`` is ``impact_at(v, impact_terms(*p, **o))``: many speeds for one parameter set
     (a co-simulation's steps) make the terms once (:func:`impact_terms`, :func:`impact_at`).
+
+    Over many cases (at least 65,536) the model runs a block of cases at a time (:mod:`restitution._blocks`),
+    and the result's arrays of one kind (float, bool) are the rows of one allocation: each is contiguous,
+    writable and shares no memory with another or with an input, but a row kept alone keeps its whole
+    block alive (``res.e.copy()`` keeps e alone). Once a result is gone its blocks serve the next call (up
+    to 256 MB of them are kept), so a run of large calls writes into memory the process already has.
     """
     want = None if outputs is None else _wanted(outputs)
     plasticity = _mode("plasticity", plasticity)
@@ -303,6 +309,10 @@ def _pipeline(v, terms, want=None):
         v, scalar = float(v), True
     else:
         v, scalar = np.asarray(v, dtype=float), False
+        from ._blocks import blockable, in_blocks  # the array mode's alone (`restitution cor` loads it not)
+
+        if blockable(v, terms):  # many cases: the same steps a cache-sized block at a time
+            return in_blocks(_pipeline, v, terms, want)
     every = want is None
     need = None if every else want.steps  # the outputs and every step they depend on
     e_ep = e_ze = d_ze = tau0 = T = t_contact = e = ratio = delay = echo = None  # the steps not needed
