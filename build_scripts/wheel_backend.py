@@ -4,8 +4,7 @@ a wheel carries the FMUs built, so that ``pip install restitution`` gives every 
 ``build_wheel`` first builds every FMU (``python -m restitution.fmu build``, from the tree being built, with
 zig from PyPI for every platform: ``RESTITUTION_COMPILER=zig``, no gcc or mingw-w64) into
 ``fmu_src/restitution/fmu/installed_fmus/`` (package data, never committed; removed again after the wheel is
-written), with ``dist/ssp/`` copied to ``installed_fmus/ssp/`` where the tree has SSP files (MANIFEST.in puts
-them into the sdist, from which ``python -m build`` makes the wheel). The wheel's
+written), the SSP files among them (the build writes them into its ``ssp/``). The wheel's
 extra build requirements (zig, pythonfmu, fmpy and the package's dependencies) are asked for by
 ``get_requires_for_build_wheel`` alone: the sdist and the editable install (the Quickstart's) need only
 setuptools. ``SOURCE_DATE_EPOCH`` passes through, so the FMUs of two wheels of a commit are identical.
@@ -29,7 +28,6 @@ from setuptools.build_meta import (build_editable, build_sdist, get_requires_for
 FMU_BUILD_REQUIRES = ["ziglang==0.17.1", "pythonfmu==0.7.0", "fmpy==0.3.32", "numpy>=2.4", "scipy>=1.17",
                       "pint>=0.25"]
 PAYLOAD = Path("fmu_src") / "restitution" / "fmu" / "installed_fmus"
-SSP_SOURCE = Path("dist") / "ssp"
 
 
 def get_requires_for_build_wheel(config_settings=None):
@@ -37,8 +35,9 @@ def get_requires_for_build_wheel(config_settings=None):
 
 
 def build_fmus(payload: Path = PAYLOAD) -> Path:
-    """Every FMU of the tree (and its SSP files) into ``payload``, built in a scratch folder first so that
-    a failed build leaves nothing; returns ``payload``."""
+    """Every FMU of the tree and its SSP files (``restitution fmu build`` writes both; a ``dist/ssp`` of
+    an earlier build in the tree is not used) into ``payload``, built in a scratch folder first so that a
+    failed build leaves nothing; returns ``payload``."""
     root = Path.cwd()
     env = dict(os.environ, RESTITUTION_COMPILER="zig",
                PYTHONPATH=os.pathsep.join(filter(None, [str(root / "fmu_src"), os.environ.get("PYTHONPATH")])))
@@ -46,8 +45,6 @@ def build_fmus(payload: Path = PAYLOAD) -> Path:
         out = Path(scratch) / "fmus"
         subprocess.run([sys.executable, "-m", "restitution.fmu", "build", "--out", str(out)], check=True, env=env,
                        cwd=scratch, stdout=sys.stderr)  # the build's lines where a frontend shows them
-        if (root / SSP_SOURCE).is_dir():
-            shutil.copytree(root / SSP_SOURCE, out / "ssp")
         shutil.rmtree(payload, ignore_errors=True)
         shutil.move(str(out), str(payload))
     return payload
