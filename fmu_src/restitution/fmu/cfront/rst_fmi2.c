@@ -234,7 +234,7 @@ fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint, fmi2R
 {
     (void)noSetFMUStatePriorToCurrentPoint;
     return (fmi2Status)front_do_step(c, "fmi2DoStep", currentCommunicationPoint, communicationStepSize, NULL,
-                                     NULL);
+                                     NULL, NULL, NULL);
 }
 
 fmi2Status fmi2CancelStep(fmi2Component c)

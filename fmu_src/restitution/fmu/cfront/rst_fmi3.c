@@ -328,32 +328,31 @@ fmi3Status fmi3DeserializeFMUState(fmi3Instance instance, const fmi3Byte seriali
 /* ------------------------------------------------------------------------------------------------ */
 /* Stepping                                                                                         */
 /* ------------------------------------------------------------------------------------------------ */
+static fmi3Status refuse_null_step_outputs(fmi3Instance instance)
+{
+    return (fmi3Status)front_refuse(instance, "fmi3DoStep", ANY_MODE | RST_MODE_EVENT, "eventHandlingNeeded, "
+                                    "terminateSimulation, earlyReturn and lastSuccessfulTime must not be NULL");
+}
+
 fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 currentCommunicationPoint, fmi3Float64 communicationStepSize,
                       fmi3Boolean noSetFMUStatePriorToCurrentPoint, fmi3Boolean *eventHandlingNeeded,
                       fmi3Boolean *terminateSimulation, fmi3Boolean *earlyReturn, fmi3Float64 *lastSuccessfulTime)
 {
-    rst_status status;
-    rst_step_end end;
     (void)noSetFMUStatePriorToCurrentPoint;
-    if (eventHandlingNeeded == NULL || terminateSimulation == NULL || earlyReturn == NULL ||
-        lastSuccessfulTime == NULL)
-        return (fmi3Status)front_refuse(instance, "fmi3DoStep", ANY_MODE | RST_MODE_EVENT, "eventHandlingNeeded, "
-                                        "terminateSimulation, earlyReturn and lastSuccessfulTime must not be NULL");
-    /* front_do_step writes lastSuccessfulTime where the step ran: its end, the event it returned early at,
-     * its start after a discard */
-    end.reached = currentCommunicationPoint + communicationStepSize;
-    end.event_pending = 0;
-    status = front_do_step(instance, "fmi3DoStep", currentCommunicationPoint, communicationStepSize,
-                           lastSuccessfulTime, &end);
-    if (status < RST_ERROR) {
-        /* an event waiting for the host's event mode (eventModeUsed only); early: it ended before t + h
-         * (earlyReturnAllowed only) */
-        *eventHandlingNeeded = status <= RST_WARNING && end.event_pending;
-        *earlyReturn = status <= RST_WARNING && end.reached < currentCommunicationPoint + communicationStepSize;
-        /* a discarded step leaves the instance unable to step on (fmi3Terminate, fmi3Reset or fmi3SetFMUState) */
-        *terminateSimulation = status == RST_DISCARD;
-    }
-    return (fmi3Status)status;
+    /* a branch each (one expression of the four compiles to vector compares, slower on the common path) */
+    if (RST_UNLIKELY(eventHandlingNeeded == NULL))
+        return refuse_null_step_outputs(instance);
+    if (RST_UNLIKELY(terminateSimulation == NULL))
+        return refuse_null_step_outputs(instance);
+    if (RST_UNLIKELY(earlyReturn == NULL))
+        return refuse_null_step_outputs(instance);
+    if (RST_UNLIKELY(lastSuccessfulTime == NULL))
+        return refuse_null_step_outputs(instance);
+    /* front_do_step writes lastSuccessfulTime where the step ran (its end, the event it returned early at, its
+     * start after a discard) and, below fmi3Error, the three flags (fmi3Boolean is bool: a pointer of another
+     * type would not compile) */
+    return (fmi3Status)front_do_step(instance, "fmi3DoStep", currentCommunicationPoint, communicationStepSize,
+                                     lastSuccessfulTime, eventHandlingNeeded, terminateSimulation, earlyReturn);
 }
 
 /* co-simulation instantiated with eventModeUsed: event mode -> step mode */

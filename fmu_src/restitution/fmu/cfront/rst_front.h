@@ -113,6 +113,10 @@ typedef struct {
     /* A check beyond the table, for a value the table allows (e.g. an option this backend does not
      * implement): not RST_OK rejects it (log why). */
     rst_status (*accept)(rst_instance *inst, const rst_variable *var, double value);
+    /* The value references `accept` may refuse a value of; the front asks it about no other variable (a
+     * host setting an input at every step pays no call for it). NULL: every variable. */
+    const unsigned int *accept_vrs;
+    size_t n_accept_vrs;
     /* New values for inputs or parameters of one type: already checked and in the store. */
     rst_status (*set)(rst_instance *inst, rst_type type, const rst_vr vr[], size_t n,
                       const double values[]);

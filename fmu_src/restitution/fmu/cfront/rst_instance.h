@@ -260,10 +260,12 @@ rst_status front_exit_initialization(void *c, const char *function);
 rst_status front_terminate(void *c, const char *function);
 rst_status front_reset(void *c, const char *function);
 /* `last_successful_time`: NULL, or where the end of the last successful step goes (FMI 3.0: the event
- * where the step returned early); `step_end`: NULL (FMI 2.0), or where FMI 3.0's eventHandlingNeeded and
- * earlyReturn go (.event_pending, and .reached < t + h) */
+ * where the step returned early). `event_handling_needed`, `terminate_simulation`, `early_return`: NULL
+ * (FMI 2.0), or all three FMI 3.0's out-arguments (fmi3Boolean is C99's bool), written wherever the step
+ * ran (a status below RST_ERROR): here, not in rst_fmi3.c, so that fmi3DoStep passes them on without a
+ * frame or a copy of its own. */
 rst_status front_do_step(void *c, const char *function, double t, double h, double *last_successful_time,
-                         rst_step_end *step_end);
+                         _Bool *event_handling_needed, _Bool *terminate_simulation, _Bool *early_return);
 /* A call this FMU does not provide, or whose arguments the version layer found wrong, in one of
  * `modes`: logs "<function>: <why>" and returns an error. */
 rst_status front_refuse(void *c, const char *function, unsigned int modes, const char *why);
@@ -328,6 +330,14 @@ static inline rst_status front_backend_status(rst_instance *inst, rst_status sta
         inst->mode = RST_MODE_ERROR;
     return status;
 }
+
+/* A test that the common path of a call expects to fail (a NULL out-argument): the compiler keeps it a
+ * branch (a chain of pointer tests otherwise may become vector compares, slower on the path taken). */
+#if defined(__GNUC__) || defined(__clang__)
+#define RST_UNLIKELY(condition) __builtin_expect((condition) != 0, 0)
+#else
+#define RST_UNLIKELY(condition) (condition)
+#endif
 
 /* NULL unless c is one of our live instances. */
 static inline rst_instance *front_instance(void *c)

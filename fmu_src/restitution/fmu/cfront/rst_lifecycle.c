@@ -296,7 +296,7 @@ static rst_status backend_step(rst_instance *inst, double t, double h, rst_step_
 }
 
 rst_status front_do_step(void *c, const char *function, double t, double h, double *last_successful_time,
-                         rst_step_end *step_end)
+                         _Bool *event_handling_needed, _Bool *terminate_simulation, _Bool *early_return)
 {
     rst_status status = RST_OK;
     rst_step_end end;
@@ -328,13 +328,22 @@ rst_status front_do_step(void *c, const char *function, double t, double h, doub
         inst->has_time = 1;
         inst->next_time = reached;
         inst->last_time = reached;
-        if (step_end != NULL) {
-            step_end->reached = reached;
-            step_end->event_pending = end.event_pending != 0;
+        if (event_handling_needed != NULL) { /* FMI 3.0: an event waiting for the host's event mode
+                                                 * (eventModeUsed only); a step that ended before t + h
+                                                 * (earlyReturnAllowed only) */
+            *event_handling_needed = end.event_pending != 0;
+            *terminate_simulation = 0;
+            *early_return = reached < t + h;
         }
     } else if (status == RST_DISCARD) {
         inst->mode = RST_MODE_STEP_FAILED;
         inst->last_time = t;
+        if (event_handling_needed != NULL) { /* FMI 3.0: the instance cannot step on (fmi3Terminate, fmi3Reset
+                                              * or fmi3SetFMUState) */
+            *event_handling_needed = 0;
+            *terminate_simulation = 1;
+            *early_return = 0;
+        }
     }
     if (last_successful_time != NULL)
         *last_successful_time = inst->last_time;

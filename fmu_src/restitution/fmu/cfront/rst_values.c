@@ -127,6 +127,20 @@ static int settable(const rst_instance *inst, const rst_variable *var)
     return 1;
 }
 
+/* Does the backend's accept hook look at `vr` (rst_model.accept_vrs)? */
+static int accept_asked(const rst_model *model, rst_vr vr)
+{
+    size_t i;
+    if (model->accept == NULL)
+        return 0;
+    if (model->accept_vrs == NULL)
+        return 1;
+    for (i = 0; i < model->n_accept_vrs; i++)
+        if (model->accept_vrs[i] == vr)
+            return 1;
+    return 0;
+}
+
 /* Checks one value the host wants to set; logs and returns 0 if it is refused. */
 static int check_set(rst_instance *inst, const char *function, rst_vr vr, unsigned int kinds, double value)
 {
@@ -164,7 +178,7 @@ static int check_set(rst_instance *inst, const char *function, rst_vr vr, unsign
                 var->range_text ? var->range_text : "finite");
         return 0;
     }
-    if (inst->model->accept != NULL && inst->model->accept(inst, var, value) != RST_OK)
+    if (accept_asked(inst->model, vr) && inst->model->accept(inst, var, value) != RST_OK)
         return 0;
     return 1;
 }

@@ -30,6 +30,9 @@
 /* A value the interface table allows but this backend refuses: zener_method = 4 (ode), which only
  * the Python FMU integrates. Nonzero with `message` saying so; 0 otherwise. */
 int rst_impact_accept(unsigned int vr, double value, char *message, size_t size);
+/* The value references rst_impact_accept may refuse a value of (it accepts every value of the others),
+ * as an initializer; the generated interface header included before this one names them. */
+#define RST_IMPACT_ACCEPT_VRS {RST_SPHEREPLATEIMPACT_VR_ZENER_METHOD}
 
 /* Evaluate the model on `values` (every variable by value reference; Integer codes and Boolean 0/1
  * as doubles): reads the inputs and parameters, writes every output. 0 (RST_PHYSICS_OK) on success;

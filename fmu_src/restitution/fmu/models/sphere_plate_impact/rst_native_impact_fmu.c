@@ -126,6 +126,9 @@ static void evaluate(rst_instance *inst, impact_backend *b)
     }
 }
 
+/* the variables rst_impact_accept looks at (the front asks about no other) */
+static const unsigned int ACCEPT_VRS[] = RST_IMPACT_ACCEPT_VRS;
+
 static rst_status accept(rst_instance *inst, const rst_variable *var, double value)
 {
     char message[256];
@@ -205,7 +208,8 @@ static rst_status do_step(rst_instance *inst, double t, double h)
 const rst_model RST_MODEL = {
     .identifier = RST_MODEL_IDENTIFIER, .guid = RST_MODEL_GUID,
     .variables = RST_MODEL_VARIABLES, .n_variables = RST_MODEL_N_VARIABLES, .backend_size = sizeof(impact_backend),
-    .instantiate = instantiate, .exit_initialization = exit_initialization, .accept = accept, .set = set,
+    .instantiate = instantiate, .exit_initialization = exit_initialization, .accept = accept,
+    .accept_vrs = ACCEPT_VRS, .n_accept_vrs = sizeof ACCEPT_VRS / sizeof ACCEPT_VRS[0], .set = set,
     .get_outputs = get_outputs, .do_step = do_step, .reset = reset, .restore_state = changed,
     /* model exchange: no states and no events, the outputs a function of the inputs (direct feedthrough) */
     .model_exchange = 1, RST_MODEL_EXCHANGE_VECTORS};
