@@ -6,7 +6,7 @@ import numpy as np
 
 from cases import params_for, random_cases
 
-N = 2 * 32768 + 777  # two whole blocks of restitution._blocks and a part of one (checked by the test)
+N = 4 * 32768 + 777  # four whole blocks of restitution._blocks and a part of one (checked by the test)
 OPTIONS = {"default": {}, "e44, paper_fit": dict(restitution_model="e44", zener_method="paper_fit"),
            "on, on, linear": dict(plasticity="on", plate_waves="on", zener_method="linear"),
            "tolerance 1e-3, edge 5 cm": dict(effect_tolerance=1e-3, plate_edge_distance=0.05)}

@@ -21,11 +21,15 @@ import threading
 
 import numpy as np
 
-__all__ = ["CASES_PER_BLOCK", "KEPT_BYTES", "blockable", "in_blocks"]
+__all__ = ["CASES_PER_BLOCK", "BLOCKS_FROM", "KEPT_BYTES", "blockable", "in_blocks"]
 
 #: Cases per block: each of a block's float temporaries is 256 kB; the thirty or so alive at once fit
 #: the shared cache. Fewer cases per call cost more in numpy's per-call overhead than they save.
 CASES_PER_BLOCK = 32768
+#: Blocks from which the blocked evaluation pays: below, the whole arrays' temporaries are reused from the
+#: allocator's heap, and a sweep's chunks of 10^5 cases (whose results it keeps, so that their blocks are
+#: not reused) took 45 ms a chunk blocked against 35 ms whole.
+BLOCKS_FROM = 4
 #: Bytes of result blocks kept for reuse once their result is gone, at most (10^6 cases with every
 #: output: 144 MB). A larger result's blocks are fresh memory, given back when it is gone.
 KEPT_BYTES = 256 * 2**20
@@ -41,18 +45,20 @@ _OWN_REFERENCES = 3  # of a kept block nobody uses: _KEPT's, the local name's, g
 def blockable(v: np.ndarray, terms) -> bool:
     """Are there enough cases for blocks to pay, and does every per-case term have them all (no
     broadcasting left to do: a speed array with parameter arrays of another shape is evaluated whole)?"""
-    if v.size < 2 * CASES_PER_BLOCK:
+    if v.size < BLOCKS_FROM * CASES_PER_BLOCK:
         return False
     if terms.floats:
         return True
     return all(np.ndim(x) == 0 or np.shape(x) == v.shape for x in (getattr(terms, f) for f in _PER_CASE))
 
 
-def in_blocks(pipeline, v: np.ndarray, terms, want):
+def in_blocks(pipeline, v: np.ndarray, terms, want, dtype_of):
     """``pipeline(v, terms, want)`` (:func:`restitution.model._pipeline`'s array mode) evaluated a block of
     cases at a time, its values gathered into arrays of ``v``'s shape: the same record (a tuple) or dict of
-    outputs. The arrays of one dtype are the rows of one 2-D block: each is contiguous, writable and shares
-    no memory with another (a row kept alone keeps its block alive)."""
+    outputs. The arrays of one dtype (``dtype_of(key)``, key a position in the record or an output's name)
+    are the rows of one 2-D block: each is contiguous, writable and shares no memory with another (a row
+    kept alone keeps its block alive). Each block's values come raw (``raw=True``: a value every case
+    shares as a scalar), written into their rows by one assignment each."""
     shape, n = v.shape, v.size
     flat_v = v.reshape(-1)
     per_case = {f: np.reshape(x, -1) for f in _PER_CASE if np.ndim(x := getattr(terms, f)) != 0}
@@ -61,10 +67,10 @@ def in_blocks(pipeline, v: np.ndarray, terms, want):
         stop = min(start + CASES_PER_BLOCK, n)
         block_terms = terms._replace(shape=() if terms.floats else (stop - start,),
                                      **{f: x[start:stop] for f, x in per_case.items()})
-        values = pipeline(flat_v[start:stop], block_terms, want)
+        values = pipeline(flat_v[start:stop], block_terms, want, raw=True)
         keys = list(values) if isinstance(values, dict) else range(len(values))
         if gathered is None:
-            gathered = _rows({key: values[key].dtype for key in keys}, n)
+            gathered = _rows({key: np.dtype(dtype_of(key)) for key in keys}, n)
         for key in keys:
             gathered[key][start:stop] = values[key]
     if isinstance(values, dict):

@@ -152,7 +152,7 @@ def impact(v, sphere_E, sphere_nu, sphere_Sy, sphere_rho, sphere_d,
     ``impact(v, *p, **o)`` is ``impact_at(v, impact_terms(*p, **o))``: many speeds for one parameter set
     (a co-simulation's steps) make the terms once (:func:`impact_terms`, :func:`impact_at`).
 
-    Over many cases (at least 65,536) the model runs a block of cases at a time (:mod:`restitution._blocks`),
+    Over many cases (at least 131,072) the model runs a block of cases at a time (:mod:`restitution._blocks`),
     and the result's arrays of one kind (float, bool) are the rows of one allocation: each is contiguous,
     writable and shares no memory with another or with an input, but a row kept alone keeps its whole
     block alive (``res.e.copy()`` keeps e alone). Once a result is gone its blocks serve the next call (up
@@ -285,7 +285,7 @@ def _terms(params, edge_distance, restitution_model, zener_method, plasticity, p
         effect_tolerance, ode_rtol, tau0_half_space if plate_waves == "auto" else TAU0_HERTZ, tau0_half_space)
 
 
-def _pipeline(v, terms, want=None):
+def _pipeline(v, terms, want=None, raw=False):
     """The record (:data:`RECORD`: :class:`ImpactResult`'s fields in order, then ``valid``) at the speed ``v``,
     from the parameter-only ``terms``; written once for Python floats
     (``v`` a float and ``terms.floats``, the scalar mode) and numpy arrays alike.
@@ -299,7 +299,9 @@ def _pipeline(v, terms, want=None):
     passes a step takes. Floats: a direct fill of the result. Arrays: scalar parameters keep their terms
     in floats; each equation's array form works in place on its own temporaries; the masks of speed 0, of
     the auto skip of Zener and of the half-space are built only where one reduction (a minimum) shows a
-    case needs them; owned output arrays.
+    case needs them; owned output arrays. ``raw`` (the blocks of :func:`restitution._blocks.in_blocks`, which
+    write each value into a row of their own): the array mode's values as computed, a value shared by every
+    case a scalar, none copied.
     """
     (floats, shape, V_c, eps_y, m_a, time_factor, lambda_factor, echo_time, restitution_model, zener_method,
      plasticity, plate_waves, effect_tolerance, ode_rtol, skipped_tau0, tau0_half_space) = terms
@@ -312,7 +314,7 @@ def _pipeline(v, terms, want=None):
         from ._blocks import blockable, in_blocks  # the array mode's alone (`restitution cor` loads it not)
 
         if blockable(v, terms):  # many cases: the same steps a cache-sized block at a time
-            return in_blocks(_pipeline, v, terms, want)
+            return in_blocks(_pipeline, v, terms, want, _dtype_of)
     every = want is None
     need = None if every else want.steps  # the outputs and every step they depend on
     e_ep = e_ze = d_ze = tau0 = T = t_contact = e = ratio = delay = echo = None  # the steps not needed
@@ -379,6 +381,8 @@ def _pipeline(v, terms, want=None):
                   edge_clear(echo))
         if scalar:  # every value is already a Python float or bool (math-module paths; the tests check it)
             return values + (lambda_ok and vstar_ok,)
+        if raw:
+            return values + (_both(lambda_ok, vstar_ok),)
         shape = np.broadcast_shapes(v.shape, shape)
         values = tuple(_own_array(value, shape, bool if name in _FLAGS else float)
                        for name, value in zip(_FIELD_NAMES, values))
@@ -387,7 +391,7 @@ def _pipeline(v, terms, want=None):
                  t_contact=t_contact, m_a=m_a, mass_ratio=ratio, wave_delay=delay, edge_echo=echo,
                  plate_waves_used=needed, lambda_in_range=lambda_ok, vstar_in_range=vstar_ok)
     out = {name: _DERIVED[name](steps) if name in _DERIVED else steps[name] for name in want.names}
-    if scalar:
+    if scalar or raw:
         return out
     shape = np.broadcast_shapes(v.shape, shape)
     return {name: _own_array(value, shape, float if name in _REALS else bool) for name, value in out.items()}
@@ -432,6 +436,11 @@ _TAU0_AT_LAMBDA0 = {"exact": TAU0_HERTZ, "ode": TAU0_HERTZ, "paper_fit": zener_p
 _FLAGS = frozenset(f.name for f in fields(ImpactResult) if f.type == "Flag")
 _FIELD_NAMES = tuple(f.name for f in fields(ImpactResult))
 _REALS = frozenset(RECORD_REALS)
+
+
+def _dtype_of(key) -> type:
+    """float or bool: the dtype of a record's value, by its position in :data:`RECORD` or its name."""
+    return float if (RECORD[key] if key.__class__ is int else key) in _REALS else bool
 
 
 def _material_terms(sphere_E, sphere_nu, sphere_Sy, sphere_rho, sphere_d, plate_E, plate_nu, plate_Sy,

@@ -37,11 +37,11 @@ def blocked(sets):
 
 
 def test_the_cases_span_more_than_two_blocks():
-    assert N > 2 * _blocks.CASES_PER_BLOCK and N % _blocks.CASES_PER_BLOCK != 0
+    assert N > _blocks.BLOCKS_FROM * _blocks.CASES_PER_BLOCK and N % _blocks.CASES_PER_BLOCK != 0
 
 
 def test_the_blocks_are_used_and_their_arrays_are_fresh_rows(sets):
-    """More than two blocks' cases take the blocked way: every output an array of the speeds' shape, writable,
+    """Enough cases take the blocked way: every output an array of the speeds' shape, writable,
     sharing memory with no input and no other output, and still its own once the next result is made."""
     v, params = sets["scalar parameters"]
     assert _blocks.blockable(np.asarray(v), r.impact_terms(**params))
