@@ -21,7 +21,7 @@ import threading
 
 import numpy as np
 
-__all__ = ["CASES_PER_BLOCK", "BLOCKS_FROM", "KEPT_BYTES", "blockable", "in_blocks"]
+__all__ = ["CASES_PER_BLOCK", "BLOCKS_FROM", "KEPT_BYTES", "blockable", "in_blocks", "is_whole_row"]
 
 #: Cases per block: each of a block's float temporaries is 256 kB; the thirty or so alive at once fit
 #: the shared cache. Fewer cases per call cost more in numpy's per-call overhead than they save.
@@ -76,6 +76,18 @@ def in_blocks(pipeline, v: np.ndarray, terms, want, dtype_of):
     if isinstance(values, dict):
         return {key: array.reshape(shape) for key, array in gathered.items()}
     return tuple(gathered[k].reshape(shape) for k in range(len(gathered)))
+
+
+def is_whole_row(array: np.ndarray) -> bool:
+    """Is ``array`` one whole row of a 2-D array that owns its memory, as :func:`in_blocks` returns the outputs?
+    Its bytes are then its own (rows never overlap), as an array's that owns its memory: a table or the
+    statistics of a sweep keep it without a copy."""
+    base = array.base
+    if not (isinstance(base, np.ndarray) and base.ndim == 2 and base.flags.owndata and base.flags.c_contiguous
+            and array.ndim == 1 and array.size == base.shape[1] and array.dtype == base.dtype):
+        return False
+    offset = array.__array_interface__["data"][0] - base.__array_interface__["data"][0]
+    return offset % base.strides[0] == 0
 
 
 def _rows(dtypes: dict, n: int) -> dict:

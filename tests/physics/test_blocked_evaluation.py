@@ -103,3 +103,17 @@ def test_every_value_is_the_one_before_the_change_bit_for_bit(before_package, bl
         before = pickle.load(f)
     assert before.keys() == blocked.keys()
     assert differing(blocked, before) == []
+
+
+def test_a_whole_row_of_a_block_is_told_from_other_views():
+    """is_whole_row, which lets a sweep's table and statistics keep impact's rows without a copy: true only
+    for a whole row of a 2-D array that owns its memory (rows never overlap), whatever the row."""
+    block = np.zeros((3, 10))
+    assert all(_blocks.is_whole_row(row) for row in block)
+    assert not _blocks.is_whole_row(block[1, 2:])  # part of a row
+    assert not _blocks.is_whole_row(block[:, 0])  # a column: strided across the rows
+    assert not _blocks.is_whole_row(np.zeros(10))  # owns its memory: no base at all
+    assert _blocks.is_whole_row(block[::2][1])  # a row of a view of rows: still a whole row of the block
+    assert not _blocks.is_whole_row(np.zeros(30).reshape(3, 10)[1])  # its memory's owner is 1-D
+    assert not _blocks.is_whole_row(block.reshape(-1)[3:13])  # a block's span across two rows
+    assert not _blocks.is_whole_row(block[0].view(np.int64))  # another dtype's view of a row

@@ -19,6 +19,7 @@ import math
 
 import numpy as np
 
+from .._blocks import is_whole_row
 from ..assumptions import E_NEGATIVE_MEANING, meaning_lines
 from ..fmu.models.sphere_plate_impact.variables import TABLE
 from ..output_files import write_json
@@ -138,11 +139,12 @@ def _bracket(n: int, p: float) -> tuple[int, int]:
 
 
 def _kept(column) -> np.ndarray:
-    """A chunk's column as the statistics keep it: a read-only view where the column owns its memory
-    (holding it costs what a copy would), else a copy (a view into a chunk's packed buffer or an Arrow
-    batch would keep every other column of the chunk alive with it)."""
+    """A chunk's column as the statistics keep it: a read-only view where the column owns its memory or
+    is a whole row of a block of outputs (holding it costs what a copy would: the statistics keep every
+    output the block holds), else a copy (a view into a chunk's packed buffer or an Arrow batch would
+    keep every other column of the chunk alive with it)."""
     column = np.asarray(column, dtype=float)
-    if column.base is not None:
+    if column.base is not None and not is_whole_row(column):
         return column.copy()
     view = column.view()
     view.flags.writeable = False

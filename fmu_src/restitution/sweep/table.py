@@ -15,6 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._blocks import is_whole_row
 from ..fmu.models.sphere_plate_impact.variables import TABLE
 from ..output_files import atomic_write as write_atomic
 from . import arrow_arrays
@@ -196,13 +197,15 @@ class TableBuilder:
 
 def _own_column(col, dtype, packed: bool):
     """A chunk's column as a table column without a copy where it can be one: a writable, contiguous
-    array of the table's type that no other column shares (an array the chunk owns, or a column of a
-    packed chunk's buffer, where each column has its own bytes); else a copy."""
+    array of the table's type that no other column shares (an array the chunk owns, a whole row of a 2-D
+    block, as ``impact`` returns its outputs over many cases, or a column of a packed chunk's buffer: each
+    has its own bytes); else a copy."""
     col = np.asarray(col)
     if (col.dtype == dtype and col.flags.c_contiguous and col.flags.writeable
-            and (col.flags.owndata or packed) and col.strides[0] != 0):
+            and (col.flags.owndata or packed or is_whole_row(col)) and col.strides[0] != 0):
         return col
     return np.array(col, dtype=dtype)
+
 
 
 def keep_columns(columns):
