@@ -19,8 +19,6 @@ import math
 import shutil
 import subprocess
 import sys
-import tarfile
-import io
 from pathlib import Path
 
 import numpy as np
@@ -29,6 +27,7 @@ import pytest
 from restitution.agreement import disagreements
 from restitution.fmu.describe.c_header import variables
 
+from git_sources import package_at
 from cases import FMU_FLAGS, FMU_REALS
 
 pytestmark = pytest.mark.skipif(shutil.which("gcc") is None, reason="gcc is needed to build the native FMU")
@@ -125,15 +124,7 @@ def _build(sources: Path, out: Path, version: str) -> Path:
 
 @pytest.fixture(scope="module")
 def before_sources(tmp_path_factory) -> Path:
-    if shutil.which("git") is None:
-        pytest.skip("git is needed to take the sources of the commit before the change")
-    done = subprocess.run(["git", "-C", str(ROOT), "archive", BEFORE, "fmu_src/restitution"], capture_output=True)
-    if done.returncode != 0:
-        pytest.skip(f"commit {BEFORE} is not in this checkout's history: {done.stderr.decode(errors='replace')[:200]}")
-    where = tmp_path_factory.mktemp("before")
-    with tarfile.open(fileobj=io.BytesIO(done.stdout)) as tar:
-        tar.extractall(where)
-    return where / "fmu_src"
+    return package_at(BEFORE, tmp_path_factory.mktemp("before"))
 
 
 def _read(fmu: Path, version: str, cases) -> list:

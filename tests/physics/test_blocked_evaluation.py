@@ -10,11 +10,8 @@ arrays and scalar ones, a 2-D speed array, several option sets, the whole result
 """
 from __future__ import annotations
 
-import io
-import shutil
 import subprocess
 import sys
-import tarfile
 from pathlib import Path
 
 import numpy as np
@@ -22,10 +19,13 @@ import pytest
 
 import restitution as r
 from restitution import _blocks
+from git_sources import package_at
 from blocked_cases import N, case_sets, differing, evaluate
 
 ROOT = Path(__file__).resolve().parents[2]
 BEFORE = "822cf88"  #: the last commit that evaluated large arrays whole, into fresh arrays
+
+
 @pytest.fixture(scope="module")
 def sets():
     return case_sets()
@@ -80,15 +80,7 @@ with open(sys.argv[3], "wb") as f:
 
 @pytest.fixture(scope="module")
 def before_package(tmp_path_factory) -> Path:
-    if shutil.which("git") is None:
-        pytest.skip("git is needed to take the package of the commit before the change")
-    done = subprocess.run(["git", "-C", str(ROOT), "archive", BEFORE, "fmu_src/restitution"], capture_output=True)
-    if done.returncode != 0:
-        pytest.skip(f"commit {BEFORE} is not in this checkout's history: {done.stderr.decode(errors='replace')[:200]}")
-    where = tmp_path_factory.mktemp("before")
-    with tarfile.open(fileobj=io.BytesIO(done.stdout)) as tar:
-        tar.extractall(where)
-    return where / "fmu_src"
+    return package_at(BEFORE, tmp_path_factory.mktemp("before"))
 
 
 def test_every_value_is_the_one_before_the_change_bit_for_bit(before_package, blocked, tmp_path):
