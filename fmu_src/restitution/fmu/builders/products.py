@@ -18,8 +18,8 @@ from .toolchains import NativeBuildSkipped
 from .files import BuildError, writable_dir
 from .plan import build_info, full_plan, model_plan, steps, to_build, zig_targets
 from .progress import PREFIX, Progress, stderr_line
-from .python_fmu import FMUS, build_one
-from .sources import PACKAGE
+from .python_fmu import build_one
+from .sources import FMUS, PACKAGE
 
 __all__ = ["FMUS", "SCOPES", "BuildError", "build_all", "build_one", "default_fmu", "default_fmu_dir", "run"]
 

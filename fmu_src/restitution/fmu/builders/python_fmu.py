@@ -38,10 +38,9 @@ from ..models import SLAVE_SUPPORT, table
 from .files import BuildError, place, rewrite_zip, writable_dir
 from .licenses import documentation_files
 from .sources import BUILD_INFO, FMUS, PACKAGE, PYTHONFMU_FOLDERS, bundle_filter, source_hash
-from .toolchains import pythonfmu_label as toolchain_label
+from .toolchains import pythonfmu_label
 
 __all__ = ["FMUS", "build_one", "registered_variables"]
-
 
 
 def _require_build_tools():
@@ -75,8 +74,6 @@ def _check_registration(model: str, xml_text: str) -> None:
                          f"table {expected[first:first + 1]})")
 
 
-
-
 def _guard_compiler_found() -> bool:
     from .toolchains import ToolchainMissing, compiler
 
@@ -106,7 +103,7 @@ def build_one(model: str, out_dir: Path, guard: bool = True, log=None, progress=
     except ValueError as exc:
         raise BuildError(str(exc)) from None
     out_dir = writable_dir(out_dir)
-    with (progress or quiet()).step(f"{model}.fmu", ", ".join(PYTHONFMU_FOLDERS), toolchain_label(guard)):
+    with (progress or quiet()).step(f"{model}.fmu", ", ".join(PYTHONFMU_FOLDERS), pythonfmu_label(guard)):
         return _build(model, out_dir, guard, log, FmuBuilder, validate_fmu)
 
 
