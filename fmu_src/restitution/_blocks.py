@@ -21,7 +21,7 @@ import threading
 
 import numpy as np
 
-__all__ = ["CASES_PER_BLOCK", "BLOCKS_FROM", "KEPT_BYTES", "blockable", "in_blocks", "is_whole_row"]
+__all__ = ["CASES_PER_BLOCK", "BLOCKS_FROM", "KEPT_BYTES", "blockable", "in_blocks", "is_whole_row", "has_own_bytes"]
 
 #: Cases per block: each of a block's float temporaries is 256 kB; the thirty or so alive at once fit
 #: the shared cache. Fewer cases per call cost more in numpy's per-call overhead than they save.
@@ -34,8 +34,6 @@ BLOCKS_FROM = 4
 #: output: 144 MB). A larger result's blocks are fresh memory, given back when it is gone.
 KEPT_BYTES = 256 * 2**20
 
-#: The :class:`~restitution.model.ImpactTerms` fields that may be arrays (one value per case).
-_PER_CASE = ("V_c", "eps_y", "m_a", "time_factor", "lambda_factor", "echo_time")
 
 _KEPT: dict = {}  # (dtype, rows, cases) -> a block made for them (2-D), the most recent last
 _KEPT_LOCK = threading.Lock()
@@ -49,7 +47,12 @@ def blockable(v: np.ndarray, terms) -> bool:
         return False
     if terms.floats:
         return True
-    return all(np.ndim(x) == 0 or np.shape(x) == v.shape for x in (getattr(terms, f) for f in _PER_CASE))
+    return all(x.shape == v.shape for x in _per_case(terms).values())
+
+
+def _per_case(terms) -> dict:
+    """The :class:`~restitution.model.ImpactTerms` fields that hold a value per case (arrays), by name."""
+    return {f: x for f, x in terms._asdict().items() if isinstance(x, np.ndarray) and x.ndim}
 
 
 def in_blocks(pipeline, v: np.ndarray, terms, want, dtype_of):
@@ -61,7 +64,7 @@ def in_blocks(pipeline, v: np.ndarray, terms, want, dtype_of):
     shares as a scalar), written into their rows by one assignment each."""
     shape, n = v.shape, v.size
     flat_v = v.reshape(-1)
-    per_case = {f: np.reshape(x, -1) for f in _PER_CASE if np.ndim(x := getattr(terms, f)) != 0}
+    per_case = {f: x.reshape(-1) for f, x in _per_case(terms).items()}
     gathered = None
     for start in range(0, n, CASES_PER_BLOCK):
         stop = min(start + CASES_PER_BLOCK, n)
@@ -88,6 +91,12 @@ def is_whole_row(array: np.ndarray) -> bool:
         return False
     offset = array.__array_interface__["data"][0] - base.__array_interface__["data"][0]
     return offset % base.strides[0] == 0
+
+
+def has_own_bytes(array: np.ndarray) -> bool:
+    """Does ``array`` own its memory, or is it a whole row of such a 2-D array (:func:`is_whole_row`)? Either
+    way no other array's bytes are among its own."""
+    return array.flags.owndata or is_whole_row(array)
 
 
 def _rows(dtypes: dict, n: int) -> dict:

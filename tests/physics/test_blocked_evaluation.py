@@ -109,3 +109,5 @@ def test_a_whole_row_of_a_block_is_told_from_other_views():
     assert not _blocks.is_whole_row(np.zeros(30).reshape(3, 10)[1])  # its memory's owner is 1-D
     assert not _blocks.is_whole_row(block.reshape(-1)[3:13])  # a block's span across two rows
     assert not _blocks.is_whole_row(block[0].view(np.int64))  # another dtype's view of a row
+    assert _blocks.has_own_bytes(block[1]) and _blocks.has_own_bytes(np.zeros(3))
+    assert not _blocks.has_own_bytes(block[1, 2:]) and not _blocks.has_own_bytes(np.zeros(6)[::2])

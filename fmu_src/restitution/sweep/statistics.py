@@ -19,7 +19,7 @@ import math
 
 import numpy as np
 
-from .._blocks import is_whole_row
+from .._blocks import has_own_bytes
 from ..assumptions import E_NEGATIVE_MEANING, meaning_lines
 from ..fmu.models.sphere_plate_impact.variables import TABLE
 from ..output_files import write_json
@@ -144,7 +144,7 @@ def _kept(column) -> np.ndarray:
     output the block holds), else a copy (a view into a chunk's packed buffer or an Arrow batch would
     keep every other column of the chunk alive with it)."""
     column = np.asarray(column, dtype=float)
-    if column.base is not None and not is_whole_row(column):
+    if not has_own_bytes(column):
         return column.copy()
     view = column.view()
     view.flags.writeable = False

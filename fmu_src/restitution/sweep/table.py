@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .._blocks import is_whole_row
+from .._blocks import has_own_bytes
 from ..fmu.models.sphere_plate_impact.variables import TABLE
 from ..output_files import atomic_write as write_atomic
 from . import arrow_arrays
@@ -202,7 +202,7 @@ def _own_column(col, dtype, packed: bool):
     has its own bytes); else a copy."""
     col = np.asarray(col)
     if (col.dtype == dtype and col.flags.c_contiguous and col.flags.writeable
-            and (col.flags.owndata or packed or is_whole_row(col)) and col.strides[0] != 0):
+            and (packed or has_own_bytes(col)) and col.strides[0] != 0):
         return col
     return np.array(col, dtype=dtype)
 
